@@ -1,0 +1,93 @@
+//! Shared helpers for the integration tests: small scenes built directly as descriptions, and
+//! rendering them through the same factory and CPU backend the CLI uses.
+
+use volpt_core::{PathSettings, Scene};
+use volpt_render::{render, with_scene, Image, RenderOptions, RenderStats, SceneVisitor};
+use volpt_scene::description::*;
+
+/// A camera at `origin` looking at the world origin with `up` = +y, Mitsuba's `lookat`.
+pub fn look_at(origin: [f32; 3]) -> Matrix4 {
+    let o = glam_vec(origin);
+    let dir = (-o).normalize();
+    let left = glam::Vec3::Y.cross(dir).normalize();
+    let up = dir.cross(left);
+    [
+        [left.x, up.x, dir.x, o.x],
+        [left.y, up.y, dir.y, o.y],
+        [left.z, up.z, dir.z, o.z],
+        [0.0, 0.0, 0.0, 1.0],
+    ]
+}
+
+fn glam_vec(v: [f32; 3]) -> glam::Vec3 {
+    glam::Vec3::from_array(v)
+}
+
+/// A `width` x `height` view of the unit cube [-0.5, 0.5]^3 from an oblique direction, so that
+/// rays cross it through faces, edges and corners, with a constant environment of radiance `env`.
+pub fn cube_scene(width: u32, height: u32, medium: MediumDesc, bsdf: BsdfDesc, env: f32) -> SceneDescription {
+    SceneDescription {
+        camera: CameraDesc {
+            to_world: look_at([2.0, 1.5, 2.5]),
+            fov_degrees: 45.0,
+            fov_axis: FovAxis::X,
+        },
+        film: FilmDesc { width, height },
+        spp: 16,
+        integrator: IntegratorDesc {
+            max_depth: None,
+            rr_depth: None,
+        },
+        boundary: BoundaryDesc {
+            bounds: Bounds {
+                min: [-0.5; 3],
+                max: [0.5; 3],
+            },
+            bsdf,
+        },
+        medium,
+        environment: EnvironmentDesc::Constant([env; 3]),
+    }
+}
+
+pub fn homogeneous(sigma_t: f32, albedo: f32, phase: PhaseDesc) -> MediumDesc {
+    MediumDesc {
+        density: DensityDesc::Constant(sigma_t),
+        scale: 1.0,
+        albedo: AlbedoDesc::Constant([albedo; 3]),
+        phase,
+    }
+}
+
+struct Cpu(RenderOptions);
+
+impl SceneVisitor for Cpu {
+    type Output = (Image, RenderStats);
+    fn visit<S: Scene + Sync>(self, scene: &S) -> Self::Output {
+        render(scene, &self.0, &|_, _| {}).expect("render")
+    }
+}
+
+/// Renders `desc` on the CPU with `spp` samples and the scene's integrator settings.
+pub fn render_cpu(desc: &SceneDescription, spp: u32, seed: u32) -> (Image, RenderStats) {
+    render_with(desc, spp, seed, volpt_render::path_settings(desc))
+}
+
+pub fn render_with(
+    desc: &SceneDescription,
+    spp: u32,
+    seed: u32,
+    settings: PathSettings,
+) -> (Image, RenderStats) {
+    let options = RenderOptions {
+        spp,
+        seed,
+        threads: None,
+    };
+    with_scene(desc, settings, Cpu(options))
+}
+
+/// Visits the built scene with a closure-like visitor, for tests that need the core scene itself.
+pub fn with_core_scene<V: SceneVisitor>(desc: &SceneDescription, visitor: V) -> V::Output {
+    with_scene(desc, volpt_render::path_settings(desc), visitor)
+}

@@ -1,0 +1,90 @@
+//! `volpt info`: what a scene loads to, in words.
+
+use std::fmt::Write;
+use std::path::Path;
+
+use volpt_render::Variant;
+use volpt_scene::{
+    AlbedoDesc, BsdfDesc, DensityDesc, EnvironmentDesc, GridDesc, PhaseDesc, SceneDescription,
+};
+
+pub fn describe(path: &Path, desc: &SceneDescription) -> String {
+    let mut s = String::new();
+    let b = &desc.boundary.bounds;
+    let m = &desc.medium;
+    let _ = writeln!(s, "scene      {}", path.display());
+    let _ = writeln!(s, "variant    {}", Variant::of(desc));
+    let _ = writeln!(
+        s,
+        "film       {}x{}, {} spp",
+        desc.film.width, desc.film.height, desc.spp
+    );
+    let _ = writeln!(
+        s,
+        "camera     origin {:?}, fov {} deg along {:?}",
+        [
+            desc.camera.to_world[0][3],
+            desc.camera.to_world[1][3],
+            desc.camera.to_world[2][3]
+        ],
+        desc.camera.fov_degrees,
+        desc.camera.fov_axis
+    );
+    let depth = |d: Option<u32>| d.map_or("unlimited".to_owned(), |d| d.to_string());
+    let _ = writeln!(
+        s,
+        "integrator volpath, max depth {}, roulette from depth {}",
+        depth(desc.integrator.max_depth),
+        depth(desc.integrator.rr_depth)
+    );
+    let _ = writeln!(s, "bounds     {:?} .. {:?}", b.min, b.max);
+    let boundary = match desc.boundary.bsdf {
+        BsdfDesc::Null => "index-matched (null)".to_owned(),
+        BsdfDesc::Dielectric { int_ior, ext_ior } => {
+            format!("smooth dielectric, int IOR {int_ior}, ext IOR {ext_ior}")
+        }
+        BsdfDesc::RoughDielectric {
+            alpha,
+            int_ior,
+            ext_ior,
+        } => format!("GGX rough dielectric, alpha {alpha}, int IOR {int_ior}, ext IOR {ext_ior}"),
+    };
+    let _ = writeln!(s, "boundary   {boundary}");
+    let grid = |g: &GridDesc| {
+        let (lo, hi) = g
+            .data
+            .iter()
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &v| {
+                (lo.min(v), hi.max(v))
+            });
+        format!(
+            "grid {}x{}x{}x{}, {:?}-centred, bounds {:?} .. {:?}, values {lo} .. {hi}",
+            g.resolution[0],
+            g.resolution[1],
+            g.resolution[2],
+            g.channels,
+            g.convention,
+            g.bounds.min,
+            g.bounds.max
+        )
+    };
+    let (density, majorant) = match &m.density {
+        DensityDesc::Constant(d) => (format!("constant {d}"), m.scale * d),
+        DensityDesc::Grid(g) => (grid(g), m.scale * g.max_value()),
+    };
+    let _ = writeln!(s, "density    {density}, scale {}", m.scale);
+    let _ = writeln!(s, "majorant   {majorant} per unit length");
+    let albedo = match &m.albedo {
+        AlbedoDesc::Constant(rgb) => format!("constant {rgb:?}"),
+        AlbedoDesc::Grid(g) => grid(g),
+    };
+    let _ = writeln!(s, "albedo     {albedo}");
+    let phase = match m.phase {
+        PhaseDesc::Isotropic => "isotropic".to_owned(),
+        PhaseDesc::HenyeyGreenstein { g } => format!("Henyey-Greenstein, g {g}"),
+    };
+    let _ = writeln!(s, "phase      {phase}");
+    let EnvironmentDesc::Constant(rgb) = desc.environment;
+    let _ = writeln!(s, "light      constant environment, radiance {rgb:?}");
+    s
+}

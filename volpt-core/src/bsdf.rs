@@ -1,0 +1,136 @@
+//! The medium's boundary: index-matched, smooth dielectric or GGX rough dielectric.
+//!
+//! Conventions: `n` is the boundary's outward unit normal and `d` the ray's propagation direction when
+//! it reaches the boundary, from either side. The sample is the new propagation direction. `eta` is
+//! `n_inside / n_outside`.
+
+use crate::frame::Frame;
+use crate::fresnel::fresnel_dielectric_cos;
+use crate::microfacet::Ggx;
+use crate::{Vec2, Vec3};
+
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample {
+    /// New propagation direction.
+    pub wo: Vec3,
+    /// `f * |cos| / pdf` of the sample, including the radiance scaling `1 / eta^2` on refraction.
+    pub weight: f32,
+    /// The path crossed the boundary.
+    pub transmitted: bool,
+    /// Relative index `n_t / n_i` the path crossed (1 when reflected); Russian roulette divides the
+    /// radiance scaling back out with it, as Mitsuba does.
+    pub eta: f32,
+}
+
+pub trait Bsdf {
+    /// An index-matched boundary: crossing it changes nothing and is not an interaction, so the path
+    /// step skips the BSDF and its random numbers entirely.
+    const IS_NULL: bool = false;
+
+    /// Samples the interaction of a ray travelling along `d` with the boundary of outward normal `n`,
+    /// or `None` when the sample carries no energy.
+    fn sample(&self, n: Vec3, d: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample>;
+}
+
+/// Index-matched (Mitsuba's `null`) boundary.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NullBoundary;
+
+impl Bsdf for NullBoundary {
+    const IS_NULL: bool = true;
+
+    #[inline]
+    fn sample(&self, _n: Vec3, d: Vec3, _u_lobe: f32, _u: Vec2) -> Option<BsdfSample> {
+        Some(BsdfSample {
+            wo: d,
+            weight: 1.0,
+            transmitted: true,
+            eta: 1.0,
+        })
+    }
+}
+
+/// Smooth dielectric interface: specular reflection with probability F, refraction otherwise.
+#[derive(Clone, Copy, Debug)]
+pub struct SmoothDielectric {
+    pub eta: f32,
+}
+
+impl Bsdf for SmoothDielectric {
+    #[inline]
+    fn sample(&self, n: Vec3, d: Vec3, u_lobe: f32, _u: Vec2) -> Option<BsdfSample> {
+        scatter_off_microfacet(n, d, self.eta, u_lobe, |_wi| (Vec3::Z, None))
+    }
+}
+
+/// GGX rough dielectric interface (Walter et al. 2007), sampled with the distribution of visible
+/// normals (Heitz 2018). Masking is Smith's separable form, as in Mitsuba's `roughdielectric`.
+#[derive(Clone, Copy, Debug)]
+pub struct RoughDielectric {
+    pub eta: f32,
+    pub distribution: Ggx,
+}
+
+impl Bsdf for RoughDielectric {
+    #[inline]
+    fn sample(&self, n: Vec3, d: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        let ggx = self.distribution;
+        scatter_off_microfacet(n, d, self.eta, u_lobe, |wi| {
+            (ggx.sample_visible_normal(wi, u), Some(ggx))
+        })
+    }
+}
+
+/// Reflects or refracts at a microfacet `m` chosen by `pick_normal` (in the local frame where the
+/// incident side is +z), choosing reflection with probability `F(wi . m)`.
+///
+/// With `m` drawn from the visible normals of `wi` and the lobe chosen by F, the estimator weight of
+/// Walter's BSDF reduces to `G1(wo, m)` (Heitz 2018, sec. 4; Mitsuba's `roughdielectric`), times
+/// `1 / eta^2` on refraction because radiance is not invariant across the interface (Veach 1997, 5.2).
+#[inline]
+fn scatter_off_microfacet(
+    n: Vec3,
+    d: Vec3,
+    eta: f32,
+    u_lobe: f32,
+    pick_normal: impl FnOnce(Vec3) -> (Vec3, Option<Ggx>),
+) -> Option<BsdfSample> {
+    // Local frame whose +z is on the side the light arrives from.
+    let outside = d.dot(n) < 0.0;
+    let frame = Frame::from_z(if outside { n } else { -n });
+    let wi = frame.to_local(-d);
+    if wi.z <= 0.0 {
+        return None;
+    }
+    let eta = if outside { eta } else { 1.0 / eta };
+    let (m, ggx) = pick_normal(wi);
+    let cos_im = wi.dot(m);
+    if cos_im <= 0.0 {
+        return None;
+    }
+    let (reflectance, cos_t) = fresnel_dielectric_cos(cos_im, eta);
+    let reflected = u_lobe < reflectance;
+    let (wo, relative_eta) = if reflected {
+        (m * (2.0 * cos_im) - wi, 1.0)
+    } else {
+        (m * (cos_im / eta - cos_t) - wi / eta, eta)
+    };
+    // A reflection must stay on the incident side and a refraction must cross.
+    if (wo.z > 0.0) != reflected {
+        return None;
+    }
+    let masking = match ggx {
+        Some(ggx) => ggx.g1(wo, m),
+        None => 1.0,
+    };
+    let weight = masking / (relative_eta * relative_eta);
+    if weight <= 0.0 {
+        return None;
+    }
+    Some(BsdfSample {
+        wo: frame.to_world(wo).normalize(),
+        weight,
+        transmitted: !reflected,
+        eta: relative_eta,
+    })
+}

@@ -1,0 +1,32 @@
+//! The pinhole perspective camera, in Mitsuba's conventions.
+
+use crate::{Ray, Vec2, Vec3};
+
+/// Camera space looks along +z with +y up and +x to the image's *left* (Mitsuba's convention, which
+/// its `lookat` builds); image x grows to the right and image y downwards.
+#[derive(Clone, Copy, Debug)]
+pub struct PerspectiveCamera {
+    pub origin: Vec3,
+    /// Images of the camera-space axes under the camera's to-world transform (not normalised: a
+    /// mirroring or scaling transform acts on directions as in Mitsuba).
+    pub axis_x: Vec3,
+    pub axis_y: Vec3,
+    pub axis_z: Vec3,
+    /// `tan(fov_x / 2)` and `tan(fov_y / 2)`.
+    pub tan_half_fov: Vec2,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl PerspectiveCamera {
+    /// The primary ray through the film position `(px + u.x, py + u.y)` in pixels.
+    #[inline]
+    pub fn generate_ray(&self, px: u32, py: u32, u: Vec2) -> Ray {
+        let sx = (px as f32 + u.x) / self.width as f32;
+        let sy = (py as f32 + u.y) / self.height as f32;
+        let x = (1.0 - 2.0 * sx) * self.tan_half_fov.x;
+        let y = (1.0 - 2.0 * sy) * self.tan_half_fov.y;
+        let dir = (self.axis_x * x + self.axis_y * y + self.axis_z).normalize();
+        Ray::new(self.origin, dir)
+    }
+}

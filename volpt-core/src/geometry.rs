@@ -1,0 +1,141 @@
+//! Rays and the axis-aligned box that bounds the medium.
+
+use crate::Vec3;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    pub origin: Vec3,
+    /// Unit propagation direction.
+    pub dir: Vec3,
+}
+
+impl Ray {
+    #[inline]
+    pub fn new(origin: Vec3, dir: Vec3) -> Self {
+        Self { origin, dir }
+    }
+
+    #[inline]
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.origin + self.dir * t
+    }
+}
+
+/// Where a ray meets a face of the box: the distance, the point (snapped exactly onto the face's
+/// plane, so that no later test sees it a rounding error inside or outside) and the outward normal.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoxHit {
+    pub t: f32,
+    pub point: Vec3,
+    pub normal: Vec3,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    pub min: Vec3,
+    pub max: Vec3,
+}
+
+impl Aabb {
+    #[inline]
+    pub fn new(min: Vec3, max: Vec3) -> Self {
+        Self { min, max }
+    }
+
+    #[inline]
+    pub fn extent(&self) -> Vec3 {
+        self.max - self.min
+    }
+
+    #[inline]
+    pub fn contains(&self, p: Vec3) -> bool {
+        p.cmpge(self.min).all() && p.cmple(self.max).all()
+    }
+
+    /// Where a ray from outside enters the box, if it does. A ray whose origin lies inside or on the
+    /// box and that points away from it does not enter: the slab test's entry distance is then
+    /// negative. Edges and corners resolve to one face, that of the last slab entered.
+    #[inline]
+    pub fn entry(&self, ray: &Ray) -> Option<BoxHit> {
+        let inv = ray.dir.recip();
+        let t0 = (self.min - ray.origin) * inv;
+        let t1 = (self.max - ray.origin) * inv;
+        let near = t0.min(t1);
+        let far = t0.max(t1);
+        // NaN (0 * inf, a ray in a face's plane) must not win a max/min: treat it as "no constraint".
+        let near = Vec3::select(near.cmpeq(near), near, Vec3::splat(f32::NEG_INFINITY));
+        let far = Vec3::select(far.cmpeq(far), far, Vec3::splat(f32::INFINITY));
+        let axis = argmax(near);
+        let t_enter = near[axis];
+        let t_leave = far.min_element();
+        if !(t_enter >= 0.0 && t_enter <= t_leave) {
+            return None;
+        }
+        let mut point = ray.at(t_enter);
+        let entering_max_face = ray.dir[axis] < 0.0;
+        point[axis] = if entering_max_face {
+            self.max[axis]
+        } else {
+            self.min[axis]
+        };
+        Some(BoxHit {
+            t: t_enter,
+            point: self.clamp(point),
+            normal: axis_normal(axis, entering_max_face),
+        })
+    }
+
+    /// Where a ray whose origin is inside (or on) the box leaves it. Only the far planes are used, so
+    /// the answer is right for an origin on a face, edge or corner, and never negative.
+    #[inline]
+    pub fn exit(&self, ray: &Ray) -> BoxHit {
+        let far_plane = Vec3::select(ray.dir.cmpgt(Vec3::ZERO), self.max, self.min);
+        let t = (far_plane - ray.origin) / ray.dir;
+        // Axes the ray runs parallel to give +-inf or NaN: never the exit face.
+        let t = Vec3::select(t.cmpeq(t), t, Vec3::splat(f32::INFINITY));
+        let t = Vec3::select(ray.dir.cmpeq(Vec3::ZERO), Vec3::splat(f32::INFINITY), t);
+        let axis = argmin(t);
+        let t_exit = t[axis].max(0.0);
+        let mut point = ray.at(t_exit);
+        point[axis] = far_plane[axis];
+        BoxHit {
+            t: t_exit,
+            point: self.clamp(point),
+            normal: axis_normal(axis, ray.dir[axis] > 0.0),
+        }
+    }
+
+    #[inline]
+    fn clamp(&self, p: Vec3) -> Vec3 {
+        p.max(self.min).min(self.max)
+    }
+}
+
+#[inline]
+fn axis_normal(axis: usize, positive: bool) -> Vec3 {
+    let mut n = Vec3::ZERO;
+    n[axis] = if positive { 1.0 } else { -1.0 };
+    n
+}
+
+#[inline]
+fn argmax(v: Vec3) -> usize {
+    if v.x >= v.y && v.x >= v.z {
+        0
+    } else if v.y >= v.z {
+        1
+    } else {
+        2
+    }
+}
+
+#[inline]
+fn argmin(v: Vec3) -> usize {
+    if v.x <= v.y && v.x <= v.z {
+        0
+    } else if v.y <= v.z {
+        1
+    } else {
+        2
+    }
+}

@@ -1,0 +1,37 @@
+//! volpt's physics, generic over the scene's parts and free of `std`, so that the same source is
+//! monomorphised into the CPU renderer and into GPU kernels.
+//!
+//! Read [`path`] first: one step of a volumetric path, the algorithm every backend runs.
+#![no_std]
+
+pub mod bsdf;
+pub mod camera;
+pub mod environment;
+pub mod frame;
+pub mod fresnel;
+pub mod geometry;
+pub mod grid;
+pub mod math;
+pub mod medium;
+pub mod microfacet;
+pub mod path;
+pub mod phase;
+pub mod rng;
+pub mod sampling;
+pub mod scene;
+pub mod tracking;
+
+pub use bsdf::{Bsdf, BsdfSample, NullBoundary, RoughDielectric, SmoothDielectric};
+pub use camera::PerspectiveCamera;
+pub use environment::{ConstantEnvironment, Environment};
+pub use geometry::{Aabb, Ray};
+pub use grid::{Grid, GridMapping};
+pub use medium::{AlbedoField, ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium, Medium};
+pub use path::{PathCounters, PathSettings, PathState};
+pub use phase::{HenyeyGreenstein, Isotropic, PhaseFunction};
+pub use rng::Rng;
+pub use scene::{Scene, VolumeScene};
+
+/// Linear RGB radiance, throughput or albedo.
+pub type Spectrum = glam::Vec3;
+pub use glam::{Vec2, Vec3};

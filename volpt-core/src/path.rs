@@ -1,0 +1,241 @@
+//! One step of a volumetric path: the algorithm every backend and every scheduling strategy runs.
+//!
+//! A path starts at the camera and alternates free flights with interactions until it escapes to
+//! the environment or dies:
+//!
+//! ```text
+//! outside the box:  fly straight; miss the box -> add throughput * environment, done
+//!                                 hit the box  -> boundary interaction
+//! inside the box:   delta-track to the next collision before the exit face
+//!                   collision   -> scatter: throughput *= albedo, sample the phase function
+//!                   no collision -> boundary interaction at the exit face
+//! boundary:         index-matched -> cross unchanged (not an interaction)
+//!                   dielectric    -> reflect or refract, throughput *= BSDF weight
+//! ```
+//!
+//! This is pure path tracing with the environment as the only light, an unbiased estimator of the
+//! volume rendering equation (Kajiya 1986; Veach 1997 ch. 4); every sample is importance sampled
+//! exactly except the microfacet masking, so weights stay near 1. Depth and roulette follow Mitsuba's
+//! `volpath`: `depth` counts scattering events and dielectric interactions, a path may see the light
+//! after at most `max_depth - 1` of them, and from `rr_depth` on it survives with probability
+//! `min(max(throughput) * eta^2, 0.95)`.
+
+use crate::bsdf::Bsdf;
+use crate::geometry::BoxHit;
+use crate::medium::Medium;
+use crate::phase::PhaseFunction;
+use crate::rng::Rng;
+use crate::scene::Scene;
+use crate::tracking::delta_tracking;
+use crate::{Ray, Spectrum, Vec3};
+
+/// The integrator's limits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PathSettings {
+    /// Longest path in segments (Mitsuba's `max_depth`); `u32::MAX` for unlimited.
+    pub max_depth: u32,
+    /// Depth from which Russian roulette runs; `u32::MAX` for never.
+    pub rr_depth: u32,
+    /// A safety bound on free flights per path. Without roulette and depth limit, a path in a
+    /// non-absorbing medium behind a reflecting boundary can in principle bounce for ever; a path
+    /// that reaches this bound is dropped (it contributes zero) and counted as truncated.
+    pub max_segments: u32,
+}
+
+impl PathSettings {
+    pub const UNLIMITED: u32 = u32::MAX;
+}
+
+impl Default for PathSettings {
+    fn default() -> Self {
+        Self {
+            max_depth: Self::UNLIMITED,
+            rr_depth: 5,
+            max_segments: 1 << 22,
+        }
+    }
+}
+
+/// Everything a path carries between steps: small and `Copy`, so that strategies can park paths in
+/// device memory and resume them anywhere.
+#[derive(Clone, Copy, Debug)]
+pub struct PathState {
+    pub ray: Ray,
+    pub throughput: Spectrum,
+    /// Radiance gathered so far (only ever added when the path escapes).
+    pub radiance: Spectrum,
+    pub rng: Rng,
+    /// Interactions so far (scattering events and dielectric reflections or refractions).
+    pub depth: u32,
+    /// Product of the relative indices crossed, for roulette.
+    pub eta_scale: f32,
+    /// Free flights so far (one per step).
+    pub segments: u32,
+    /// Tentative collisions of delta tracking so far.
+    pub tracking_steps: u32,
+    pub inside: bool,
+    pub alive: bool,
+    pub truncated: bool,
+}
+
+impl PathState {
+    /// Sample `sample` of pixel `(px, py)`: a camera ray through a uniformly jittered film position.
+    #[inline]
+    pub fn from_camera<S: Scene>(scene: &S, px: u32, py: u32, sample: u32, seed: u32) -> Self {
+        let camera = scene.camera();
+        let mut rng = Rng::new(seed, py * camera.width + px, sample);
+        let ray = camera.generate_ray(px, py, rng.next_2d());
+        Self {
+            ray,
+            throughput: Spectrum::ONE,
+            radiance: Spectrum::ZERO,
+            rng,
+            depth: 0,
+            eta_scale: 1.0,
+            segments: 0,
+            tracking_steps: 0,
+            inside: scene.bounds().contains(ray.origin),
+            alive: true,
+            truncated: false,
+        }
+    }
+
+    /// Counts an interaction; false (and the path ends) if it is one more than `max_depth` allows.
+    #[inline]
+    fn begin_interaction(&mut self, settings: &PathSettings) -> bool {
+        self.depth += 1;
+        self.alive = self.depth < settings.max_depth;
+        self.alive
+    }
+
+    #[inline]
+    fn russian_roulette(&mut self, settings: &PathSettings) {
+        if self.depth <= settings.rr_depth {
+            return;
+        }
+        let q = (self.throughput.max_element() * self.eta_scale * self.eta_scale).min(0.95);
+        if self.rng.next_f32() < q {
+            self.throughput /= q;
+        } else {
+            self.alive = false;
+        }
+    }
+}
+
+/// Advances `path` by one free flight and the event that ends it.
+#[inline]
+pub fn step<S: Scene>(scene: &S, path: &mut PathState) {
+    path.segments += 1;
+    if path.segments > scene.settings().max_segments {
+        path.truncated = true;
+        path.alive = false;
+        return;
+    }
+    if path.inside {
+        let exit = scene.bounds().exit(&path.ray);
+        let collision = delta_tracking(
+            scene.medium(),
+            &path.ray,
+            exit.t,
+            &mut path.rng,
+            &mut path.tracking_steps,
+        );
+        match collision {
+            Some(t) => scatter(scene, path, path.ray.at(t)),
+            None => interact_with_boundary(scene, path, exit),
+        }
+    } else {
+        match scene.bounds().entry(&path.ray) {
+            Some(hit) => interact_with_boundary(scene, path, hit),
+            None => {
+                path.radiance += path.throughput * scene.background(path.ray.dir);
+                path.alive = false;
+            }
+        }
+    }
+}
+
+/// Runs `path` to its end.
+#[inline]
+pub fn trace<S: Scene>(scene: &S, path: &mut PathState) {
+    while path.alive {
+        step(scene, path);
+    }
+}
+
+/// A real collision at `p`: the albedo scales the throughput (the scattering/extinction ratio of the
+/// collision estimator) and the phase function, sampled exactly, gives the new direction.
+#[inline]
+fn scatter<S: Scene>(scene: &S, path: &mut PathState, p: Vec3) {
+    let settings = scene.settings();
+    if !path.begin_interaction(settings) {
+        return;
+    }
+    path.throughput *= scene.medium().albedo(p);
+    if path.throughput == Spectrum::ZERO {
+        // A black albedo absorbs the path: nothing it could gather would count.
+        path.alive = false;
+        return;
+    }
+    let sample = scene.phase().sample(path.ray.dir, path.rng.next_2d());
+    path.ray = Ray::new(p, sample.wo);
+    path.russian_roulette(settings);
+}
+
+#[inline]
+fn interact_with_boundary<S: Scene>(scene: &S, path: &mut PathState, hit: BoxHit) {
+    if S::Bsdf::IS_NULL {
+        path.ray.origin = hit.point;
+        path.inside = !path.inside;
+        return;
+    }
+    let settings = scene.settings();
+    if !path.begin_interaction(settings) {
+        return;
+    }
+    let u_lobe = path.rng.next_f32();
+    let u = path.rng.next_2d();
+    match scene.boundary().sample(hit.normal, path.ray.dir, u_lobe, u) {
+        Some(sample) => {
+            path.throughput *= sample.weight;
+            if sample.transmitted {
+                path.inside = !path.inside;
+                path.eta_scale *= sample.eta;
+            }
+            path.ray = Ray::new(hit.point, sample.wo);
+            path.russian_roulette(settings);
+        }
+        None => path.alive = false,
+    }
+}
+
+/// Totals over many paths, for throughput reports. Segments are free flights (each ends in a
+/// collision, a boundary or the environment); tracking steps are delta tracking's tentative collisions.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PathCounters {
+    pub paths: u64,
+    pub segments: u64,
+    pub tracking_steps: u64,
+    pub truncated: u64,
+}
+
+impl PathCounters {
+    #[inline]
+    pub fn record(&mut self, path: &PathState) {
+        self.paths += 1;
+        self.segments += path.segments as u64;
+        self.tracking_steps += path.tracking_steps as u64;
+        self.truncated += path.truncated as u64;
+    }
+
+    #[inline]
+    pub fn merge(self, other: Self) -> Self {
+        Self {
+            paths: self.paths + other.paths,
+            segments: self.segments + other.segments,
+            tracking_steps: self.tracking_steps + other.tracking_steps,
+            truncated: self.truncated + other.truncated,
+        }
+    }
+}
+

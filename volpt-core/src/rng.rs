@@ -1,0 +1,58 @@
+//! A counter-based random number generator keyed by (seed, pixel, sample) and indexed by dimension.
+//!
+//! The i-th number of a path is a pure function of (seed, pixel, sample, i), so a path's random numbers
+//! do not depend on which thread, strategy or backend traces it: every backend traces the same paths.
+//! Each number is SplitMix64's finaliser applied to `key + (i + 1) * golden` (Steele, Lea & Flood 2014,
+//! "Fast splittable pseudorandom number generators"), which passes BigCrush as a counter-based generator.
+
+const GOLDEN_GAMMA: u64 = 0x9E37_79B9_7F4A_7C15;
+
+#[inline]
+fn mix64(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Rng {
+    key: u64,
+    dimension: u32,
+}
+
+impl Rng {
+    /// The stream of sample `sample` of pixel `pixel` (a linear pixel index) under `seed`.
+    #[inline]
+    pub fn new(seed: u32, pixel: u32, sample: u32) -> Self {
+        let seed_key = mix64((seed as u64).wrapping_add(GOLDEN_GAMMA));
+        let key = mix64((((pixel as u64) << 32) | sample as u64) ^ seed_key);
+        Self { key, dimension: 0 }
+    }
+
+    /// How many numbers this stream has handed out.
+    #[inline]
+    pub fn dimension(&self) -> u32 {
+        self.dimension
+    }
+
+    #[inline]
+    pub fn next_u64(&mut self) -> u64 {
+        self.dimension += 1;
+        mix64(
+            self.key
+                .wrapping_add((self.dimension as u64).wrapping_mul(GOLDEN_GAMMA)),
+        )
+    }
+
+    /// A uniform number in [0, 1): the top 24 bits, so every value is exactly representable.
+    #[inline]
+    pub fn next_f32(&mut self) -> f32 {
+        (self.next_u64() >> 40) as f32 * (1.0 / (1u32 << 24) as f32)
+    }
+
+    #[inline]
+    pub fn next_2d(&mut self) -> crate::Vec2 {
+        let x = self.next_f32();
+        crate::Vec2::new(x, self.next_f32())
+    }
+}

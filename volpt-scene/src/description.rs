@@ -1,0 +1,148 @@
+//! The scene as plain data: what a loader produces and what a renderer's factory consumes.
+//!
+//! Nothing here knows about a file format or about a backend. Units are Mitsuba's: world space is
+//! whatever the scene file says, extinction coefficients are per world unit, colours are linear RGB.
+
+/// An axis-aligned box in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounds {
+    pub min: [f32; 3],
+    pub max: [f32; 3],
+}
+
+/// A 4x4 affine transform, row-major: `p' = m * [p, 1]`.
+pub type Matrix4 = [[f32; 4]; 4];
+
+pub const IDENTITY: Matrix4 = [
+    [1.0, 0.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0, 0.0],
+    [0.0, 0.0, 1.0, 0.0],
+    [0.0, 0.0, 0.0, 1.0],
+];
+
+/// Everything needed to render one image.
+#[derive(Clone, Debug)]
+pub struct SceneDescription {
+    pub camera: CameraDesc,
+    pub film: FilmDesc,
+    /// Samples per pixel the scene file asks for (the sampler's sample count).
+    pub spp: u32,
+    pub integrator: IntegratorDesc,
+    pub boundary: BoundaryDesc,
+    pub medium: MediumDesc,
+    pub environment: EnvironmentDesc,
+}
+
+/// Which image axis the field of view spans (Mitsuba's `fovAxis` / `fov_axis`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FovAxis {
+    X,
+    Y,
+    /// The smaller of the two image axes.
+    Smaller,
+    /// The larger of the two image axes.
+    Larger,
+    /// The diagonal of the image.
+    Diagonal,
+}
+
+/// A pinhole perspective camera. Camera space is Mitsuba's: it looks along +z with +y up and +x to the
+/// left of the image; `to_world` maps camera space to world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraDesc {
+    pub to_world: Matrix4,
+    /// Full field of view in degrees along `fov_axis`.
+    pub fov_degrees: f32,
+    pub fov_axis: FovAxis,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FilmDesc {
+    pub width: u32,
+    pub height: u32,
+}
+
+/// Mitsuba's `volpath` settings. `None` means unlimited (Mitsuba's -1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct IntegratorDesc {
+    /// Longest path, counted in segments: 1 shows only directly visible light.
+    pub max_depth: Option<u32>,
+    /// Depth from which Russian roulette is used; `None` disables it.
+    pub rr_depth: Option<u32>,
+}
+
+/// The shape that encloses the medium, and its surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoundaryDesc {
+    pub bounds: Bounds,
+    pub bsdf: BsdfDesc,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BsdfDesc {
+    /// Index-matched boundary: light crosses it unchanged.
+    Null,
+    /// Smooth dielectric interface.
+    Dielectric { int_ior: f32, ext_ior: f32 },
+    /// GGX (Trowbridge-Reitz) rough dielectric interface with isotropic roughness `alpha`.
+    RoughDielectric { alpha: f32, int_ior: f32, ext_ior: f32 },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct MediumDesc {
+    /// Density; the extinction coefficient is `scale * density`.
+    pub density: DensityDesc,
+    pub scale: f32,
+    pub albedo: AlbedoDesc,
+    pub phase: PhaseDesc,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum DensityDesc {
+    Constant(f32),
+    Grid(GridDesc),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum AlbedoDesc {
+    Constant([f32; 3]),
+    /// A 3-channel grid (a 1-channel grid is expanded to grey RGB by the loader).
+    Grid(GridDesc),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PhaseDesc {
+    Isotropic,
+    HenyeyGreenstein { g: f32 },
+}
+
+/// Where the grid's samples sit inside its bounding box.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GridConvention {
+    /// Mitsuba 0.5/0.6: sample `i` at `min + i / (res - 1) * extent` (samples on the box's faces).
+    Vertex,
+    /// Mitsuba 3: sample `i` at `min + (i + 0.5) / res * extent` (samples at cell centres).
+    Cell,
+}
+
+/// A dense 3D grid, x fastest: `data[((z * res_y + y) * res_x + x) * channels + c]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GridDesc {
+    pub resolution: [u32; 3],
+    pub channels: u32,
+    pub bounds: Bounds,
+    pub convention: GridConvention,
+    pub data: Vec<f32>,
+}
+
+impl GridDesc {
+    pub fn max_value(&self) -> f32 {
+        self.data.iter().copied().fold(0.0, f32::max)
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum EnvironmentDesc {
+    /// Constant radiance from every direction.
+    Constant([f32; 3]),
+}
