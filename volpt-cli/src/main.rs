@@ -1,20 +1,19 @@
 //! `volpt`: render solid participating media from Mitsuba scene files.
 
+mod backend;
+mod bench;
 mod info;
 
 use std::path::PathBuf;
-use std::time::Duration;
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand};
-use indicatif::{ProgressBar, ProgressStyle};
 use tracing_subscriber::EnvFilter;
-use volpt_core::Scene;
 use volpt_render::image::preview_path;
-use volpt_render::{
-    path_settings, render, with_scene, Image, RenderOptions, RenderStats, SceneVisitor, Variant,
-};
+use volpt_render::{path_settings, Image, RenderOptions, RenderStats, Variant};
 use volpt_scene::SceneDescription;
+
+use backend::{BackendKind, RenderJob};
 
 #[derive(Parser)]
 #[command(name = "volpt", version, about = "A path tracer for solid participating media")]
@@ -27,6 +26,8 @@ struct Cli {
 enum Command {
     /// Render a scene to OpenEXR, with a PNG preview beside it.
     Render(RenderArgs),
+    /// Time repeated renders of a scene (the first trial is a discarded warm-up).
+    Bench(BenchArgs),
     /// Print what a scene file loads to, and the variant it renders with.
     Info(SceneArgs),
 }
@@ -41,21 +42,47 @@ struct SceneArgs {
 }
 
 #[derive(Args)]
-struct RenderArgs {
-    #[command(flatten)]
-    scene: SceneArgs,
-    /// Output OpenEXR file; the PNG preview gets the same name with `.png`.
-    #[arg(short, long, default_value = "out.exr")]
-    output: PathBuf,
+struct SamplingArgs {
     /// Samples per pixel (default: the scene's sampler).
     #[arg(long)]
     spp: Option<u32>,
     /// Seed of the random streams: the same seed gives the same image on every backend.
     #[arg(long, default_value_t = 0)]
     seed: u32,
-    /// Worker threads (default: all cores).
+    /// CPU worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
+    /// Where to render.
+    #[arg(long, value_enum, default_value_t = BackendKind::Cpu)]
+    backend: BackendKind,
+    /// GPU scheduling strategy (see `volpt render --help` of a CUDA build for the list).
+    #[arg(long)]
+    strategy: Option<String>,
+}
+
+#[derive(Args)]
+struct RenderArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    #[command(flatten)]
+    sampling: SamplingArgs,
+    /// Output OpenEXR file; the PNG preview gets the same name with `.png`.
+    #[arg(short, long, default_value = "out.exr")]
+    output: PathBuf,
+}
+
+#[derive(Args)]
+struct BenchArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    #[command(flatten)]
+    sampling: SamplingArgs,
+    /// Timed trials, after one discarded warm-up trial.
+    #[arg(long, default_value_t = 5)]
+    trials: usize,
+    /// Print the report as JSON.
+    #[arg(long)]
+    json: bool,
 }
 
 fn parse_param(s: &str) -> Result<(String, String), String> {
@@ -74,6 +101,7 @@ fn main() -> Result<()> {
         .init();
     match Cli::parse().command {
         Command::Render(args) => render_command(args),
+        Command::Bench(args) => bench_command(args),
         Command::Info(args) => {
             let desc = load(&args)?;
             print!("{}", info::describe(&args.scene, &desc));
@@ -86,73 +114,52 @@ fn load(args: &SceneArgs) -> Result<SceneDescription> {
     Ok(volpt_scene::load_mitsuba_with(&args.scene, &args.params)?)
 }
 
-fn render_command(args: RenderArgs) -> Result<()> {
-    let desc = load(&args.scene)?;
-    let options = RenderOptions {
-        spp: args.spp.unwrap_or(desc.spp),
-        seed: args.seed,
-        threads: args.threads,
-    };
-    if options.threads == Some(0) {
+fn options(desc: &SceneDescription, sampling: &SamplingArgs) -> Result<RenderOptions> {
+    if sampling.threads == Some(0) {
         bail!("--threads must be at least 1");
     }
+    Ok(RenderOptions {
+        spp: sampling.spp.unwrap_or(desc.spp),
+        seed: sampling.seed,
+        threads: sampling.threads,
+    })
+}
+
+fn render_command(args: RenderArgs) -> Result<()> {
+    let desc = load(&args.scene)?;
+    let job = RenderJob {
+        desc: &desc,
+        settings: path_settings(&desc),
+        options: options(&desc, &args.sampling)?,
+        strategy: args.sampling.strategy.as_deref(),
+        show_progress: true,
+    };
     let variant = Variant::of(&desc);
     tracing::info!(
         scene = %args.scene.scene.display(),
         %variant,
         width = desc.film.width,
         height = desc.film.height,
-        spp = options.spp,
-        "rendering on the CPU"
+        spp = job.options.spp,
+        backend = ?args.sampling.backend,
+        "rendering"
     );
-    let (image, stats) = with_scene(&desc, path_settings(&desc), CpuRender { options })?;
+    let (image, stats) = backend::run(args.sampling.backend, &job)?;
     image
         .write_exr(&args.output)
         .with_context(|| format!("writing {}", args.output.display()))?;
     let preview = preview_path(&args.output);
     image.write_png(&preview)?;
-    println!(
-        "{}",
-        summary(&image, options.spp, &stats, &variant.to_string())
-    );
-    println!(
-        "wrote {} and {}",
-        args.output.display(),
-        preview.display()
-    );
+    println!("{}", summary(&image, job.options.spp, &stats, variant));
+    println!("wrote {} and {}", args.output.display(), preview.display());
     Ok(())
 }
 
-struct CpuRender {
-    options: RenderOptions,
-}
-
-impl SceneVisitor for CpuRender {
-    type Output = Result<(Image, RenderStats)>;
-
-    fn visit<S: Scene + Sync>(self, scene: &S) -> Self::Output {
-        let bar = ProgressBar::new(0);
-        bar.set_style(
-            ProgressStyle::with_template(
-                "{spinner} [{elapsed_precise}] {wide_bar} {percent}% eta {eta}",
-            )
-            .expect("static template"),
-        );
-        bar.enable_steady_tick(Duration::from_millis(200));
-        let result = render(scene, &self.options, &|done, total| {
-            bar.set_length(total);
-            bar.set_position(done);
-        });
-        bar.finish_and_clear();
-        Ok(result?)
-    }
-}
-
-fn summary(image: &Image, spp: u32, stats: &RenderStats, variant: &str) -> String {
+fn summary(image: &Image, spp: u32, stats: &RenderStats, variant: Variant) -> String {
     let c = &stats.counters;
     let mut s = format!(
-        "{}x{} at {} spp ({}) in {:.3} s: {:.3} M paths/s, {:.3} M segments/s, {:.3} M tracking steps/s \
-         ({:.2} segments/path)",
+        "{}x{} at {} spp ({}) in {:.3} s: {:.3} M paths/s, {:.3} M segments/s, \
+         {:.3} M tracking steps/s ({:.2} segments/path)",
         image.width,
         image.height,
         spp,
@@ -170,4 +177,65 @@ fn summary(image: &Image, spp: u32, stats: &RenderStats, variant: &str) -> Strin
         );
     }
     s
+}
+
+fn bench_command(args: BenchArgs) -> Result<()> {
+    if args.trials == 0 {
+        bail!("--trials must be at least 1");
+    }
+    let desc = load(&args.scene)?;
+    let job = RenderJob {
+        desc: &desc,
+        settings: path_settings(&desc),
+        options: options(&desc, &args.sampling)?,
+        strategy: args.sampling.strategy.as_deref(),
+        show_progress: false,
+    };
+    let mut trials = Vec::with_capacity(args.trials);
+    let mut last = None;
+    for trial in 0..=args.trials {
+        let (image, stats) = backend::run(args.sampling.backend, &job)?;
+        tracing::debug!(trial, seconds = stats.elapsed.as_secs_f64(), "trial");
+        if trial > 0 {
+            trials.push(stats);
+        }
+        last = Some(image);
+    }
+    let image = last.expect("at least one trial ran");
+    let time = bench::time_stats(&trials);
+    let counters = trials[0].counters;
+    let mut image_mean = [0.0f64; 3];
+    for p in &image.pixels {
+        for c in 0..3 {
+            image_mean[c] += p[c] as f64 / image.pixels.len() as f64;
+        }
+    }
+    let report = bench::BenchReport {
+        scene: args.scene.scene.display().to_string(),
+        backend: format!("{:?}", args.sampling.backend).to_lowercase(),
+        strategy: args.sampling.strategy.clone(),
+        device: backend::device_name(args.sampling.backend),
+        variant: Variant::of(&desc).to_string(),
+        width: image.width,
+        height: image.height,
+        spp: job.options.spp,
+        trials: trials.len(),
+        time_mean_s: time.mean,
+        time_std_s: time.std,
+        time_median_s: time.median,
+        paths: counters.paths,
+        segments: counters.segments,
+        tracking_steps: counters.tracking_steps,
+        truncated_paths: counters.truncated,
+        paths_per_s: counters.paths as f64 / time.mean,
+        segments_per_s: counters.segments as f64 / time.mean,
+        tracking_steps_per_s: counters.tracking_steps as f64 / time.mean,
+        image_mean,
+    };
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        println!("{}", report.table_row());
+    }
+    Ok(())
 }

@@ -1,0 +1,165 @@
+//! The `volpt` binary end to end: a real scene file in, real EXR and PNG out, and clear errors
+//! (never a panic) for bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use volpt_scene::vol::{write_vol, VolGrid};
+use volpt_scene::Bounds;
+
+fn volpt(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_volpt"))
+        .args(args)
+        .env("RUST_LOG", "warn")
+        .output()
+        .expect("run volpt")
+}
+
+fn example() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/example/cube.xml")
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// Fails with a message that contains every one of `needles`, and does not panic.
+fn assert_clean_error(out: &Output, needles: &[&str]) {
+    let err = stderr(out);
+    assert!(!out.status.success(), "expected failure, stderr: {err}");
+    assert!(!err.contains("panicked"), "panicked: {err}");
+    for n in needles {
+        assert!(err.contains(n), "error lacks {n:?}: {err}");
+    }
+}
+
+#[test]
+fn renders_the_example_to_exr_and_png() {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("cube.exr");
+    let out = volpt(&[
+        "render",
+        example().to_str().unwrap(),
+        "-o",
+        exr.to_str().unwrap(),
+        "--spp",
+        "2",
+        "-D",
+        "resolution=24",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("24x24 at 2 spp"), "{stdout}");
+    assert!(stdout.contains("M paths/s"), "{stdout}");
+    let image = exr::prelude::read_first_rgba_layer_from_file(
+        &exr,
+        |res, _| vec![[0.0f32; 3]; res.width() * res.height()],
+        |px: &mut Vec<[f32; 3]>, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            px[pos.y() * 24 + pos.x()] = [r, g, b];
+        },
+    )
+    .expect("a readable EXR");
+    let pixels = image.layer_data.channel_data.pixels;
+    assert_eq!(pixels.len(), 24 * 24);
+    // The corner sees the white environment; the centre sees the amber cube, darker in blue.
+    assert_eq!(pixels[0], [1.0, 1.0, 1.0]);
+    let centre = pixels[12 * 24 + 12];
+    assert!(centre[2] < centre[0], "centre {centre:?}");
+    let png = std::fs::read(dir.path().join("cube.png")).expect("PNG preview");
+    assert_eq!(&png[1..4], b"PNG");
+}
+
+#[test]
+fn info_names_the_variant() {
+    let out = volpt(&["info", example().to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("homogeneous/rough-dielectric/hg"),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn missing_scene_file_is_a_clear_error() {
+    let out = volpt(&["render", "no/such/scene.xml"]);
+    assert_clean_error(&out, &["no/such/scene.xml"]);
+}
+
+#[test]
+fn malformed_xml_names_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("broken.xml");
+    std::fs::write(&scene, "<scene version=\"0.6.0\">\n  <sensor type=\"perspective\">\n</scene>\n")
+        .unwrap();
+    let out = volpt(&["info", scene.to_str().unwrap()]);
+    assert_clean_error(&out, &["broken.xml", ":3"]);
+}
+
+fn grid_scene(dir: &Path, vol_name: &str) -> PathBuf {
+    let scene = dir.join("grid.xml");
+    let xml = format!(
+        r#"<scene version="0.6.0">
+  <sensor type="perspective">
+    <float name="fov" value="30"/>
+    <transform name="toWorld"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film>
+  </sensor>
+  <emitter type="constant"/>
+  <medium type="heterogeneous" id="m">
+    <volume name="density" type="gridvolume"><string name="filename" value="{vol_name}"/></volume>
+    <volume name="albedo" type="constvolume"><spectrum name="value" value="0.9"/></volume>
+  </medium>
+  <shape type="cube"><bsdf type="null"/><ref name="interior" id="m"/></shape>
+</scene>"#
+    );
+    std::fs::write(&scene, xml).unwrap();
+    scene
+}
+
+fn grid(values: Vec<f32>) -> VolGrid {
+    VolGrid {
+        resolution: [2, 2, 2],
+        channels: 1,
+        bbox: Bounds {
+            min: [-1.0; 3],
+            max: [1.0; 3],
+        },
+        data: values,
+    }
+}
+
+#[test]
+fn truncated_vol_is_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let vol = dir.path().join("d.vol");
+    write_vol(&vol, &grid(vec![1.0; 8])).unwrap();
+    let bytes = std::fs::read(&vol).unwrap();
+    std::fs::write(&vol, &bytes[..bytes.len() - 5]).unwrap();
+    let scene = grid_scene(dir.path(), "d.vol");
+    let out = volpt(&["render", scene.to_str().unwrap(), "-o", dir.path().join("o.exr").to_str().unwrap()]);
+    assert_clean_error(&out, &["d.vol"]);
+}
+
+#[test]
+fn nan_and_negative_densities_are_clear_errors() {
+    for (i, bad) in [f32::NAN, -1.0].into_iter().enumerate() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut values = vec![1.0; 8];
+        values[5] = bad;
+        let name = format!("bad{i}.vol");
+        write_vol(&dir.path().join(&name), &grid(values)).unwrap();
+        let scene = grid_scene(dir.path(), &name);
+        let out = volpt(&["info", scene.to_str().unwrap()]);
+        assert_clean_error(&out, &[name.as_str()]);
+    }
+}
+
+#[test]
+fn zero_threads_and_zero_trials_are_refused() {
+    let e = example();
+    let out = volpt(&["render", e.to_str().unwrap(), "--threads", "0"]);
+    assert_clean_error(&out, &["--threads"]);
+    let out = volpt(&["bench", e.to_str().unwrap(), "--trials", "0"]);
+    assert_clean_error(&out, &["--trials"]);
+}
