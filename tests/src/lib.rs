@@ -25,7 +25,13 @@ fn glam_vec(v: [f32; 3]) -> glam::Vec3 {
 
 /// A `width` x `height` view of the unit cube [-0.5, 0.5]^3 from an oblique direction, so that
 /// rays cross it through faces, edges and corners, with a constant environment of radiance `env`.
-pub fn cube_scene(width: u32, height: u32, medium: MediumDesc, bsdf: BsdfDesc, env: f32) -> SceneDescription {
+pub fn cube_scene(
+    width: u32,
+    height: u32,
+    medium: MediumDesc,
+    bsdf: BsdfDesc,
+    env: f32,
+) -> SceneDescription {
     SceneDescription {
         camera: CameraDesc {
             to_world: look_at([2.0, 1.5, 2.5]),

@@ -186,7 +186,13 @@ fn white_furnace_index_matched() {
         (30.0, PhaseDesc::HenyeyGreenstein { g: 0.9 }),
         (30.0, PhaseDesc::HenyeyGreenstein { g: -0.6 }),
     ] {
-        let desc = cube_scene(16, 16, homogeneous(sigma_t, 1.0, phase), BsdfDesc::Null, 0.8);
+        let desc = cube_scene(
+            16,
+            16,
+            homogeneous(sigma_t, 1.0, phase),
+            BsdfDesc::Null,
+            0.8,
+        );
         let (image, stats) = render_cpu(&desc, 16, 1);
         assert_eq!(stats.counters.truncated, 0);
         assert_furnace(&image, 0.8, 1e-6);
@@ -201,7 +207,13 @@ fn white_furnace_smooth_dielectric() {
         int_ior: 1.5,
         ext_ior: 1.0,
     };
-    let desc = cube_scene(16, 16, homogeneous(10.0, 1.0, PhaseDesc::Isotropic), bsdf, 0.8);
+    let desc = cube_scene(
+        16,
+        16,
+        homogeneous(10.0, 1.0, PhaseDesc::Isotropic),
+        bsdf,
+        0.8,
+    );
     let (image, stats) = render_cpu(&desc, 16, 1);
     assert_eq!(stats.counters.truncated, 0);
     assert_furnace(&image, 0.8, 1e-4);
@@ -222,7 +234,13 @@ fn rough_furnace(alpha: f32) -> (f64, f64) {
         int_ior: 1.05,
         ext_ior: 1.01,
     };
-    let desc = cube_scene(32, 32, homogeneous(10.0, 1.0, PhaseDesc::Isotropic), bsdf, 1.0);
+    let desc = cube_scene(
+        32,
+        32,
+        homogeneous(10.0, 1.0, PhaseDesc::Isotropic),
+        bsdf,
+        1.0,
+    );
     let (image, stats) = render_cpu(&desc, 64, 5);
     assert_eq!(stats.counters.truncated, 0);
     mean_and_standard_error(&image)
@@ -237,10 +255,19 @@ fn rough_furnace(alpha: f32) -> (f64, f64) {
 #[test]
 fn white_furnace_rough_dielectric() {
     let (mean, se) = rough_furnace(1e-3);
-    assert!((mean - 1.0).abs() <= 4.0 * se + 1e-4, "alpha 1e-3: {mean} +- {se}");
+    assert!(
+        (mean - 1.0).abs() <= 4.0 * se + 1e-4,
+        "alpha 1e-3: {mean} +- {se}"
+    );
     let (mean, se) = rough_furnace(0.1);
-    assert!(mean <= 1.0 + 4.0 * se, "alpha 0.1 created energy: {mean} +- {se}");
-    assert!(mean >= 0.98, "alpha 0.1 lost too much energy: {mean} +- {se}");
+    assert!(
+        mean <= 1.0 + 4.0 * se,
+        "alpha 0.1 created energy: {mean} +- {se}"
+    );
+    assert!(
+        mean >= 0.98,
+        "alpha 0.1 lost too much energy: {mean} +- {se}"
+    );
 }
 
 /// Russian roulette is unbiased: with roulette from the first interaction on, a white furnace's paths
@@ -288,7 +315,10 @@ fn russian_roulette_is_unbiased() {
     let (mean, se, killed) = with_scene(&desc, rr, FurnaceSampleMean { paths: 200_000 });
     assert!(killed > 10_000, "roulette never ran");
     let z = (mean - reference) / (se * se + ref_se * ref_se).sqrt();
-    assert!(z.abs() < 5.0, "roulette {mean} vs none {reference}: z = {z}");
+    assert!(
+        z.abs() < 5.0,
+        "roulette {mean} vs none {reference}: z = {z}"
+    );
 }
 
 #[test]

@@ -29,14 +29,22 @@ pub struct RenderJob<'a> {
 
 pub fn run(backend: BackendKind, job: &RenderJob) -> Result<(Image, RenderStats)> {
     match backend {
-        BackendKind::Cpu => with_scene(
-            job.desc,
-            job.settings,
-            CpuRender {
-                options: job.options,
-                show_progress: job.show_progress,
-            },
-        ),
+        BackendKind::Cpu => {
+            if let Some(strategy) = job.strategy {
+                anyhow::bail!(
+                    "--strategy {strategy} schedules GPU work; the CPU backend has no strategies \
+                     (use --backend cuda, or drop --strategy)"
+                );
+            }
+            with_scene(
+                job.desc,
+                job.settings,
+                CpuRender {
+                    options: job.options,
+                    show_progress: job.show_progress,
+                },
+            )
+        }
         BackendKind::Cuda => anyhow::bail!(
             "this volpt was built without the CUDA backend (see the GPU backend issue)"
         ),

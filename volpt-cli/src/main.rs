@@ -16,7 +16,11 @@ use volpt_scene::SceneDescription;
 use backend::{BackendKind, RenderJob};
 
 #[derive(Parser)]
-#[command(name = "volpt", version, about = "A path tracer for solid participating media")]
+#[command(
+    name = "volpt",
+    version,
+    about = "A path tracer for solid participating media"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

@@ -90,8 +90,11 @@ fn missing_scene_file_is_a_clear_error() {
 fn malformed_xml_names_file_and_line() {
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("broken.xml");
-    std::fs::write(&scene, "<scene version=\"0.6.0\">\n  <sensor type=\"perspective\">\n</scene>\n")
-        .unwrap();
+    std::fs::write(
+        &scene,
+        "<scene version=\"0.6.0\">\n  <sensor type=\"perspective\">\n</scene>\n",
+    )
+    .unwrap();
     let out = volpt(&["info", scene.to_str().unwrap()]);
     assert_clean_error(&out, &["broken.xml", ":3"]);
 }
@@ -137,7 +140,12 @@ fn truncated_vol_is_a_clear_error() {
     let bytes = std::fs::read(&vol).unwrap();
     std::fs::write(&vol, &bytes[..bytes.len() - 5]).unwrap();
     let scene = grid_scene(dir.path(), "d.vol");
-    let out = volpt(&["render", scene.to_str().unwrap(), "-o", dir.path().join("o.exr").to_str().unwrap()]);
+    let out = volpt(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        dir.path().join("o.exr").to_str().unwrap(),
+    ]);
     assert_clean_error(&out, &["d.vol"]);
 }
 

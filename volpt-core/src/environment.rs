@@ -1,9 +1,10 @@
 //! Light arriving from infinitely far away.
 
+use crate::math::{clamp, INV_PI};
 use crate::{Spectrum, Vec3};
 
 pub trait Environment {
-    /// Radiance arriving along the propagation direction `-dir`, i.e. seen when looking along `dir`.
+    /// Radiance seen when looking along `dir` (arriving along `-dir`).
     fn radiance(&self, dir: Vec3) -> Spectrum;
 }
 
@@ -14,5 +15,52 @@ impl Environment for ConstantEnvironment {
     #[inline]
     fn radiance(&self, _dir: Vec3) -> Spectrum {
         self.0
+    }
+}
+
+/// An environment map in latitude-longitude layout (Mitsuba's `envmap`): the look direction `v` in the
+/// map's local frame maps to `u = atan2(v.x, -v.z) / 2 pi`, `v = acos(v.y) / pi`, so the image's top
+/// row is the +y pole. Pixels are bilinearly interpolated around their centres, wrapping in `u`.
+#[derive(Clone, Copy, Debug)]
+pub struct LatLongEnvironment<'a> {
+    /// RGB, row-major from the top-left pixel.
+    pub rgb: &'a [f32],
+    pub width: u32,
+    pub height: u32,
+    /// Rows of the world-to-map rotation.
+    pub world_to_map: [Vec3; 3],
+    pub scale: f32,
+}
+
+impl LatLongEnvironment<'_> {
+    #[inline]
+    fn texel(&self, x: u32, y: u32) -> Spectrum {
+        let i = 3 * (y * self.width + x) as usize;
+        Spectrum::new(self.rgb[i], self.rgb[i + 1], self.rgb[i + 2])
+    }
+}
+
+impl Environment for LatLongEnvironment<'_> {
+    #[inline]
+    fn radiance(&self, dir: Vec3) -> Spectrum {
+        let v = Vec3::new(
+            self.world_to_map[0].dot(dir),
+            self.world_to_map[1].dot(dir),
+            self.world_to_map[2].dot(dir),
+        );
+        let u = libm::atan2f(v.x, -v.z) * (0.5 * INV_PI);
+        let u = u - libm::floorf(u);
+        let t = libm::acosf(clamp(v.y, -1.0, 1.0)) * INV_PI;
+        let x = u * self.width as f32 - 0.5;
+        let y = clamp(t * self.height as f32 - 0.5, 0.0, (self.height - 1) as f32);
+        let (x0f, y0f) = (libm::floorf(x), libm::floorf(y));
+        let (fx, fy) = (x - x0f, y - y0f);
+        let wrap = |i: i32| i.rem_euclid(self.width as i32) as u32;
+        let (x0, x1) = (wrap(x0f as i32), wrap(x0f as i32 + 1));
+        let y0 = y0f as u32;
+        let y1 = (y0 + 1).min(self.height - 1);
+        let top = self.texel(x0, y0) * (1.0 - fx) + self.texel(x1, y0) * fx;
+        let bottom = self.texel(x0, y1) * (1.0 - fx) + self.texel(x1, y1) * fx;
+        (top * (1.0 - fy) + bottom * fy) * self.scale
     }
 }

@@ -52,9 +52,13 @@ impl Aabb {
         p.cmpge(self.min).all() && p.cmple(self.max).all()
     }
 
-    /// Where a ray from outside enters the box, if it does. A ray whose origin lies inside or on the
-    /// box and that points away from it does not enter: the slab test's entry distance is then
-    /// negative. Edges and corners resolve to one face, that of the last slab entered.
+    /// Where a ray from outside enters the box, if it does: the ray must run along a segment of
+    /// positive length inside the closed box, starting at a distance >= 0. A ray whose origin lies
+    /// inside or on the box and that points away from it does not enter (the slab test's entry
+    /// distance is then negative, or, from an edge or corner, equal to the exit distance 0), and
+    /// neither does a ray that only touches an edge or a corner. A ray in the plane of a face that
+    /// crosses the face enters (the box is closed). Edges and corners resolve to one face, that of
+    /// the last slab entered.
     #[inline]
     pub fn entry(&self, ray: &Ray) -> Option<BoxHit> {
         let inv = ray.dir.recip();
@@ -62,13 +66,19 @@ impl Aabb {
         let t1 = (self.max - ray.origin) * inv;
         let near = t0.min(t1);
         let far = t0.max(t1);
-        // NaN (0 * inf, a ray in a face's plane) must not win a max/min: treat it as "no constraint".
-        let near = Vec3::select(near.cmpeq(near), near, Vec3::splat(f32::NEG_INFINITY));
-        let far = Vec3::select(far.cmpeq(far), far, Vec3::splat(f32::INFINITY));
+        // An axis the ray runs parallel to (a zero component of either sign, or one so small that
+        // its reciprocal overflows) gives +-inf, or NaN (0 * inf) for a plane the ray lies in, and
+        // `min`/`max` would let one plane's infinity or NaN decide. Such a slab puts no constraint on
+        // a ray whose origin lies in it (the closed slab, planes included) and excludes any other.
+        let parallel = inv.abs().cmpeq(Vec3::INFINITY);
+        let in_slab = ray.origin.cmpge(self.min) & ray.origin.cmple(self.max);
+        let inf = Vec3::INFINITY;
+        let near = Vec3::select(parallel, Vec3::select(in_slab, -inf, inf), near);
+        let far = Vec3::select(parallel, Vec3::select(in_slab, inf, -inf), far);
         let axis = argmax(near);
         let t_enter = near[axis];
         let t_leave = far.min_element();
-        if !(t_enter >= 0.0 && t_enter <= t_leave) {
+        if !(t_enter >= 0.0 && t_enter < t_leave) {
             return None;
         }
         let mut point = ray.at(t_enter);

@@ -3,6 +3,8 @@
 //!
 //! Read [`path`] first: one step of a volumetric path, the algorithm every backend runs.
 #![no_std]
+// Inline PTX for exact hardware instructions (math::sqrt); nvptx builds already need nightly features.
+#![cfg_attr(target_arch = "nvptx64", feature(asm_experimental_arch))]
 
 pub mod bsdf;
 pub mod camera;
@@ -11,6 +13,7 @@ pub mod frame;
 pub mod fresnel;
 pub mod geometry;
 pub mod grid;
+pub mod launch;
 pub mod math;
 pub mod medium;
 pub mod microfacet;
@@ -23,7 +26,7 @@ pub mod tracking;
 
 pub use bsdf::{Bsdf, BsdfSample, NullBoundary, RoughDielectric, SmoothDielectric};
 pub use camera::PerspectiveCamera;
-pub use environment::{ConstantEnvironment, Environment};
+pub use environment::{ConstantEnvironment, Environment, LatLongEnvironment};
 pub use geometry::{Aabb, Ray};
 pub use grid::{Grid, GridMapping};
 pub use medium::{AlbedoField, ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium, Medium};

@@ -8,9 +8,25 @@ pub const PI: f32 = core::f32::consts::PI;
 pub const INV_PI: f32 = core::f32::consts::FRAC_1_PI;
 pub const INV_4PI: f32 = 0.25 * core::f32::consts::FRAC_1_PI;
 
+/// The correctly rounded square root (IEEE 754), so every backend gets the same bits.
 #[inline]
 pub fn sqrt(x: f32) -> f32 {
-    libm::sqrtf(x)
+    #[cfg(target_arch = "nvptx64")]
+    {
+        // `sqrt.rn` is IEEE round-to-nearest, the value libm's software square root computes, in one
+        // instruction instead of an integer loop.
+        let r: f32;
+        // SAFETY: a pure arithmetic instruction on registers.
+        unsafe {
+            core::arch::asm!("sqrt.rn.f32 {r}, {x};", r = out(reg32) r, x = in(reg32) x,
+                options(pure, nomem, nostack));
+        }
+        r
+    }
+    #[cfg(not(target_arch = "nvptx64"))]
+    {
+        libm::sqrtf(x)
+    }
 }
 
 /// `sqrt(max(x, 0))`: rounding can push a quantity that is non-negative in exact arithmetic below 0.

@@ -91,12 +91,17 @@ pub fn render<S: Scene + Sync>(
                     let mut row_counters = PathCounters::default();
                     for (x, sum) in row.iter_mut().enumerate() {
                         for sample in samples.clone() {
-                            let mut path =
-                                PathState::from_camera(scene, x as u32, y as u32, sample, options.seed);
+                            let mut path = PathState::from_camera(
+                                scene,
+                                x as u32,
+                                y as u32,
+                                sample,
+                                options.seed,
+                            );
                             trace(scene, &mut path);
                             row_counters.record(&path);
-                            for c in 0..3 {
-                                sum[c] += path.radiance[c] as f64;
+                            for (s, r) in sum.iter_mut().zip(path.radiance.to_array()) {
+                                *s += r as f64;
                             }
                         }
                     }

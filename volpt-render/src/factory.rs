@@ -16,7 +16,7 @@ use volpt_core::{
     Scene, SmoothDielectric, Spectrum, Vec2, Vec3, VolumeScene,
 };
 use volpt_scene::description::{
-    AlbedoDesc, BsdfDesc, Bounds, CameraDesc, DensityDesc, EnvironmentDesc, FilmDesc, FovAxis,
+    AlbedoDesc, Bounds, BsdfDesc, CameraDesc, DensityDesc, EnvironmentDesc, FilmDesc, FovAxis,
     GridConvention, GridDesc, PhaseDesc, SceneDescription,
 };
 
@@ -295,10 +295,7 @@ pub fn camera(desc: &CameraDesc, film: &FilmDesc) -> PerspectiveCamera {
 /// The integrator settings a scene file asks for.
 pub fn path_settings(desc: &SceneDescription) -> PathSettings {
     PathSettings {
-        max_depth: desc
-            .integrator
-            .max_depth
-            .unwrap_or(PathSettings::UNLIMITED),
+        max_depth: desc.integrator.max_depth.unwrap_or(PathSettings::UNLIMITED),
         rr_depth: desc.integrator.rr_depth.unwrap_or(PathSettings::UNLIMITED),
         ..PathSettings::default()
     }

@@ -40,15 +40,10 @@ impl Image {
     }
 
     pub fn write_exr(&self, path: &Path) -> Result<(), ImageError> {
-        exr::prelude::write_rgb_file(
-            path,
-            self.width as usize,
-            self.height as usize,
-            |x, y| {
-                let [r, g, b] = self.pixels[y * self.width as usize + x];
-                (r, g, b)
-            },
-        )
+        exr::prelude::write_rgb_file(path, self.width as usize, self.height as usize, |x, y| {
+            let [r, g, b] = self.pixels[y * self.width as usize + x];
+            (r, g, b)
+        })
         .map_err(|source| ImageError::Exr {
             path: path.to_owned(),
             source,

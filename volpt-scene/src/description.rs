@@ -85,7 +85,11 @@ pub enum BsdfDesc {
     /// Smooth dielectric interface.
     Dielectric { int_ior: f32, ext_ior: f32 },
     /// GGX (Trowbridge-Reitz) rough dielectric interface with isotropic roughness `alpha`.
-    RoughDielectric { alpha: f32, int_ior: f32, ext_ior: f32 },
+    RoughDielectric {
+        alpha: f32,
+        int_ior: f32,
+        ext_ior: f32,
+    },
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -1,0 +1,328 @@
+//! Kernel launch parameters: plain `repr(C)` data that the host fills and a GPU kernel reads, and the
+//! conversion from them to the same [`VolumeScene`] types the CPU renders with.
+//!
+//! The host writes one [`LaunchParams`] into device memory and passes its address to the kernel. The
+//! kernel copies it, rebuilds its monomorphised scene with [`FromParams`] and runs the shared path step
+//! on it. Grids travel as device addresses plus their shape; every scalar is the very `f32` the host's
+//! render factory computed, and grid mappings are recomputed from the same inputs with the same
+//! operations, so a kernel's scene is bit for bit the CPU's scene.
+//!
+//! Pointers are stored as `u64` addresses so that the structs are the same on every target and are
+//! `Send + Sync` on the host. Only [`FromParams::from_params`] turns them back into references.
+
+use crate::bsdf::{NullBoundary, RoughDielectric, SmoothDielectric};
+use crate::camera::PerspectiveCamera;
+use crate::environment::ConstantEnvironment;
+use crate::grid::{Grid, GridMapping};
+use crate::medium::{ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium};
+use crate::microfacet::Ggx;
+use crate::path::PathSettings;
+use crate::phase::{HenyeyGreenstein, Isotropic};
+use crate::scene::VolumeScene;
+use crate::{Aabb, Spectrum, Vec2, Vec3};
+
+/// Where a grid's samples sit in its box: [`GridMapping::vertex_centred`].
+pub const GRID_VERTEX_CENTRED: u32 = 0;
+/// Where a grid's samples sit in its box: [`GridMapping::cell_centred`].
+pub const GRID_CELL_CENTRED: u32 = 1;
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CameraParams {
+    pub origin: [f32; 3],
+    pub axis_x: [f32; 3],
+    pub axis_y: [f32; 3],
+    pub axis_z: [f32; 3],
+    pub tan_half_fov: [f32; 2],
+    pub width: u32,
+    pub height: u32,
+}
+
+impl From<&PerspectiveCamera> for CameraParams {
+    fn from(c: &PerspectiveCamera) -> Self {
+        Self {
+            origin: c.origin.to_array(),
+            axis_x: c.axis_x.to_array(),
+            axis_y: c.axis_y.to_array(),
+            axis_z: c.axis_z.to_array(),
+            tan_half_fov: c.tan_half_fov.to_array(),
+            width: c.width,
+            height: c.height,
+        }
+    }
+}
+
+impl CameraParams {
+    #[inline]
+    pub fn camera(&self) -> PerspectiveCamera {
+        PerspectiveCamera {
+            origin: Vec3::from_array(self.origin),
+            axis_x: Vec3::from_array(self.axis_x),
+            axis_y: Vec3::from_array(self.axis_y),
+            axis_z: Vec3::from_array(self.axis_z),
+            tan_half_fov: Vec2::from_array(self.tan_half_fov),
+            width: self.width,
+            height: self.height,
+        }
+    }
+}
+
+/// A dense grid in device memory: `len` `f32` values at address `data`, laid out as [`Grid`] says.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GridParams {
+    pub data: u64,
+    /// Number of `f32` values at `data` (`res_x * res_y * res_z * channels`).
+    pub len: u64,
+    pub res: [u32; 3],
+    /// [`GRID_VERTEX_CENTRED`] or [`GRID_CELL_CENTRED`].
+    pub convention: u32,
+    pub bounds_min: [f32; 3],
+    pub bounds_max: [f32; 3],
+}
+
+impl GridParams {
+    /// The grid these parameters describe.
+    ///
+    /// # Safety
+    /// `data` must point to `len` initialised `f32` values that stay valid and unchanged for `'a`,
+    /// and `len` must equal `res_x * res_y * res_z * C`.
+    #[inline]
+    pub unsafe fn grid<'a, const C: usize>(&self) -> Grid<'a, C> {
+        let bounds = Aabb::new(
+            Vec3::from_array(self.bounds_min),
+            Vec3::from_array(self.bounds_max),
+        );
+        let mapping = if self.convention == GRID_VERTEX_CENTRED {
+            GridMapping::vertex_centred(bounds, self.res)
+        } else {
+            GridMapping::cell_centred(bounds, self.res)
+        };
+        Grid {
+            // SAFETY: the caller guarantees the address range.
+            data: unsafe {
+                core::slice::from_raw_parts(self.data as *const f32, self.len as usize)
+            },
+            res: self.res,
+            mapping,
+        }
+    }
+}
+
+/// The medium: the fields a variant does not use are ignored (a homogeneous medium reads no grid).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MediumParams {
+    /// Homogeneous extinction (already multiplied by the scale).
+    pub sigma_t: f32,
+    /// Constant albedo (homogeneous and grid-density media).
+    pub albedo: [f32; 3],
+    /// Grid media: `sigma_t(p) = density_scale * density(p)`.
+    pub density_scale: f32,
+    /// Grid media: `density_scale * max(density)`.
+    pub majorant: f32,
+    pub density: GridParams,
+    /// Three channels, grid-density-albedo media only.
+    pub albedo_grid: GridParams,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BoundaryParams {
+    /// `n_inside / n_outside` (dielectric boundaries).
+    pub eta: f32,
+    /// GGX roughness (rough dielectric).
+    pub alpha: f32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PhaseParams {
+    /// Henyey-Greenstein asymmetry.
+    pub g: f32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SettingsParams {
+    pub max_depth: u32,
+    pub rr_depth: u32,
+    pub max_segments: u32,
+}
+
+impl From<&PathSettings> for SettingsParams {
+    fn from(s: &PathSettings) -> Self {
+        Self {
+            max_depth: s.max_depth,
+            rr_depth: s.rr_depth,
+            max_segments: s.max_segments,
+        }
+    }
+}
+
+impl SettingsParams {
+    #[inline]
+    pub fn settings(&self) -> PathSettings {
+        PathSettings {
+            max_depth: self.max_depth,
+            rr_depth: self.rr_depth,
+            max_segments: self.max_segments,
+        }
+    }
+}
+
+/// Everything a kernel needs to rebuild any scene variant.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SceneParams {
+    pub camera: CameraParams,
+    pub bounds_min: [f32; 3],
+    pub bounds_max: [f32; 3],
+    pub medium: MediumParams,
+    pub boundary: BoundaryParams,
+    pub phase: PhaseParams,
+    /// Constant environment radiance.
+    pub environment: [f32; 3],
+    pub settings: SettingsParams,
+}
+
+/// One launch: the scene, the sampling, and the device buffers the kernel writes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LaunchParams {
+    pub scene: SceneParams,
+    pub spp: u32,
+    pub seed: u32,
+    /// `width * height * 3` `f64` sums of the samples' radiance, zeroed before the launch.
+    pub film: u64,
+    /// [`COUNTERS`] `u64` totals (paths, segments, tracking steps, truncated), zeroed before the launch.
+    pub counters: u64,
+    /// One `u64`, zeroed before the launch: the next path index a persistent thread takes.
+    pub next_path: u64,
+    /// Paths to trace: `width * height * spp`.
+    pub total_paths: u64,
+}
+
+/// Number of `u64` counters a launch reduces: paths, segments, tracking steps, truncated paths.
+pub const COUNTERS: usize = 4;
+
+/// Rebuilds a scene component from launch parameters.
+pub trait FromParams<'a>: Sized {
+    /// # Safety
+    /// The grid addresses in `p` that this component reads must satisfy [`GridParams::grid`]'s
+    /// contract for `'a`.
+    unsafe fn from_params(p: &'a SceneParams) -> Self;
+}
+
+impl FromParams<'_> for HomogeneousMedium {
+    #[inline]
+    unsafe fn from_params(p: &SceneParams) -> Self {
+        Self {
+            sigma_t: p.medium.sigma_t,
+            albedo: Spectrum::from_array(p.medium.albedo),
+        }
+    }
+}
+
+impl<'a> FromParams<'a> for GridMedium<'a, ConstantAlbedo> {
+    #[inline]
+    unsafe fn from_params(p: &'a SceneParams) -> Self {
+        Self {
+            // SAFETY: forwarded to the caller.
+            density: unsafe { p.medium.density.grid::<1>() },
+            scale: p.medium.density_scale,
+            majorant: p.medium.majorant,
+            albedo: ConstantAlbedo(Spectrum::from_array(p.medium.albedo)),
+        }
+    }
+}
+
+impl<'a> FromParams<'a> for GridMedium<'a, GridAlbedo<'a>> {
+    #[inline]
+    unsafe fn from_params(p: &'a SceneParams) -> Self {
+        Self {
+            // SAFETY: forwarded to the caller.
+            density: unsafe { p.medium.density.grid::<1>() },
+            scale: p.medium.density_scale,
+            majorant: p.medium.majorant,
+            // SAFETY: forwarded to the caller.
+            albedo: GridAlbedo(unsafe { p.medium.albedo_grid.grid::<3>() }),
+        }
+    }
+}
+
+impl FromParams<'_> for NullBoundary {
+    #[inline]
+    unsafe fn from_params(_p: &SceneParams) -> Self {
+        NullBoundary
+    }
+}
+
+impl FromParams<'_> for SmoothDielectric {
+    #[inline]
+    unsafe fn from_params(p: &SceneParams) -> Self {
+        Self {
+            eta: p.boundary.eta,
+        }
+    }
+}
+
+impl FromParams<'_> for RoughDielectric {
+    #[inline]
+    unsafe fn from_params(p: &SceneParams) -> Self {
+        Self {
+            eta: p.boundary.eta,
+            distribution: Ggx {
+                alpha: p.boundary.alpha,
+            },
+        }
+    }
+}
+
+impl FromParams<'_> for Isotropic {
+    #[inline]
+    unsafe fn from_params(_p: &SceneParams) -> Self {
+        Isotropic
+    }
+}
+
+impl FromParams<'_> for HenyeyGreenstein {
+    #[inline]
+    unsafe fn from_params(p: &SceneParams) -> Self {
+        Self { g: p.phase.g }
+    }
+}
+
+impl FromParams<'_> for ConstantEnvironment {
+    #[inline]
+    unsafe fn from_params(p: &SceneParams) -> Self {
+        ConstantEnvironment(Spectrum::from_array(p.environment))
+    }
+}
+
+impl<'a, M, B, P, E> FromParams<'a> for VolumeScene<M, B, P, E>
+where
+    M: FromParams<'a>,
+    B: FromParams<'a>,
+    P: FromParams<'a>,
+    E: FromParams<'a>,
+{
+    #[inline]
+    unsafe fn from_params(p: &'a SceneParams) -> Self {
+        // SAFETY: forwarded to the caller.
+        unsafe {
+            Self {
+                camera: p.camera.camera(),
+                bounds: Aabb::new(
+                    Vec3::from_array(p.bounds_min),
+                    Vec3::from_array(p.bounds_max),
+                ),
+                medium: M::from_params(p),
+                boundary: B::from_params(p),
+                phase: P::from_params(p),
+                environment: E::from_params(p),
+                settings: p.settings.settings(),
+            }
+        }
+    }
+}

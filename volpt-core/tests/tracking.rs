@@ -1,0 +1,300 @@
+//! Delta (Woodcock) tracking: free-flight distances against the analytic distribution
+//! `1 - exp(-tau(t))`, escape probabilities, the tentative-collision counter, and vacuum.
+//!
+//! Tentative collisions are a Poisson process of rate `majorant` along the ray, stopped at the
+//! accepted collision or at `t_max`. The counter counts the points of that process in
+//! [0, min(t_collision, t_max)] (the accepted one included), so by Wald's identity for Poisson
+//! processes E[steps] = majorant * E[min(t_collision, t_max)] = majorant * int_0^t_max exp(-tau(s)) ds.
+//! For a homogeneous medium (majorant = sigma_t, every collision accepted) that is
+//! 1 - exp(-sigma_t t_max), the collision probability: one step or none.
+
+mod common;
+
+use common::*;
+use volpt_core::math::ln;
+use volpt_core::tracking::delta_tracking;
+use volpt_core::{HomogeneousMedium, Medium, Ray, Rng, Spectrum, Vec3};
+
+const N: u32 = 100_000;
+
+/// sigma_t = 1 for x < 1, 4 for 1 <= x < 2, 0.5 beyond, with a chosen majorant.
+struct Layered {
+    majorant: f32,
+}
+
+impl Medium for Layered {
+    const HOMOGENEOUS: bool = false;
+
+    fn majorant(&self) -> f32 {
+        self.majorant
+    }
+
+    fn sigma_t(&self, p: Vec3) -> f32 {
+        if p.x < 1.0 {
+            1.0
+        } else if p.x < 2.0 {
+            4.0
+        } else {
+            0.5
+        }
+    }
+
+    fn albedo(&self, _p: Vec3) -> Spectrum {
+        Spectrum::ONE
+    }
+}
+
+/// A constant sigma_t that declares itself heterogeneous, so that the rejection step runs.
+struct ConstantButTracked {
+    sigma_t: f32,
+    majorant: f32,
+}
+
+impl Medium for ConstantButTracked {
+    const HOMOGENEOUS: bool = false;
+
+    fn majorant(&self) -> f32 {
+        self.majorant
+    }
+
+    fn sigma_t(&self, _p: Vec3) -> f32 {
+        self.sigma_t
+    }
+
+    fn albedo(&self, _p: Vec3) -> Spectrum {
+        Spectrum::ONE
+    }
+}
+
+/// Optical depth of `Layered` from x = 0 to x = t.
+fn layered_tau(t: f64) -> f64 {
+    if t < 1.0 {
+        t
+    } else if t < 2.0 {
+        1.0 + 4.0 * (t - 1.0)
+    } else {
+        5.0 + 0.5 * (t - 2.0)
+    }
+}
+
+/// int_0^t_max exp(-tau(s)) ds for `Layered`, segment by segment in closed form.
+fn layered_mean_flight(t_max: f64) -> f64 {
+    let segments = [(0.0, 1.0, 1.0), (1.0, 2.0, 4.0), (2.0, f64::INFINITY, 0.5)];
+    segments
+        .iter()
+        .filter(|(a, _, _)| *a < t_max)
+        .map(|&(a, b, sigma)| {
+            let b: f64 = if b < t_max { b } else { t_max };
+            (-layered_tau(a)).exp() * (1.0 - (-sigma * (b - a)).exp()) / sigma
+        })
+        .sum()
+}
+
+fn ray() -> Ray {
+    Ray::new(Vec3::ZERO, Vec3::X)
+}
+
+struct Flights {
+    /// Distances of the paths that collided.
+    distances: Vec<f64>,
+    escaped: usize,
+    steps: Moments,
+}
+
+fn fly<M: Medium>(medium: &M, t_max: f32, seed: u32) -> Flights {
+    let mut flights = Flights {
+        distances: Vec::new(),
+        escaped: 0,
+        steps: Moments::default(),
+    };
+    for i in 0..N {
+        let mut rng = Rng::new(seed, 7, i);
+        let mut steps = 0;
+        match delta_tracking(medium, &ray(), t_max, &mut rng, &mut steps) {
+            Some(t) => {
+                assert!(t >= 0.0 && t < t_max, "t = {t}");
+                flights.distances.push(t as f64);
+            }
+            None => flights.escaped += 1,
+        }
+        flights.steps.push(steps as f64);
+    }
+    flights
+}
+
+/// A deliberately wrong tracker that accepts with (sigma_t / majorant)^2: the power check.
+fn squared_acceptance_tracking<M: Medium>(medium: &M, ray: &Ray, rng: &mut Rng) -> f32 {
+    let majorant = medium.majorant();
+    let mut t = 0.0;
+    loop {
+        t -= ln(1.0 - rng.next_f32()) / majorant;
+        let ratio = medium.sigma_t(ray.at(t)) / majorant;
+        if rng.next_f32() < ratio * ratio {
+            return t;
+        }
+    }
+}
+
+// Every KS test below rejects at ALPHA over the number of KS tests in this file (Bonferroni).
+const KS_TESTS: f64 = 7.0;
+
+#[test]
+fn homogeneous_free_flights_are_exponential() {
+    let sigma = 2.5f64;
+    let medium = HomogeneousMedium {
+        sigma_t: sigma as f32,
+        albedo: Spectrum::ONE,
+    };
+    for (case, t_max) in [f32::INFINITY, 1e30].into_iter().enumerate() {
+        let f = fly(&medium, t_max, 10 + case as u32);
+        assert_eq!(f.escaped, 0);
+        let ks = ks_test(&f.distances, |t| 1.0 - (-sigma * t).exp());
+        assert!(ks.p_value > ALPHA / KS_TESTS, "t_max {t_max}: {ks:?}");
+        // Power: the same samples are rejected as exponential with sigma 4% off (D ~ 0.006 vs the
+        // 1.9 / sqrt(N) = 0.006 critical value at the Bonferroni level; 2.6 is farther).
+        let wrong = ks_test(&f.distances, |t| 1.0 - (-2.6 * t).exp());
+        assert!(wrong.p_value < ALPHA / KS_TESTS, "no power: {wrong:?}");
+        // A homogeneous medium accepts its first tentative collision: exactly one step.
+        assert_eq!(f.steps.mean(), 1.0);
+    }
+}
+
+#[test]
+fn homogeneous_escape_probability_and_steps() {
+    let sigma = 2.5f64;
+    let t_max = 0.6f64;
+    let medium = HomogeneousMedium {
+        sigma_t: sigma as f32,
+        albedo: Spectrum::ONE,
+    };
+    let f = fly(&medium, t_max as f32, 20);
+    // Escapes are Bernoulli(exp(-sigma t_max)): within 5 standard errors.
+    let p = (-sigma * t_max).exp();
+    let freq = f.escaped as f64 / N as f64;
+    let se = (p * (1.0 - p) / N as f64).sqrt();
+    assert!((freq - p).abs() < Z_MAX * se, "escaped {freq} vs {p}");
+    // Collided distances follow the exponential truncated at t_max.
+    let ks = ks_test(&f.distances, |t| (1.0 - (-sigma * t).exp()) / (1.0 - p));
+    assert!(ks.p_value > ALPHA / KS_TESTS, "{ks:?}");
+    // One step per collision, none per escape: E[steps] = sigma E[min(t, t_max)] = 1 - p.
+    assert!(
+        f.steps.z_score(1.0 - p) < Z_MAX,
+        "steps {} vs {}",
+        f.steps.mean(),
+        1.0 - p
+    );
+    assert!((f.steps.mean() - f.distances.len() as f64 / N as f64).abs() < 1e-9);
+}
+
+#[test]
+fn piecewise_constant_medium_matches_optical_depth() {
+    let cdf = |t: f64| 1.0 - (-layered_tau(t)).exp();
+    let mut by_majorant = Vec::new();
+    for (case, majorant) in [4.0f32, 40.0].into_iter().enumerate() {
+        let medium = Layered { majorant };
+        let f = fly(&medium, f32::INFINITY, 30 + case as u32);
+        assert_eq!(f.escaped, 0);
+        let ks = ks_test(&f.distances, cdf);
+        eprintln!("majorant {majorant}: {ks:?}");
+        assert!(ks.p_value > ALPHA / KS_TESTS, "majorant {majorant}: {ks:?}");
+        // Tentative collisions: E[steps] = majorant * int_0^inf exp(-tau) (see the module doc).
+        let expected = majorant as f64 * layered_mean_flight(f64::INFINITY);
+        assert!(
+            f.steps.z_score(expected) < Z_MAX,
+            "majorant {majorant}: steps {} +- {} vs {expected}",
+            f.steps.mean(),
+            f.steps.std_error()
+        );
+        by_majorant.push(f.distances);
+    }
+    // A ten times looser majorant samples the same distribution (only more slowly).
+    let ks = ks_test_2(&by_majorant[0], &by_majorant[1]);
+    assert!(ks.p_value > ALPHA / KS_TESTS, "majorant 4 vs 40: {ks:?}");
+
+    // Power: accepting with (sigma / majorant)^2 gives a different distribution, and the same test
+    // rejects it.
+    let medium = Layered { majorant: 4.0 };
+    let wrong: Vec<f64> = (0..N)
+        .map(|i| squared_acceptance_tracking(&medium, &ray(), &mut Rng::new(39, 7, i)) as f64)
+        .collect();
+    let ks = ks_test(&wrong, cdf);
+    assert!(ks.p_value < ALPHA / KS_TESTS, "no power: {ks:?}");
+}
+
+#[test]
+fn piecewise_constant_medium_with_finite_t_max() {
+    let t_max = 1.5f64;
+    for (case, majorant) in [4.0f32, 40.0].into_iter().enumerate() {
+        let medium = Layered { majorant };
+        let f = fly(&medium, t_max as f32, 40 + case as u32);
+        // P(escape) = exp(-tau(t_max)) = exp(-3).
+        let p = (-layered_tau(t_max)).exp();
+        let freq = f.escaped as f64 / N as f64;
+        let se = (p * (1.0 - p) / N as f64).sqrt();
+        assert!(
+            (freq - p).abs() < Z_MAX * se,
+            "majorant {majorant}: escaped {freq} vs {p}"
+        );
+        let expected = majorant as f64 * layered_mean_flight(t_max);
+        assert!(
+            f.steps.z_score(expected) < Z_MAX,
+            "majorant {majorant}: steps {} vs {expected}",
+            f.steps.mean()
+        );
+    }
+}
+
+#[test]
+fn rejection_on_a_constant_medium_is_exponential() {
+    // sigma_t 2.5 under majorant 4: the thinned process is again exponential with rate 2.5, and the
+    // expected number of steps is 4 / 2.5 (geometric number of trials).
+    let medium = ConstantButTracked {
+        sigma_t: 2.5,
+        majorant: 4.0,
+    };
+    let f = fly(&medium, f32::INFINITY, 50);
+    let ks = ks_test(&f.distances, |t| 1.0 - (-2.5 * t).exp());
+    assert!(ks.p_value > ALPHA / KS_TESTS, "{ks:?}");
+    assert!(
+        f.steps.z_score(4.0 / 2.5) < Z_MAX,
+        "steps {}",
+        f.steps.mean()
+    );
+}
+
+#[test]
+fn vacuum_returns_immediately() {
+    let mut rng = Rng::new(1, 2, 3);
+    let mut steps = 0;
+    let vacuum = HomogeneousMedium {
+        sigma_t: 0.0,
+        albedo: Spectrum::ONE,
+    };
+    assert_eq!(
+        delta_tracking(&vacuum, &ray(), f32::INFINITY, &mut rng, &mut steps),
+        None
+    );
+    assert_eq!(
+        delta_tracking(
+            &Layered { majorant: 0.0 },
+            &ray(),
+            10.0,
+            &mut rng,
+            &mut steps
+        ),
+        None
+    );
+    // No tentative collision, and no random number consumed.
+    assert_eq!(steps, 0);
+    assert_eq!(rng.dimension(), 0);
+    // t_max = 0: nothing can happen before the boundary.
+    let medium = HomogeneousMedium {
+        sigma_t: 2.5,
+        albedo: Spectrum::ONE,
+    };
+    for i in 0..1000 {
+        let mut rng = Rng::new(1, 2, i);
+        let hit = delta_tracking(&medium, &ray(), 0.0, &mut rng, &mut steps);
+        assert!(hit.is_none() || hit == Some(0.0));
+    }
+}

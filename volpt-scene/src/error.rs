@@ -1,0 +1,212 @@
+//! Errors from loading a scene.
+//!
+//! Every message names the file it is about and, for XML, the line; value errors also name the
+//! field and say what was expected and what was found, so that a user can fix the scene without
+//! reading volpt's source. Each variant's message is complete on its own (it includes any
+//! underlying cause), so callers can print it with `{}` alone.
+
+use std::fmt;
+use std::path::PathBuf;
+
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum SceneError {
+    /// A file could not be read or written.
+    #[error("{}: {error}", path.display())]
+    Io {
+        path: PathBuf,
+        error: std::io::Error,
+    },
+
+    /// The file is not well-formed XML (or not UTF-8).
+    #[error("{}:{line}: malformed XML: {message}", path.display())]
+    Xml {
+        path: PathBuf,
+        line: usize,
+        message: String,
+    },
+
+    /// Valid Mitsuba that volpt does not render (an unknown element, plugin or combination).
+    #[error("{}:{line}: {what} is not supported: {reason}", path.display())]
+    Unsupported {
+        path: PathBuf,
+        line: usize,
+        what: String,
+        reason: String,
+    },
+
+    /// A value that cannot be parsed or is out of range.
+    #[error("{}:{line}: {field}: expected {expected}, found {found}", path.display())]
+    InvalidValue {
+        path: PathBuf,
+        line: usize,
+        field: String,
+        expected: String,
+        found: String,
+    },
+
+    /// Something required is absent; `element` is the element that should contain it.
+    #[error("{}:{line}: {element}: missing {what}", path.display())]
+    Missing {
+        path: PathBuf,
+        line: usize,
+        element: String,
+        what: String,
+    },
+
+    /// A `.vol` grid file is malformed or holds values volpt cannot use.
+    #[error("{}: {problem}", path.display())]
+    Vol { path: PathBuf, problem: VolProblem },
+
+    /// An error in a file that a scene file refers to (a grid, a mesh): says which element
+    /// referred to it, then the error itself (which names the referred-to file).
+    #[error("{}:{line}: {element}: {error}", path.display())]
+    Referenced {
+        path: PathBuf,
+        line: usize,
+        element: String,
+        error: Box<SceneError>,
+    },
+}
+
+/// What is wrong with a `.vol` file.
+#[derive(Clone, Debug, PartialEq)]
+pub enum VolProblem {
+    /// The file is shorter than the fixed-size header.
+    TruncatedHeader {
+        expected_bytes: u64,
+        actual_bytes: u64,
+    },
+    BadMagic {
+        found: [u8; 3],
+    },
+    UnsupportedVersion {
+        found: u8,
+    },
+    UnsupportedEncoding {
+        found: i32,
+    },
+    BadResolution {
+        found: [i32; 3],
+    },
+    BadChannels {
+        found: i32,
+    },
+    /// The declared size overflows or cannot be held in this machine's memory.
+    TooLarge {
+        resolution: [i32; 3],
+        channels: i32,
+    },
+    /// The data after the header is not exactly the size the header declares.
+    SizeMismatch {
+        resolution: [u32; 3],
+        channels: u32,
+        expected_bytes: u64,
+        actual_bytes: u64,
+    },
+    BadBounds {
+        min: [f32; 3],
+        max: [f32; 3],
+    },
+    /// A voxel value outside what the grid's role allows (non-finite, negative, above 1).
+    BadValue {
+        voxel: [u32; 3],
+        channel: u32,
+        value: f32,
+        expected: &'static str,
+    },
+    /// The grid has a channel count its role does not allow.
+    WrongChannels {
+        role: &'static str,
+        expected: &'static str,
+        found: u32,
+    },
+    /// An in-memory grid whose data length disagrees with its resolution (when writing).
+    DataLength {
+        expected: usize,
+        found: usize,
+    },
+}
+
+impl fmt::Display for VolProblem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::TruncatedHeader {
+                expected_bytes,
+                actual_bytes,
+            } => write!(
+                f,
+                "truncated .vol header: expected {expected_bytes} bytes, found {actual_bytes}"
+            ),
+            Self::BadMagic { found } => write!(
+                f,
+                "not a Mitsuba .vol file: expected the bytes \"VOL\", found {:?}",
+                String::from_utf8_lossy(found)
+            ),
+            Self::UnsupportedVersion { found } => {
+                write!(f, "expected .vol format version 3, found version {found}")
+            }
+            Self::UnsupportedEncoding { found } => write!(
+                f,
+                "unsupported .vol encoding: expected 1 (float32), 2 (float16) or 3 (uint8), \
+                 found {found}"
+            ),
+            Self::BadResolution { found: [x, y, z] } => write!(
+                f,
+                "expected a positive resolution on every axis, found {x} x {y} x {z}"
+            ),
+            Self::BadChannels { found } => {
+                write!(f, "expected 1 or 3 channels, found {found}")
+            }
+            Self::TooLarge {
+                resolution: [x, y, z],
+                channels,
+            } => write!(
+                f,
+                "header declares {x} x {y} x {z} voxels x {channels} channels, \
+                 more than this machine can address"
+            ),
+            Self::SizeMismatch {
+                resolution: [x, y, z],
+                channels,
+                expected_bytes,
+                actual_bytes,
+            } => {
+                write!(
+                    f,
+                    "header declares {x} x {y} x {z} voxels x {channels} channels = \
+                     {expected_bytes} data bytes, but the file holds {actual_bytes} bytes \
+                     after the header"
+                )
+            }
+            Self::BadBounds { min, max } => write!(
+                f,
+                "bounding box: expected finite numbers, found min {min:?} max {max:?}"
+            ),
+            Self::BadValue {
+                voxel: [x, y, z],
+                channel,
+                value,
+                expected,
+            } => write!(
+                f,
+                "voxel (x={x}, y={y}, z={z}) channel {channel}: expected {expected}, found {value}"
+            ),
+            Self::WrongChannels {
+                role,
+                expected,
+                found,
+            } => {
+                write!(
+                    f,
+                    "{role} grid: expected {expected}, found {found} channels"
+                )
+            }
+            Self::DataLength { expected, found } => write!(
+                f,
+                "grid data: expected {expected} values (resolution x channels), found {found}"
+            ),
+        }
+    }
+}
