@@ -69,7 +69,7 @@ struct Cpu(RenderOptions);
 
 impl SceneVisitor for Cpu {
     type Output = (Image, RenderStats);
-    fn visit<S: Scene + Sync>(self, scene: &S) -> Self::Output {
+    fn visit<S: Scene + Sync + volpt_core::launch::ToParams>(self, scene: &S) -> Self::Output {
         render(scene, &self.0, &|_, _| {}).expect("render")
     }
 }

@@ -23,7 +23,7 @@ struct ExpectedTransmittance {
 impl SceneVisitor for ExpectedTransmittance {
     type Output = (Vec<f64>, Vec<f64>);
 
-    fn visit<S: Scene + Sync>(self, scene: &S) -> Self::Output {
+    fn visit<S: Scene + Sync + volpt_core::launch::ToParams>(self, scene: &S) -> Self::Output {
         let camera = scene.camera();
         let (mut mean, mut var) = (Vec::new(), Vec::new());
         for y in 0..camera.height {
@@ -278,7 +278,7 @@ struct FurnaceSampleMean {
 
 impl SceneVisitor for FurnaceSampleMean {
     type Output = (f64, f64, u64);
-    fn visit<S: Scene + Sync>(self, scene: &S) -> Self::Output {
+    fn visit<S: Scene + Sync + volpt_core::launch::ToParams>(self, scene: &S) -> Self::Output {
         let (mut sum, mut sum2, mut killed) = (0.0, 0.0, 0);
         for s in 0..self.paths {
             let mut path = PathState::from_camera(scene, 8, 8, s, 9);

@@ -5,8 +5,10 @@ use std::time::Duration;
 use anyhow::Result;
 use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressStyle};
+use volpt_core::launch::ToParams;
 use volpt_core::{PathSettings, Scene};
-use volpt_render::{render, with_scene, Image, RenderOptions, RenderStats, SceneVisitor};
+use volpt_cuda::{CudaRenderer, Strategy};
+use volpt_render::{render, with_scene, Image, RenderOptions, RenderStats, SceneVisitor, Variant};
 use volpt_scene::SceneDescription;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -22,73 +24,116 @@ pub struct RenderJob<'a> {
     pub desc: &'a SceneDescription,
     pub settings: PathSettings,
     pub options: RenderOptions,
-    /// The GPU scheduling strategy (ignored by the CPU).
-    pub strategy: Option<&'a str>,
     pub show_progress: bool,
 }
 
-pub fn run(backend: BackendKind, job: &RenderJob) -> Result<(Image, RenderStats)> {
-    match backend {
-        BackendKind::Cpu => {
-            if let Some(strategy) = job.strategy {
-                anyhow::bail!(
-                    "--strategy {strategy} schedules GPU work; the CPU backend has no strategies \
-                     (use --backend cuda, or drop --strategy)"
-                );
+/// An opened backend, reused across renders (a GPU's kernels are loaded once).
+pub enum Backend {
+    Cpu,
+    Cuda {
+        renderer: CudaRenderer,
+        strategy: Strategy,
+    },
+}
+
+impl Backend {
+    /// Opens `kind`; `strategy` is the GPU scheduling strategy (regeneration-sk by default).
+    pub fn open(kind: BackendKind, strategy: Option<&str>) -> Result<Self> {
+        match kind {
+            BackendKind::Cpu => {
+                if let Some(strategy) = strategy {
+                    anyhow::bail!(
+                        "--strategy {strategy} schedules GPU work; the CPU backend has no \
+                         strategies (use --backend cuda, or drop --strategy)"
+                    );
+                }
+                Ok(Backend::Cpu)
             }
-            with_scene(
-                job.desc,
-                job.settings,
-                CpuRender {
-                    options: job.options,
-                    show_progress: job.show_progress,
-                },
-            )
+            BackendKind::Cuda => {
+                let strategy = match strategy {
+                    Some(name) => name.parse()?,
+                    None => Strategy::RegenerationSk,
+                };
+                Ok(Backend::Cuda {
+                    renderer: CudaRenderer::new(0)?,
+                    strategy,
+                })
+            }
         }
-        BackendKind::Cuda => anyhow::bail!(
-            "this volpt was built without the CUDA backend (see the GPU backend issue)"
-        ),
+    }
+
+    /// What the report calls the machine this backend runs on.
+    pub fn device_name(&self) -> String {
+        match self {
+            Backend::Cpu => format!(
+                "CPU, {} threads",
+                std::thread::available_parallelism().map_or(1, |n| n.get())
+            ),
+            Backend::Cuda { renderer, .. } => renderer.device_name().to_owned(),
+        }
+    }
+
+    pub fn strategy(&self) -> Option<Strategy> {
+        match self {
+            Backend::Cpu => None,
+            Backend::Cuda { strategy, .. } => Some(*strategy),
+        }
+    }
+
+    pub fn render(&self, job: &RenderJob) -> Result<(Image, RenderStats)> {
+        let visitor = Render {
+            backend: self,
+            variant: Variant::of(job.desc),
+            options: job.options,
+            progress: progress_bar(job.show_progress),
+        };
+        let result = with_scene(job.desc, job.settings, visitor);
+        result
     }
 }
 
-struct CpuRender {
+struct Render<'a> {
+    backend: &'a Backend,
+    variant: Variant,
     options: RenderOptions,
-    show_progress: bool,
+    progress: ProgressBar,
 }
 
-impl SceneVisitor for CpuRender {
+impl SceneVisitor for Render<'_> {
     type Output = Result<(Image, RenderStats)>;
 
-    fn visit<S: Scene + Sync>(self, scene: &S) -> Self::Output {
-        let bar = if self.show_progress {
-            let bar = ProgressBar::new(0);
-            bar.set_style(
-                ProgressStyle::with_template(
-                    "{spinner} [{elapsed_precise}] {wide_bar} {percent}% eta {eta}",
-                )
-                .expect("static template"),
-            );
-            bar.enable_steady_tick(Duration::from_millis(200));
-            bar
-        } else {
-            ProgressBar::hidden()
-        };
-        let result = render(scene, &self.options, &|done, total| {
+    fn visit<S: Scene + Sync + ToParams>(self, scene: &S) -> Self::Output {
+        let bar = &self.progress;
+        let report = |done, total| {
             bar.set_length(total);
             bar.set_position(done);
-        });
+        };
+        let result = match self.backend {
+            Backend::Cpu => render(scene, &self.options, &report)?,
+            Backend::Cuda { renderer, strategy } => renderer.render(
+                scene,
+                &self.variant.to_string(),
+                *strategy,
+                &self.options,
+                &report,
+            )?,
+        };
         bar.finish_and_clear();
-        Ok(result?)
+        Ok(result)
     }
 }
 
-/// What the report calls the machine a backend ran on.
-pub fn device_name(backend: BackendKind) -> String {
-    match backend {
-        BackendKind::Cpu => format!(
-            "CPU, {} threads",
-            std::thread::available_parallelism().map_or(1, |n| n.get())
-        ),
-        BackendKind::Cuda => "CUDA (not built)".to_owned(),
+fn progress_bar(show: bool) -> ProgressBar {
+    if !show {
+        return ProgressBar::hidden();
     }
+    let bar = ProgressBar::new(0);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{spinner} [{elapsed_precise}] {wide_bar} {percent}% eta {eta}",
+        )
+        .expect("static template"),
+    );
+    bar.enable_steady_tick(Duration::from_millis(200));
+    bar
 }

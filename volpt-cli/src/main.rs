@@ -2,6 +2,7 @@
 
 mod backend;
 mod bench;
+mod compare;
 mod info;
 
 use std::path::PathBuf;
@@ -13,7 +14,7 @@ use volpt_render::image::preview_path;
 use volpt_render::{path_settings, Image, RenderOptions, RenderStats, Variant};
 use volpt_scene::SceneDescription;
 
-use backend::{BackendKind, RenderJob};
+use backend::{Backend, BackendKind, RenderJob};
 
 #[derive(Parser)]
 #[command(
@@ -34,6 +35,21 @@ enum Command {
     Bench(BenchArgs),
     /// Print what a scene file loads to, and the variant it renders with.
     Info(SceneArgs),
+    /// Work on the included scenes.
+    #[command(subcommand)]
+    Scene(SceneCommand),
+    /// Compare two OpenEXR images pixel by pixel (e.g. a CPU and a GPU render of one seed).
+    Compare(compare::CompareArgs),
+}
+
+#[derive(Subcommand)]
+enum SceneCommand {
+    /// Write the generated grids of the thesis scenes (cgg-logo, ad) under DIR.
+    Generate {
+        /// The `scenes/` directory of a volpt checkout or bundle.
+        #[arg(default_value = "scenes")]
+        dir: PathBuf,
+    },
 }
 
 #[derive(Args)]
@@ -59,7 +75,7 @@ struct SamplingArgs {
     /// Where to render.
     #[arg(long, value_enum, default_value_t = BackendKind::Cpu)]
     backend: BackendKind,
-    /// GPU scheduling strategy (see `volpt render --help` of a CUDA build for the list).
+    /// GPU scheduling strategy: naive-sk or regeneration-sk (default).
     #[arg(long)]
     strategy: Option<String>,
 }
@@ -111,6 +127,13 @@ fn main() -> Result<()> {
             print!("{}", info::describe(&args.scene, &desc));
             Ok(())
         }
+        Command::Scene(SceneCommand::Generate { dir }) => {
+            for path in volpt_scene::generate::generate_thesis_grids(&dir)? {
+                println!("wrote {}", path.display());
+            }
+            Ok(())
+        }
+        Command::Compare(args) => compare::run(&args),
     }
 }
 
@@ -135,9 +158,9 @@ fn render_command(args: RenderArgs) -> Result<()> {
         desc: &desc,
         settings: path_settings(&desc),
         options: options(&desc, &args.sampling)?,
-        strategy: args.sampling.strategy.as_deref(),
         show_progress: true,
     };
+    let backend = Backend::open(args.sampling.backend, args.sampling.strategy.as_deref())?;
     let variant = Variant::of(&desc);
     tracing::info!(
         scene = %args.scene.scene.display(),
@@ -145,10 +168,11 @@ fn render_command(args: RenderArgs) -> Result<()> {
         width = desc.film.width,
         height = desc.film.height,
         spp = job.options.spp,
-        backend = ?args.sampling.backend,
+        device = %backend.device_name(),
+        strategy = ?backend.strategy(),
         "rendering"
     );
-    let (image, stats) = backend::run(args.sampling.backend, &job)?;
+    let (image, stats) = backend.render(&job)?;
     image
         .write_exr(&args.output)
         .with_context(|| format!("writing {}", args.output.display()))?;
@@ -192,13 +216,13 @@ fn bench_command(args: BenchArgs) -> Result<()> {
         desc: &desc,
         settings: path_settings(&desc),
         options: options(&desc, &args.sampling)?,
-        strategy: args.sampling.strategy.as_deref(),
         show_progress: false,
     };
+    let backend = Backend::open(args.sampling.backend, args.sampling.strategy.as_deref())?;
     let mut trials = Vec::with_capacity(args.trials);
     let mut last = None;
     for trial in 0..=args.trials {
-        let (image, stats) = backend::run(args.sampling.backend, &job)?;
+        let (image, stats) = backend.render(&job)?;
         tracing::debug!(trial, seconds = stats.elapsed.as_secs_f64(), "trial");
         if trial > 0 {
             trials.push(stats);
@@ -217,8 +241,8 @@ fn bench_command(args: BenchArgs) -> Result<()> {
     let report = bench::BenchReport {
         scene: args.scene.scene.display().to_string(),
         backend: format!("{:?}", args.sampling.backend).to_lowercase(),
-        strategy: args.sampling.strategy.clone(),
-        device: backend::device_name(args.sampling.backend),
+        strategy: backend.strategy().map(|s| s.name().to_owned()),
+        device: backend.device_name(),
         variant: Variant::of(&desc).to_string(),
         width: image.width,
         height: image.height,

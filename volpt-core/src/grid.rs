@@ -34,6 +34,26 @@ impl GridMapping {
         }
     }
 
+    /// A mapping from its parts, as [`GridMapping::scale`] and [`GridMapping::offset`] return them
+    /// (used to ship a mapping to a GPU bit for bit).
+    pub fn from_parts(bounds: Aabb, scale: Vec3, offset: Vec3) -> Self {
+        Self {
+            bounds,
+            scale,
+            offset,
+        }
+    }
+
+    /// Index-space units per unit of normalised box coordinate, per axis.
+    pub fn scale(&self) -> Vec3 {
+        self.scale
+    }
+
+    /// Index-space offset added after scaling.
+    pub fn offset(&self) -> Vec3 {
+        self.offset
+    }
+
     #[inline]
     pub fn to_index_space(&self, p: Vec3) -> Vec3 {
         (p - self.bounds.min) / self.bounds.extent() * self.scale + self.offset

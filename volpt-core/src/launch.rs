@@ -1,11 +1,11 @@
 //! Kernel launch parameters: plain `repr(C)` data that the host fills and a GPU kernel reads, and the
 //! conversion from them to the same [`VolumeScene`] types the CPU renders with.
 //!
-//! The host writes one [`LaunchParams`] into device memory and passes its address to the kernel. The
-//! kernel copies it, rebuilds its monomorphised scene with [`FromParams`] and runs the shared path step
-//! on it. Grids travel as device addresses plus their shape; every scalar is the very `f32` the host's
-//! render factory computed, and grid mappings are recomputed from the same inputs with the same
-//! operations, so a kernel's scene is bit for bit the CPU's scene.
+//! The host fills one [`LaunchParams`] from its render-ready scene with [`ToParams`], copies it into
+//! device memory and passes its address to the kernel. The kernel copies it back, rebuilds its
+//! monomorphised scene with [`FromParams`] and runs the shared path step on it. Grids travel as
+//! device addresses plus their shape and mapping; every scalar is the very `f32` the host's render
+//! factory computed, so a kernel's scene is bit for bit the CPU's scene.
 //!
 //! Pointers are stored as `u64` addresses so that the structs are the same on every target and are
 //! `Send + Sync` on the host. Only [`FromParams::from_params`] turns them back into references.
@@ -20,11 +20,6 @@ use crate::path::PathSettings;
 use crate::phase::{HenyeyGreenstein, Isotropic};
 use crate::scene::VolumeScene;
 use crate::{Aabb, Spectrum, Vec2, Vec3};
-
-/// Where a grid's samples sit in its box: [`GridMapping::vertex_centred`].
-pub const GRID_VERTEX_CENTRED: u32 = 0;
-/// Where a grid's samples sit in its box: [`GridMapping::cell_centred`].
-pub const GRID_CELL_CENTRED: u32 = 1;
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -67,7 +62,8 @@ impl CameraParams {
     }
 }
 
-/// A dense grid in device memory: `len` `f32` values at address `data`, laid out as [`Grid`] says.
+/// A dense grid in device memory: `len` `f32` values at address `data`, laid out as [`Grid`] says,
+/// and its world-to-index mapping as the host computed it.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct GridParams {
@@ -75,13 +71,28 @@ pub struct GridParams {
     /// Number of `f32` values at `data` (`res_x * res_y * res_z * channels`).
     pub len: u64,
     pub res: [u32; 3],
-    /// [`GRID_VERTEX_CENTRED`] or [`GRID_CELL_CENTRED`].
-    pub convention: u32,
+    pub channels: u32,
     pub bounds_min: [f32; 3],
     pub bounds_max: [f32; 3],
+    pub scale: [f32; 3],
+    pub offset: [f32; 3],
 }
 
 impl GridParams {
+    /// The parameters of `grid`, whose values were copied to device address `data`.
+    pub fn new<const C: usize>(grid: &Grid<'_, C>, data: u64) -> Self {
+        Self {
+            data,
+            len: grid.data.len() as u64,
+            res: grid.res,
+            channels: C as u32,
+            bounds_min: grid.mapping.bounds.min.to_array(),
+            bounds_max: grid.mapping.bounds.max.to_array(),
+            scale: grid.mapping.scale().to_array(),
+            offset: grid.mapping.offset().to_array(),
+        }
+    }
+
     /// The grid these parameters describe.
     ///
     /// # Safety
@@ -93,18 +104,17 @@ impl GridParams {
             Vec3::from_array(self.bounds_min),
             Vec3::from_array(self.bounds_max),
         );
-        let mapping = if self.convention == GRID_VERTEX_CENTRED {
-            GridMapping::vertex_centred(bounds, self.res)
-        } else {
-            GridMapping::cell_centred(bounds, self.res)
-        };
         Grid {
             // SAFETY: the caller guarantees the address range.
             data: unsafe {
                 core::slice::from_raw_parts(self.data as *const f32, self.len as usize)
             },
             res: self.res,
-            mapping,
+            mapping: GridMapping::from_parts(
+                bounds,
+                Vec3::from_array(self.scale),
+                Vec3::from_array(self.offset),
+            ),
         }
     }
 }
@@ -184,6 +194,8 @@ pub struct SceneParams {
     /// Constant environment radiance.
     pub environment: [f32; 3],
     pub settings: SettingsParams,
+    /// Explicit, so that no byte of the struct is uninitialised padding when it is copied.
+    pub padding: u32,
 }
 
 /// One launch: the scene, the sampling, and the device buffers the kernel writes.
@@ -191,17 +203,29 @@ pub struct SceneParams {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct LaunchParams {
     pub scene: SceneParams,
-    pub spp: u32,
+    /// This launch traces samples `first_sample .. first_sample + samples` of every pixel.
+    pub first_sample: u32,
+    pub samples: u32,
     pub seed: u32,
-    /// `width * height * 3` `f64` sums of the samples' radiance, zeroed before the launch.
+    /// Explicit, so that no byte of the struct is uninitialised padding when it is copied.
+    pub padding: u32,
+    /// `width * height * 3` `f64` sums of the samples' radiance, zeroed before the first launch;
+    /// each launch adds its samples.
     pub film: u64,
     /// [`COUNTERS`] `u64` totals (paths, segments, tracking steps, truncated), zeroed before the launch.
     pub counters: u64,
     /// One `u64`, zeroed before the launch: the next path index a persistent thread takes.
     pub next_path: u64,
-    /// Paths to trace: `width * height * spp`.
+    /// Paths to trace in this launch: `width * height * samples`.
     pub total_paths: u64,
 }
+
+// The host copies these structs to the device as bytes: they must have no implicit padding.
+const _: () = assert!(core::mem::size_of::<CameraParams>() == 64);
+const _: () = assert!(core::mem::size_of::<GridParams>() == 16 + 4 * 4 + 4 * 12);
+const _: () = assert!(core::mem::size_of::<MediumParams>() == 24 + 2 * 80);
+const _: () = assert!(core::mem::size_of::<SceneParams>() == 64 + 24 + 184 + 8 + 4 + 12 + 12 + 4);
+const _: () = assert!(core::mem::size_of::<LaunchParams>() == 312 + 16 + 4 * 8);
 
 /// Number of `u64` counters a launch reduces: paths, segments, tracking steps, truncated paths.
 pub const COUNTERS: usize = 4;
@@ -324,5 +348,84 @@ where
                 settings: p.settings.settings(),
             }
         }
+    }
+}
+
+/// The host side of [`FromParams`]: writes a scene component into launch parameters.
+///
+/// `upload` copies a grid's values to device memory and returns their device address; the caller
+/// keeps that memory alive for as long as the parameters are used.
+pub trait ToParams {
+    fn to_params(&self, p: &mut SceneParams, upload: &mut dyn FnMut(&[f32]) -> u64);
+}
+
+impl ToParams for HomogeneousMedium {
+    fn to_params(&self, p: &mut SceneParams, _upload: &mut dyn FnMut(&[f32]) -> u64) {
+        p.medium.sigma_t = self.sigma_t;
+        p.medium.albedo = self.albedo.to_array();
+    }
+}
+
+impl ToParams for GridMedium<'_, ConstantAlbedo> {
+    fn to_params(&self, p: &mut SceneParams, upload: &mut dyn FnMut(&[f32]) -> u64) {
+        p.medium.density = GridParams::new(&self.density, upload(self.density.data));
+        p.medium.density_scale = self.scale;
+        p.medium.majorant = self.majorant;
+        p.medium.albedo = self.albedo.0.to_array();
+    }
+}
+
+impl ToParams for GridMedium<'_, GridAlbedo<'_>> {
+    fn to_params(&self, p: &mut SceneParams, upload: &mut dyn FnMut(&[f32]) -> u64) {
+        p.medium.density = GridParams::new(&self.density, upload(self.density.data));
+        p.medium.density_scale = self.scale;
+        p.medium.majorant = self.majorant;
+        p.medium.albedo_grid = GridParams::new(&self.albedo.0, upload(self.albedo.0.data));
+    }
+}
+
+impl ToParams for NullBoundary {
+    fn to_params(&self, _p: &mut SceneParams, _upload: &mut dyn FnMut(&[f32]) -> u64) {}
+}
+
+impl ToParams for SmoothDielectric {
+    fn to_params(&self, p: &mut SceneParams, _upload: &mut dyn FnMut(&[f32]) -> u64) {
+        p.boundary.eta = self.eta;
+    }
+}
+
+impl ToParams for RoughDielectric {
+    fn to_params(&self, p: &mut SceneParams, _upload: &mut dyn FnMut(&[f32]) -> u64) {
+        p.boundary.eta = self.eta;
+        p.boundary.alpha = self.distribution.alpha;
+    }
+}
+
+impl ToParams for Isotropic {
+    fn to_params(&self, _p: &mut SceneParams, _upload: &mut dyn FnMut(&[f32]) -> u64) {}
+}
+
+impl ToParams for HenyeyGreenstein {
+    fn to_params(&self, p: &mut SceneParams, _upload: &mut dyn FnMut(&[f32]) -> u64) {
+        p.phase.g = self.g;
+    }
+}
+
+impl ToParams for ConstantEnvironment {
+    fn to_params(&self, p: &mut SceneParams, _upload: &mut dyn FnMut(&[f32]) -> u64) {
+        p.environment = self.0.to_array();
+    }
+}
+
+impl<M: ToParams, B: ToParams, P: ToParams, E: ToParams> ToParams for VolumeScene<M, B, P, E> {
+    fn to_params(&self, p: &mut SceneParams, upload: &mut dyn FnMut(&[f32]) -> u64) {
+        p.camera = CameraParams::from(&self.camera);
+        p.bounds_min = self.bounds.min.to_array();
+        p.bounds_max = self.bounds.max.to_array();
+        p.settings = SettingsParams::from(&self.settings);
+        self.medium.to_params(p, upload);
+        self.boundary.to_params(p, upload);
+        self.phase.to_params(p, upload);
+        self.environment.to_params(p, upload);
     }
 }

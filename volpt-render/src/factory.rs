@@ -8,6 +8,7 @@
 use std::fmt;
 
 use volpt_core::grid::{Grid, GridMapping};
+use volpt_core::launch::ToParams;
 use volpt_core::math::tan;
 use volpt_core::microfacet::Ggx;
 use volpt_core::{
@@ -99,7 +100,8 @@ impl fmt::Display for Variant {
 /// A computation over a render-ready scene of any variant.
 pub trait SceneVisitor {
     type Output;
-    fn visit<S: Scene + Sync>(self, scene: &S) -> Self::Output;
+    /// `ToParams` lets a GPU backend ship the very same scene to its kernels.
+    fn visit<S: Scene + Sync + ToParams>(self, scene: &S) -> Self::Output;
 }
 
 /// Builds the scene that `desc` describes, with `settings` for the integrator, and hands it to
@@ -176,7 +178,7 @@ struct Parts {
 
 fn with_boundary<M, V>(desc: &SceneDescription, parts: Parts, medium: M, visitor: V) -> V::Output
 where
-    M: volpt_core::Medium + Sync,
+    M: volpt_core::Medium + Sync + ToParams,
     V: SceneVisitor,
 {
     match desc.boundary.bsdf {
@@ -209,8 +211,8 @@ fn with_phase<M, B, V>(
     visitor: V,
 ) -> V::Output
 where
-    M: volpt_core::Medium + Sync,
-    B: volpt_core::Bsdf + Sync,
+    M: volpt_core::Medium + Sync + ToParams,
+    B: volpt_core::Bsdf + Sync + ToParams,
     V: SceneVisitor,
 {
     match desc.medium.phase {

@@ -8,7 +8,7 @@ use thiserror::Error;
 
 #[derive(Debug, Error)]
 pub enum ImageError {
-    #[error("{path}: cannot write OpenEXR: {source}")]
+    #[error("{path}: cannot read or write OpenEXR: {source}")]
     Exr {
         path: PathBuf,
         source: exr::error::Error,
@@ -47,6 +47,33 @@ impl Image {
         .map_err(|source| ImageError::Exr {
             path: path.to_owned(),
             source,
+        })
+    }
+
+    /// Reads the first RGB layer of an OpenEXR file (as [`Image::write_exr`] writes it).
+    pub fn read_exr(path: &Path) -> Result<Self, ImageError> {
+        use exr::prelude::{read_first_rgba_layer_from_file, Vec2};
+        let image = read_first_rgba_layer_from_file(
+            path,
+            |resolution: Vec2<usize>, _| {
+                let (w, h) = (resolution.width(), resolution.height());
+                (w, vec![[0.0f32; 3]; w * h])
+            },
+            |(w, pixels): &mut (usize, Vec<[f32; 3]>),
+             p: Vec2<usize>,
+             (r, g, b, _a): (f32, f32, f32, f32)| {
+                pixels[p.y() * *w + p.x()] = [r, g, b];
+            },
+        )
+        .map_err(|source| ImageError::Exr {
+            path: path.to_owned(),
+            source,
+        })?;
+        let size = image.layer_data.size;
+        Ok(Image {
+            width: size.width() as u32,
+            height: size.height() as u32,
+            pixels: image.layer_data.channel_data.pixels.1,
         })
     }
 

@@ -1,1 +1,144 @@
-fn main() {}
+//! Project automation: `cargo xtask <task>`.
+//!
+//! - `ptx`: compiles the GPU kernels (`volpt-cuda/kernels`) with rustc's NVPTX backend and writes
+//!   `volpt-cuda/ptx/volpt_kernels.ptx`, which `volpt-cuda` embeds at its next build.
+//! - `device-bundle`: the PTX, a release `volpt` with it embedded, the scenes, the third-party data
+//!   and the device script, in `bundle/` (git-ignored), ready to carry to the GPU machine.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use anyhow::{bail, Context, Result};
+
+fn main() -> Result<()> {
+    let task = std::env::args().nth(1);
+    match task.as_deref() {
+        Some("ptx") => ptx().map(|_| ()),
+        Some("device-bundle") => device_bundle(),
+        _ => {
+            eprintln!("usage: cargo xtask <ptx|device-bundle>");
+            std::process::exit(2)
+        }
+    }
+}
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("xtask lives in the workspace")
+        .to_owned()
+}
+
+fn run(cmd: &mut Command) -> Result<()> {
+    eprintln!("xtask: {cmd:?}");
+    let status = cmd.status().with_context(|| format!("starting {cmd:?}"))?;
+    if !status.success() {
+        bail!("{cmd:?} failed: {status}");
+    }
+    Ok(())
+}
+
+/// `core` must be rebuilt for nvptx64 (`-Zbuild-std`), which needs the standard library's source.
+fn ensure_rust_src() -> Result<()> {
+    let sysroot = Command::new("rustc")
+        .args(["--print", "sysroot"])
+        .output()?;
+    let sysroot = PathBuf::from(String::from_utf8(sysroot.stdout)?.trim());
+    if sysroot.join("lib/rustlib/src/rust/library/core").is_dir() {
+        return Ok(());
+    }
+    run(Command::new("rustup").args(["component", "add", "rust-src"]))
+}
+
+/// Builds the kernels and returns the path of the PTX.
+///
+/// Stable rustc with `RUSTC_BOOTSTRAP=1` (the `abi_ptx` feature); no linker is needed, because with
+/// fat LTO `--emit=asm` writes the whole linked module as PTX. A separate target directory keeps
+/// host builds from rebuilding `core`.
+fn ptx() -> Result<PathBuf> {
+    ensure_rust_src()?;
+    let root = root();
+    let target_dir = root.join("target-ptx");
+    run(Command::new(env!("CARGO"))
+        .current_dir(&root)
+        .env("RUSTC_BOOTSTRAP", "1")
+        .env(
+            "CARGO_TARGET_NVPTX64_NVIDIA_CUDA_RUSTFLAGS",
+            "-C target-cpu=sm_70 --emit=asm",
+        )
+        .env("CARGO_TARGET_NVPTX64_NVIDIA_CUDA_LINKER", "/bin/true")
+        .args([
+            "build",
+            "-Zbuild-std=core",
+            "--target",
+            "nvptx64-nvidia-cuda",
+        ])
+        .args(["--profile", "nvptx", "-p", "volpt-kernels", "--target-dir"])
+        .arg(&target_dir))?;
+    let built = target_dir.join("nvptx64-nvidia-cuda/nvptx/deps/volpt_kernels.s");
+    let ptx =
+        std::fs::read_to_string(&built).with_context(|| format!("reading {}", built.display()))?;
+    let entries = ptx.lines().filter(|l| l.contains(".entry")).count();
+    if entries == 0 {
+        bail!("{} has no kernel entry points", built.display());
+    }
+    let out = root.join("volpt-cuda/ptx/volpt_kernels.ptx");
+    // Rewrite only on change, so that an unchanged PTX does not rebuild volpt-cuda.
+    if std::fs::read_to_string(&out).ok().as_deref() != Some(ptx.as_str()) {
+        std::fs::write(&out, &ptx).with_context(|| format!("writing {}", out.display()))?;
+    }
+    eprintln!("xtask: {} kernels -> {}", entries, out.display());
+    Ok(out)
+}
+
+fn copy_dir(from: &Path, to: &Path, skip: &dyn Fn(&Path) -> bool) -> Result<()> {
+    std::fs::create_dir_all(to)?;
+    for entry in std::fs::read_dir(from)? {
+        let path = entry?.path();
+        if skip(&path) {
+            continue;
+        }
+        let dest = to.join(path.file_name().expect("directory entries have names"));
+        if path.is_dir() {
+            copy_dir(&path, &dest, skip)?;
+        } else {
+            std::fs::copy(&path, &dest).with_context(|| format!("copying {}", path.display()))?;
+        }
+    }
+    Ok(())
+}
+
+/// `bundle/`: everything the GPU machine (which has no Rust) needs for `bundle/run.sh`.
+fn device_bundle() -> Result<()> {
+    let root = root();
+    let ptx = ptx()?;
+    run(Command::new(env!("CARGO")).current_dir(&root).args([
+        "build",
+        "--release",
+        "-p",
+        "volpt-cli",
+    ]))?;
+    let bundle = root.join("bundle");
+    if bundle.exists() {
+        std::fs::remove_dir_all(&bundle)?;
+    }
+    std::fs::create_dir_all(bundle.join("bin"))?;
+    std::fs::copy(root.join("target/release/volpt"), bundle.join("bin/volpt"))?;
+    std::fs::copy(&ptx, bundle.join("volpt_kernels.ptx"))?;
+    // Generated grids are large and are regenerated on the device by `volpt scene generate`.
+    copy_dir(&root.join("scenes"), &bundle.join("scenes"), &|p| {
+        p.extension().is_some_and(|e| e == "vol")
+    })?;
+    let shared = root.join("../shared/data");
+    if shared.is_dir() {
+        copy_dir(&shared, &bundle.join("data"), &|_| false)?;
+    } else {
+        eprintln!(
+            "xtask: warning: {} is missing; smoke and bucky will not load",
+            shared.display()
+        );
+    }
+    std::fs::copy(root.join("bench/device/run.sh"), bundle.join("run.sh"))?;
+    eprintln!("xtask: bundle ready in {}", bundle.display());
+    Ok(())
+}

@@ -37,7 +37,8 @@ unsafe fn add_counters(c: &PathCounters, lp: &LaunchParams) {
     }
 }
 
-/// naiveSK: thread `i` renders pixel `i`, samples `0..spp` in order, summed in `f64`.
+/// naiveSK: thread `i` renders pixel `i`, adding this launch's samples to its `f64` sum in order
+/// (the CPU's order, so the sums are the CPU's bit for bit).
 ///
 /// # Safety
 /// `lp.film` must hold `3 * width * height` `f64`s and `lp.counters` `launch::COUNTERS` `u64`s.
@@ -49,19 +50,15 @@ pub unsafe fn naive<S: Scene>(scene: &S, lp: &LaunchParams) {
     let mut counters = PathCounters::default();
     if i < pixels {
         let (px, py) = (i % width, i / width);
-        let mut sum = [0.0f64; 3];
-        for sample in 0..lp.spp {
+        // SAFETY: pixel `i` is inside the film, and no other thread touches it.
+        let sum = unsafe { &mut *(lp.film as *mut [f64; 3]).add(i as usize) };
+        for sample in lp.first_sample..lp.first_sample + lp.samples {
             let mut path = PathState::from_camera(scene, px, py, sample, lp.seed);
             trace(scene, &mut path);
             counters.record(&path);
-            for (c, s) in sum.iter_mut().enumerate() {
-                *s += path.radiance[c] as f64;
+            for (s, r) in sum.iter_mut().zip(path.radiance.to_array()) {
+                *s += r as f64;
             }
-        }
-        let film = lp.film as *mut f64;
-        for (c, s) in sum.into_iter().enumerate() {
-            // SAFETY: pixel `i` is inside the film.
-            unsafe { *film.add(3 * i as usize + c) = s };
         }
     }
     // SAFETY: forwarded.
@@ -104,7 +101,7 @@ pub unsafe fn regeneration<S: Scene>(scene: &S, lp: &LaunchParams) {
                 let index = base + (wanting & below).count_ones() as u64;
                 if index < lp.total_paths {
                     pixel = (index % pixels) as u32;
-                    let sample = (index / pixels) as u32;
+                    let sample = lp.first_sample + (index / pixels) as u32;
                     path = PathState::from_camera(
                         scene,
                         pixel % width,

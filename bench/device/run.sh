@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# The GPU check-and-benchmark, run on the device machine from the bundle that
+# `cargo xtask device-bundle` builds (it has no Rust: everything here is prebuilt).
+#
+#   bash bundle/run.sh            # writes everything under $OUT (default: ./out)
+#   QUICK=1 bash bundle/run.sh    # correctness only, no benchmark
+#
+# 1. device and driver, and `ptxas -v` (registers, spills, stack) for every kernel;
+# 2. per scene: the CPU and each GPU strategy render the same seed; naive-sk must be bit-identical
+#    to the CPU (same paths, same summation order), regeneration-sk equal up to summation order;
+# 3. compute-sanitizer memcheck on one small render per strategy;
+# 4. `volpt bench` of every scene x strategy (first trial discarded), as JSON.
+set -uo pipefail
+cd "$(dirname "$0")"
+OUT=${OUT:-$PWD/out}
+mkdir -p "$OUT"
+VOLPT=$PWD/bin/volpt
+DATA=$PWD/data
+TRIALS=${TRIALS:-5}
+STRATEGIES=(naive-sk regeneration-sk)
+failures=0
+log() { echo "== $*" | tee -a "$OUT/summary.txt"; }
+check() { # check NAME CMD...: run, record, count failures
+    local name=$1; shift
+    if "$@" >"$OUT/$name.log" 2>&1; then log "PASS $name: $(tail -n 1 "$OUT/$name.log")"
+    else log "FAIL $name: $(tail -n 3 "$OUT/$name.log" | tr '\n' ' ')"; failures=$((failures + 1)); fi
+}
+
+log "date $(date -u +%Y-%m-%dT%H:%MZ)"
+nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.max.sm --format=csv,noheader | tee "$OUT/device.txt"
+nvcc --version | tail -n 2 >>"$OUT/device.txt"
+ARCH=sm_$(nvidia-smi --query-gpu=compute_cap --format=csv,noheader | head -n 1 | tr -d '.')
+ptxas -arch="$ARCH" -v volpt_kernels.ptx -o /dev/null >"$OUT/ptxas-$ARCH.txt" 2>&1
+log "ptxas -arch=$ARCH: $(grep -c 'Used' "$OUT/ptxas-$ARCH.txt") kernels reported"
+
+"$VOLPT" scene generate scenes >"$OUT/generate.log" 2>&1 || { log "FAIL generate"; failures=$((failures + 1)); }
+
+# name : scene file : extra -D parameters
+SCENES=(
+    "homogeneous-cube:scenes/homogeneous-cube/scene.xml:"
+    "homogeneous-cube-null:scenes/homogeneous-cube/scene.xml:-Dboundary=null"
+    "cgg-logo:scenes/cgg-logo/scene.xml:"
+    "ad:scenes/ad/scene.xml:"
+    "smoke:scenes/smoke/scene.xml:-Ddata=$DATA"
+    "bucky:scenes/bucky/scene.xml:-Ddata=$DATA"
+)
+
+for entry in "${SCENES[@]}"; do
+    IFS=: read -r name file params <<<"$entry"
+    [ -f "$file" ] || { log "SKIP $name: $file not in this bundle"; continue; }
+    # shellcheck disable=SC2086
+    "$VOLPT" render "$file" $params --spp 4 --seed 7 -o "$OUT/$name-cpu.exr" >"$OUT/$name-cpu.log" 2>&1 \
+        || { log "FAIL $name cpu render"; failures=$((failures + 1)); continue; }
+    for s in "${STRATEGIES[@]}"; do
+        # shellcheck disable=SC2086
+        if "$VOLPT" render "$file" $params --spp 4 --seed 7 --backend cuda --strategy "$s" \
+            -o "$OUT/$name-$s.exr" >"$OUT/$name-$s.log" 2>&1; then
+            if [ "$s" = naive-sk ]; then
+                check "$name-cpu-vs-$s" "$VOLPT" compare "$OUT/$name-cpu.exr" "$OUT/$name-$s.exr" --identical
+            else
+                check "$name-cpu-vs-$s" "$VOLPT" compare "$OUT/$name-cpu.exr" "$OUT/$name-$s.exr" --max-relative 1e-6
+            fi
+        else
+            log "FAIL $name $s render: $(tail -n 2 "$OUT/$name-$s.log" | tr '\n' ' ')"; failures=$((failures + 1))
+        fi
+    done
+done
+
+for s in "${STRATEGIES[@]}"; do
+    check "memcheck-$s" compute-sanitizer --tool memcheck --error-exitcode 1 \
+        "$VOLPT" render scenes/cgg-logo/scene.xml -Dresolution=64 --spp 2 --backend cuda --strategy "$s" \
+        -o "$OUT/memcheck-$s.exr"
+done
+
+if [ -z "${QUICK:-}" ]; then
+    for entry in "${SCENES[@]}"; do
+        IFS=: read -r name file params <<<"$entry"
+        [ -f "$file" ] || continue
+        for s in "${STRATEGIES[@]}"; do
+            # shellcheck disable=SC2086
+            if "$VOLPT" bench "$file" $params --backend cuda --strategy "$s" --trials "$TRIALS" --json \
+                >"$OUT/bench-$name-$s.json" 2>"$OUT/bench-$name-$s.log"; then
+                log "bench $name $s: $(grep -E '"(time_mean_s|segments_per_s)"' "$OUT/bench-$name-$s.json" | tr -d ' \n')"
+            else
+                log "FAIL bench $name $s"; failures=$((failures + 1))
+            fi
+        done
+    done
+fi
+log "failures: $failures"
+exit $((failures > 0))

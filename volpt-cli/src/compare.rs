@@ -1,0 +1,73 @@
+//! `volpt compare A.exr B.exr`: how far apart two renders are.
+//!
+//! Renders of one scene and seed on the CPU and with the GPU's naiveSK trace the same paths and
+//! sum them in the same order, so they must be bit-identical; other strategies sum in another
+//! order and differ by rounding only. The report says which case holds.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Result};
+use clap::Args;
+use volpt_render::Image;
+
+#[derive(Args)]
+pub struct CompareArgs {
+    a: PathBuf,
+    b: PathBuf,
+    /// Fail unless every pixel is bit-identical.
+    #[arg(long)]
+    identical: bool,
+    /// Fail if any pixel channel differs by more than this, relative to max(|a|, |b|, 1e-3).
+    #[arg(long)]
+    max_relative: Option<f64>,
+}
+
+pub fn run(args: &CompareArgs) -> Result<()> {
+    let a = Image::read_exr(&args.a)?;
+    let b = Image::read_exr(&args.b)?;
+    if (a.width, a.height) != (b.width, b.height) {
+        bail!(
+            "{} is {}x{} but {} is {}x{}",
+            args.a.display(),
+            a.width,
+            a.height,
+            args.b.display(),
+            b.width,
+            b.height
+        );
+    }
+    let mut identical = 0usize;
+    let mut max_abs = 0.0f64;
+    let mut max_rel = 0.0f64;
+    let (mut sum_a, mut sum_b) = (0.0f64, 0.0f64);
+    for (pa, pb) in a.pixels.iter().zip(&b.pixels) {
+        if pa.map(f32::to_bits) == pb.map(f32::to_bits) {
+            identical += 1;
+        }
+        for (&x, &y) in pa.iter().zip(pb) {
+            let (x, y) = (x as f64, y as f64);
+            sum_a += x;
+            sum_b += y;
+            let diff = (x - y).abs();
+            max_abs = max_abs.max(diff);
+            max_rel = max_rel.max(diff / x.abs().max(y.abs()).max(1e-3));
+        }
+    }
+    let n = a.pixels.len();
+    println!(
+        "{n} pixels: {identical} bit-identical ({:.4}%), max |a-b| {max_abs:.3e}, \
+         max relative {max_rel:.3e}, mean a {:.6}, mean b {:.6}",
+        100.0 * identical as f64 / n as f64,
+        sum_a / (3 * n) as f64,
+        sum_b / (3 * n) as f64,
+    );
+    if args.identical && identical != n {
+        bail!("{} pixels differ", n - identical);
+    }
+    if let Some(bound) = args.max_relative {
+        if max_rel > bound {
+            bail!("largest relative difference {max_rel:.3e} exceeds {bound:.3e}");
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,40 @@
+use cudarc::driver::DriverError;
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum CudaError {
+    #[error(
+        "no CUDA driver found (libcuda.so could not be loaded): --backend cuda needs an NVIDIA GPU \
+         and its driver; use --backend cpu"
+    )]
+    NoDriver,
+    #[error(
+        "this volpt was built without GPU kernels: run `cargo xtask ptx` (it installs the rust-src \
+         component if needed), then rebuild volpt"
+    )]
+    NoKernels,
+    #[error(
+        "the GPU kernels have no entry point `{0}`: the PTX is out of date, run `cargo xtask ptx`"
+    )]
+    MissingKernel(String),
+    #[error("unknown GPU strategy `{given}`; choose one of: {known}")]
+    UnknownStrategy { given: String, known: String },
+    #[error("nothing to render: the image is {width}x{height} with {spp} samples per pixel")]
+    Empty { width: u32, height: u32, spp: u32 },
+    #[error("CUDA driver call failed while {doing}: {source}")]
+    Driver {
+        doing: &'static str,
+        source: DriverError,
+    },
+}
+
+/// Attaches what volpt was doing to a driver error.
+pub(crate) trait Doing<T> {
+    fn doing(self, doing: &'static str) -> Result<T, CudaError>;
+}
+
+impl<T> Doing<T> for Result<T, DriverError> {
+    fn doing(self, doing: &'static str) -> Result<T, CudaError> {
+        self.map_err(|source| CudaError::Driver { doing, source })
+    }
+}
