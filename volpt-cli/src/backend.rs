@@ -87,8 +87,7 @@ impl Backend {
             options: job.options,
             progress: progress_bar(job.show_progress),
         };
-        let result = with_scene(job.desc, job.settings, visitor);
-        result
+        with_scene(job.desc, job.settings, visitor)
     }
 }
 

@@ -123,7 +123,7 @@ impl PathState {
 }
 
 /// Advances `path` by one free flight and the event that ends it.
-#[inline]
+#[inline(always)]
 pub fn step<S: Scene>(scene: &S, path: &mut PathState) {
     path.segments += 1;
     if path.segments > scene.settings().max_segments {

@@ -13,6 +13,11 @@ pub enum CudaError {
          component if needed), then rebuild volpt"
     )]
     NoKernels,
+    #[error("cannot read the kernels' PTX from {path} (VOLPT_PTX): {source}")]
+    PtxFile {
+        path: std::path::PathBuf,
+        source: std::io::Error,
+    },
     #[error(
         "the GPU kernels have no entry point `{0}`: the PTX is out of date, run `cargo xtask ptx`"
     )]

@@ -35,7 +35,15 @@ impl CudaRenderer {
         if !unsafe { sys::is_culib_present() } {
             return Err(CudaError::NoDriver);
         }
-        let ptx = crate::ptx::PTX.ok_or(CudaError::NoKernels)?;
+        // `VOLPT_PTX=file.ptx` runs other kernels with this binary: A/B measurements of a kernel
+        // change in one device session.
+        let ptx = match std::env::var_os("VOLPT_PTX") {
+            Some(path) => std::fs::read_to_string(&path).map_err(|source| CudaError::PtxFile {
+                path: path.into(),
+                source,
+            })?,
+            None => crate::ptx::PTX.ok_or(CudaError::NoKernels)?.to_owned(),
+        };
         let ctx = CudaContext::new(ordinal).doing("opening the GPU")?;
         let device_name = ctx.name().doing("reading the GPU's name")?;
         let multiprocessors = ctx

@@ -59,6 +59,10 @@ pub enum SceneError {
     #[error("{}: {problem}", path.display())]
     Vol { path: PathBuf, problem: VolProblem },
 
+    /// A volume grid file (MetaImage, VTK, raw) is malformed or holds values volpt cannot use.
+    #[error("{}: {problem}", path.display())]
+    Grid { path: PathBuf, problem: GridProblem },
+
     /// An error in a file that a scene file refers to (a grid, a mesh): says which element
     /// referred to it, then the error itself (which names the referred-to file).
     #[error("{}:{line}: {element}: {error}", path.display())]
@@ -203,6 +207,108 @@ impl fmt::Display for VolProblem {
                     "{role} grid: expected {expected}, found {found} channels"
                 )
             }
+            Self::DataLength { expected, found } => write!(
+                f,
+                "grid data: expected {expected} values (resolution x channels), found {found}"
+            ),
+        }
+    }
+}
+
+/// What is wrong with a volume grid file (MetaImage, VTK, raw).
+#[derive(Clone, Debug, PartialEq)]
+pub enum GridProblem {
+    /// A required header field is absent.
+    MissingField {
+        field: &'static str,
+        expected: &'static str,
+    },
+    /// A header field (or a caller-supplied layout value) that cannot be parsed or is out of
+    /// range; `line` is the header line, where there is one.
+    BadField {
+        line: Option<usize>,
+        field: String,
+        expected: String,
+        found: String,
+    },
+    /// Valid in the format, but not something volpt reads (a rotated grid, compressed VTK XML).
+    Unsupported { what: String, reason: String },
+    /// The declared size overflows or exceeds the most values volpt reads from one grid.
+    TooLarge {
+        resolution: [u32; 3],
+        channels: u32,
+        limit: u64,
+    },
+    /// The data holds fewer bytes than the header declares.
+    SizeMismatch {
+        what: String,
+        expected_bytes: u64,
+        actual_bytes: u64,
+    },
+    /// The data holds more bytes than the header declares.
+    ExcessData { what: String, expected_bytes: u64 },
+    /// The data cannot be decoded (a corrupt zlib stream, a VTK file vtkio rejects).
+    Decode { what: String, message: String },
+    /// A voxel value volpt cannot use (non-finite or negative).
+    BadValue {
+        voxel: [u32; 3],
+        channel: u32,
+        value: f64,
+        expected: &'static str,
+    },
+    /// An in-memory grid whose data length disagrees with its resolution (when writing).
+    DataLength { expected: usize, found: usize },
+}
+
+impl fmt::Display for GridProblem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::MissingField { field, expected } => {
+                write!(f, "missing header field {field}: expected {expected}")
+            }
+            Self::BadField {
+                line,
+                field,
+                expected,
+                found,
+            } => {
+                if let Some(line) = line {
+                    write!(f, "line {line}: ")?;
+                }
+                write!(f, "{field}: expected {expected}, found {found:?}")
+            }
+            Self::Unsupported { what, reason } => write!(f, "{what} is not supported: {reason}"),
+            Self::TooLarge {
+                resolution: [x, y, z],
+                channels,
+                limit,
+            } => write!(
+                f,
+                "header declares {x} x {y} x {z} voxels x {channels} channels, \
+                 more than the {limit} values volpt reads from one grid"
+            ),
+            Self::SizeMismatch {
+                what,
+                expected_bytes,
+                actual_bytes,
+            } => write!(
+                f,
+                "{what}: expected {expected_bytes} bytes, found only {actual_bytes}"
+            ),
+            Self::ExcessData {
+                what,
+                expected_bytes,
+            } => write!(f, "{what}: expected {expected_bytes} bytes, found more"),
+            Self::Decode { what, message } => write!(f, "{what}: {message}"),
+            Self::BadValue {
+                voxel: [x, y, z],
+                channel,
+                value,
+                expected,
+            } => write!(
+                f,
+                "voxel (x={x}, y={y}, z={z}) channel {channel}: expected {expected}, found {value}"
+            ),
             Self::DataLength { expected, found } => write!(
                 f,
                 "grid data: expected {expected} values (resolution x channels), found {found}"

@@ -6,18 +6,33 @@
 //! - [`vol`]: Mitsuba's `.vol` grid files, read and written.
 //! - [`mitsuba`]: Mitsuba 0.5/0.6 and Mitsuba 3 XML scene files.
 //! - [`generate`]: the thesis's printed-block grids (`cgg-logo`, `ad`), generated rather than stored.
+//! - [`raw`]: raw voxel files with a caller-given layout (such as `Bucky.raw`), read and written.
+//! - [`metaimage`]: MetaImage `.mha`/`.mhd` grids, read and written.
+//! - [`vtk`]: VTK image data (legacy `STRUCTURED_POINTS` `.vtk`, XML `.vti`), read and written.
+//! - [`transfer`]: transfer functions from density to RGB albedo, and their text files.
+//! - [`normalise`]: rescaling a grid's values onto `[0, target]` (raw counts to densities).
 
 pub mod description;
 pub mod error;
 pub mod generate;
+pub mod metaimage;
 pub mod mitsuba;
+pub mod normalise;
+pub mod raw;
+pub mod transfer;
 pub mod vol;
+pub mod vtk;
 
 use std::path::Path;
 
 pub use description::*;
-pub use error::{SceneError, VolProblem};
+pub use error::{GridProblem, SceneError, VolProblem};
+pub use metaimage::{read_metaimage, write_metaimage, MetaImageOptions};
+pub use normalise::normalise;
+pub use raw::{read_raw, write_raw, ByteOrder, RawLayout, ScalarType};
+pub use transfer::TransferFunction;
 pub use vol::{read_vol, write_vol, VolGrid};
+pub use vtk::{read_vtk, write_vtk};
 
 /// Loads a Mitsuba XML scene with the `<default>` values it declares.
 pub fn load_mitsuba(path: &Path) -> Result<SceneDescription, SceneError> {
