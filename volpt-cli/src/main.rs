@@ -12,7 +12,7 @@ use clap::{Args, Parser, Subcommand};
 use tracing_subscriber::EnvFilter;
 use volpt_render::image::preview_path;
 use volpt_render::{path_settings, Image, RenderOptions, RenderStats, Variant};
-use volpt_scene::SceneDescription;
+use volpt_scene::{Config, SceneAssembler, SceneDescription};
 
 use backend::{Backend, BackendKind, RenderJob};
 
@@ -54,18 +54,40 @@ enum SceneCommand {
 
 #[derive(Args)]
 struct SceneArgs {
-    /// Mitsuba XML scene file.
+    /// Scene file: Mitsuba XML, a volpt TOML scene, or a grid file (.mha, .mhd, .vtk, .vti, .vol).
     scene: PathBuf,
     /// Scene parameter, as Mitsuba's `-D name=value` (fills `$name` and overrides `<default>`).
     #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_param)]
     params: Vec<(String, String)>,
+    /// Samples per pixel (default: the scene's sampler).
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Film size WIDTHxHEIGHT (default: the scene's film).
+    #[arg(long, value_name = "WxH", value_parser = parse_resolution)]
+    resolution: Option<(u32, u32)>,
+    /// Longest path, Mitsuba's max_depth; -1 is unlimited (default: the scene's integrator).
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(i64).range(-1..=u32::MAX as i64))]
+    max_depth: Option<i64>,
+    /// Depth from which Russian roulette starts, Mitsuba's rr_depth; -1 disables it.
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(i64).range(-1..=u32::MAX as i64))]
+    rr_depth: Option<i64>,
+}
+
+impl SceneArgs {
+    /// The command line's part of the scene, for the assembler.
+    fn config(&self) -> Config {
+        Config {
+            params: self.params.clone(),
+            spp: self.spp,
+            resolution: self.resolution,
+            max_depth: self.max_depth.map(depth),
+            rr_depth: self.rr_depth.map(depth),
+        }
+    }
 }
 
 #[derive(Args)]
 struct SamplingArgs {
-    /// Samples per pixel (default: the scene's sampler).
-    #[arg(long)]
-    spp: Option<u32>,
     /// Seed of the random streams: the same seed gives the same image on every backend.
     #[arg(long, default_value_t = 0)]
     seed: u32,
@@ -105,6 +127,21 @@ struct BenchArgs {
     json: bool,
 }
 
+fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
+    let parsed = s
+        .split_once('x')
+        .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)));
+    match parsed {
+        Some((w, h)) if w > 0 && h > 0 => Ok((w, h)),
+        _ => Err(format!("expected WIDTHxHEIGHT, e.g. 400x400, found {s:?}")),
+    }
+}
+
+/// Mitsuba's depth convention: -1 is unlimited (clap has checked the range).
+fn depth(d: i64) -> Option<u32> {
+    u32::try_from(d).ok()
+}
+
 fn parse_param(s: &str) -> Result<(String, String), String> {
     match s.split_once('=') {
         Some((name, value)) if !name.is_empty() => Ok((name.to_owned(), value.to_owned())),
@@ -138,7 +175,8 @@ fn main() -> Result<()> {
 }
 
 fn load(args: &SceneArgs) -> Result<SceneDescription> {
-    Ok(volpt_scene::load_mitsuba_with(&args.scene, &args.params)?)
+    let builder = volpt_scene::builder_for(&args.scene)?;
+    Ok(SceneAssembler::new(args.config()).assemble(builder.as_ref())?)
 }
 
 fn options(desc: &SceneDescription, sampling: &SamplingArgs) -> Result<RenderOptions> {
@@ -146,7 +184,7 @@ fn options(desc: &SceneDescription, sampling: &SamplingArgs) -> Result<RenderOpt
         bail!("--threads must be at least 1");
     }
     Ok(RenderOptions {
-        spp: sampling.spp.unwrap_or(desc.spp),
+        spp: desc.spp,
         seed: sampling.seed,
         threads: sampling.threads,
     })

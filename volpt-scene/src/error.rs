@@ -55,6 +55,14 @@ pub enum SceneError {
         what: String,
     },
 
+    /// A volpt TOML scene file is malformed: bad TOML, an unknown key, or a value of the wrong type.
+    #[error("{}:{line}: {message}", path.display())]
+    Toml {
+        path: PathBuf,
+        line: usize,
+        message: String,
+    },
+
     /// A `.vol` grid file is malformed or holds values volpt cannot use.
     #[error("{}: {problem}", path.display())]
     Vol { path: PathBuf, problem: VolProblem },
@@ -62,6 +70,13 @@ pub enum SceneError {
     /// A volume grid file (MetaImage, VTK, raw) is malformed or holds values volpt cannot use.
     #[error("{}: {problem}", path.display())]
     Grid { path: PathBuf, problem: GridProblem },
+
+    /// An environment map image is unreadable or holds values volpt cannot use.
+    #[error("{}: {problem}", path.display())]
+    Envmap {
+        path: PathBuf,
+        problem: EnvmapProblem,
+    },
 
     /// An error in a file that a scene file refers to (a grid, a mesh): says which element
     /// referred to it, then the error itself (which names the referred-to file).
@@ -312,6 +327,72 @@ impl fmt::Display for GridProblem {
             Self::DataLength { expected, found } => write!(
                 f,
                 "grid data: expected {expected} values (resolution x channels), found {found}"
+            ),
+        }
+    }
+}
+
+/// What is wrong with an environment map image.
+#[derive(Clone, Debug, PartialEq)]
+pub enum EnvmapProblem {
+    /// Not an image format volpt reads (only OpenEXR).
+    Format { extension: String },
+    /// The file is not a readable OpenEXR image.
+    Decode { message: String },
+    /// Neither R, G and B channels nor a single luminance (Y) channel.
+    Channels { found: Vec<String> },
+    /// Fewer pixels than the lookup needs.
+    TooSmall {
+        width: usize,
+        height: usize,
+        min_width: usize,
+        min_height: usize,
+    },
+    /// A pixel value that is not a radiance (non-finite or negative).
+    BadTexel {
+        x: usize,
+        y: usize,
+        channel: String,
+        value: f32,
+    },
+}
+
+impl fmt::Display for EnvmapProblem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Format { extension } => write!(
+                f,
+                ".{extension} environment maps are not supported: volpt reads OpenEXR only, \
+                 so convert it to .exr (linear RGB, half or float)"
+            ),
+            Self::Decode { message } => write!(f, "not a readable OpenEXR image: {message}"),
+            Self::Channels { found } => write!(
+                f,
+                "expected R, G and B channels (or one Y channel), found {}",
+                if found.is_empty() {
+                    "none".to_owned()
+                } else {
+                    found.join(", ")
+                }
+            ),
+            Self::TooSmall {
+                width,
+                height,
+                min_width,
+                min_height,
+            } => write!(
+                f,
+                "expected at least {min_width} x {min_height} pixels, found {width} x {height}"
+            ),
+            Self::BadTexel {
+                x,
+                y,
+                channel,
+                value,
+            } => write!(
+                f,
+                "pixel (x={x}, y={y}) channel {channel}: expected a finite radiance >= 0, \
+                 found {value}"
             ),
         }
     }

@@ -1,6 +1,9 @@
 //! volpt's scenes: the plain-data description a renderer consumes, and the loaders that build it.
 //!
 //! - [`description`]: the scene as plain data ([`SceneDescription`]).
+//! - [`builder`]: [`SceneBuilder`]s (one per source) and the [`SceneAssembler`] that applies the
+//!   command line's [`Config`] to what they build.
+//! - [`toml_scene`]: volpt's own TOML scene files: one grid file, a transfer function, defaults.
 //! - [`error`]: what can go wrong loading one ([`SceneError`]); every message names the file and,
 //!   for XML, the line.
 //! - [`vol`]: Mitsuba's `.vol` grid files, read and written.
@@ -12,6 +15,7 @@
 //! - [`transfer`]: transfer functions from density to RGB albedo, and their text files.
 //! - [`normalise`]: rescaling a grid's values onto `[0, target]` (raw counts to densities).
 
+pub mod builder;
 pub mod description;
 pub mod error;
 pub mod generate;
@@ -19,12 +23,14 @@ pub mod metaimage;
 pub mod mitsuba;
 pub mod normalise;
 pub mod raw;
+pub mod toml_scene;
 pub mod transfer;
 pub mod vol;
 pub mod vtk;
 
 use std::path::Path;
 
+pub use builder::{builder_for, Config, SceneAssembler, SceneBuilder};
 pub use description::*;
 pub use error::{GridProblem, SceneError, VolProblem};
 pub use metaimage::{read_metaimage, write_metaimage, MetaImageOptions};

@@ -56,6 +56,22 @@ impl ScalarType {
         Self::F64,
     ];
 
+    /// The type's name in volpt's scene files: `u8`, `i16`, `f32`, ...
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::I8 => "i8",
+            Self::U8 => "u8",
+            Self::I16 => "i16",
+            Self::U16 => "u16",
+            Self::I32 => "i32",
+            Self::U32 => "u32",
+            Self::I64 => "i64",
+            Self::U64 => "u64",
+            Self::F32 => "f32",
+            Self::F64 => "f64",
+        }
+    }
+
     /// Size of one value in bytes.
     pub fn bytes(self) -> usize {
         match self {

@@ -1,0 +1,686 @@
+//! volpt's own scene files (`.toml`): one volume from any grid file volpt reads (raw, MetaImage,
+//! VTK, Mitsuba `.vol`), with a transfer function or a constant albedo, and the rest of the scene
+//! in a few keys. Everything but `[volume]` has a default: the thesis setup (DESIGN.md section 4),
+//! so a CT volume needs four lines. The format is documented in `docs/scene-files.md`.
+//!
+//! Paths are relative to the scene file. `$name` in a path is replaced by a parameter: the
+//! `[defaults]` table gives values, and `-D name=value` overrides them, as in Mitsuba XML.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use crate::description::*;
+use crate::error::SceneError;
+use crate::mitsuba::ior::named_ior;
+use crate::raw::{read_raw, ByteOrder, RawLayout, ScalarType};
+use crate::{normalise, read_metaimage, read_vol, read_vtk, TransferFunction};
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    #[serde(default)]
+    pub defaults: BTreeMap<String, String>,
+    pub volume: VolumeSpec,
+    #[serde(default)]
+    pub albedo: AlbedoSpec,
+    #[serde(default)]
+    pub phase: PhaseSpec,
+    #[serde(default)]
+    pub boundary: BoundarySpec,
+    #[serde(default)]
+    pub camera: CameraSpec,
+    #[serde(default)]
+    pub film: FilmSpec,
+    #[serde(default)]
+    pub sampler: SamplerSpec,
+    #[serde(default)]
+    pub integrator: IntegratorSpec,
+    #[serde(default)]
+    pub environment: EnvironmentSpec,
+}
+
+/// The density grid.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VolumeSpec {
+    pub file: String,
+    /// `raw`, `metaimage`, `vtk` or `vol`; by default from the extension (`.raw` needs it said).
+    pub format: Option<String>,
+    /// Raw files: voxels per axis.
+    pub resolution: Option<[u32; 3]>,
+    /// Raw files: `u8`, `i8`, `u16`, `i16`, `u32`, `i32`, `u64`, `i64`, `f32`, `f64`.
+    #[serde(rename = "type")]
+    pub scalar: Option<String>,
+    /// Raw files: `little` (default) or `big`.
+    pub byte_order: Option<String>,
+    /// Raw files: bytes to skip before the data.
+    #[serde(default)]
+    pub header_bytes: u64,
+    /// World box `[[min], [max]]`: required for raw files; for other formats it replaces the
+    /// file's own box.
+    pub bounds: Option<[[f32; 3]; 2]>,
+    /// VTK files: the point-data array to read (default: the first scalar array).
+    pub array: Option<String>,
+    /// Map the grid's `[0, max]` linearly onto `[0, normalise]` before scaling.
+    pub normalise: Option<f32>,
+    /// Extinction per unit density.
+    #[serde(default = "one")]
+    pub scale: f32,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AlbedoSpec {
+    /// A transfer function file (docs/transfer-functions.md) applied to the normalised density.
+    pub transfer_function: Option<String>,
+    /// A constant albedo, grey or RGB (default 0.9 grey, unless a transfer function is given).
+    pub value: Option<OneOrThree>,
+}
+
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(untagged)]
+pub enum OneOrThree {
+    One(f32),
+    Three([f32; 3]),
+}
+
+impl OneOrThree {
+    fn rgb(self) -> [f32; 3] {
+        match self {
+            OneOrThree::One(v) => [v; 3],
+            OneOrThree::Three(rgb) => rgb,
+        }
+    }
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PhaseSpec {
+    /// Henyey-Greenstein asymmetry; absent means isotropic.
+    pub g: Option<f32>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoundarySpec {
+    /// `null` (index-matched), `dielectric` or `roughdielectric` (GGX).
+    #[serde(default = "rough_dielectric")]
+    pub bsdf: String,
+    #[serde(default = "thesis_alpha")]
+    pub alpha: f32,
+    /// A number or a Mitsuba IOR name (`water`, `air`, ...).
+    #[serde(default = "thesis_int_ior")]
+    pub int_ior: Ior,
+    #[serde(default = "thesis_ext_ior")]
+    pub ext_ior: Ior,
+    /// The boundary box; by default the volume's.
+    pub bounds: Option<[[f32; 3]; 2]>,
+}
+
+impl Default for BoundarySpec {
+    fn default() -> Self {
+        Self {
+            bsdf: rough_dielectric(),
+            alpha: thesis_alpha(),
+            int_ior: thesis_int_ior(),
+            ext_ior: thesis_ext_ior(),
+            bounds: None,
+        }
+    }
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(untagged)]
+pub enum Ior {
+    Value(f32),
+    Named(String),
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraSpec {
+    #[serde(default = "thesis_origin")]
+    pub origin: [f32; 3],
+    #[serde(default)]
+    pub target: [f32; 3],
+    #[serde(default = "y_up")]
+    pub up: [f32; 3],
+    /// Full field of view in degrees along `fov_axis`.
+    #[serde(default = "thesis_fov")]
+    pub fov: f32,
+    /// `x` (default), `y`, `smaller`, `larger` or `diagonal`, as in Mitsuba.
+    #[serde(default = "x_axis")]
+    pub fov_axis: String,
+}
+
+impl Default for CameraSpec {
+    fn default() -> Self {
+        Self {
+            origin: thesis_origin(),
+            target: [0.0; 3],
+            up: y_up(),
+            fov: thesis_fov(),
+            fov_axis: x_axis(),
+        }
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FilmSpec {
+    #[serde(default = "thesis_resolution")]
+    pub width: u32,
+    #[serde(default = "thesis_resolution")]
+    pub height: u32,
+}
+
+impl Default for FilmSpec {
+    fn default() -> Self {
+        Self {
+            width: thesis_resolution(),
+            height: thesis_resolution(),
+        }
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SamplerSpec {
+    #[serde(default = "thesis_spp")]
+    pub spp: u32,
+}
+
+impl Default for SamplerSpec {
+    fn default() -> Self {
+        Self { spp: thesis_spp() }
+    }
+}
+
+/// Mitsuba's semantics: -1 is unlimited.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IntegratorSpec {
+    #[serde(default = "unlimited")]
+    pub max_depth: i64,
+    #[serde(default = "unlimited")]
+    pub rr_depth: i64,
+}
+
+impl Default for IntegratorSpec {
+    fn default() -> Self {
+        Self {
+            max_depth: unlimited(),
+            rr_depth: unlimited(),
+        }
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnvironmentSpec {
+    /// Constant radiance, grey or RGB.
+    #[serde(default = "unit_radiance")]
+    pub radiance: OneOrThree,
+}
+
+impl Default for EnvironmentSpec {
+    fn default() -> Self {
+        Self {
+            radiance: unit_radiance(),
+        }
+    }
+}
+
+fn one() -> f32 {
+    1.0
+}
+fn rough_dielectric() -> String {
+    "roughdielectric".into()
+}
+fn thesis_alpha() -> f32 {
+    0.1
+}
+fn thesis_int_ior() -> Ior {
+    Ior::Value(1.05)
+}
+fn thesis_ext_ior() -> Ior {
+    Ior::Value(1.01)
+}
+fn thesis_origin() -> [f32; 3] {
+    [0.0, 0.0, 100.0]
+}
+fn y_up() -> [f32; 3] {
+    [0.0, 1.0, 0.0]
+}
+fn thesis_fov() -> f32 {
+    0.7
+}
+fn x_axis() -> String {
+    "x".into()
+}
+fn thesis_resolution() -> u32 {
+    400
+}
+fn thesis_spp() -> u32 {
+    100
+}
+fn unlimited() -> i64 {
+    -1
+}
+fn unit_radiance() -> OneOrThree {
+    OneOrThree::One(1.0)
+}
+
+/// Reads and parses a TOML scene file (without loading the files it names).
+pub fn parse(path: &Path) -> Result<SceneFile, SceneError> {
+    parse_with_text(path).map(|(file, _)| file)
+}
+
+fn parse_with_text(path: &Path) -> Result<(SceneFile, String), SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|error| SceneError::Io {
+        path: path.to_owned(),
+        error,
+    })?;
+    let file = toml::from_str(&text).map_err(|e| SceneError::Toml {
+        path: path.to_owned(),
+        line: e
+            .span()
+            .map_or(1, |span| text[..span.start].matches('\n').count() + 1),
+        message: e.message().to_owned(),
+    })?;
+    Ok((file, text))
+}
+
+/// The file being loaded, for error messages: value errors point at the line of their key.
+struct Cx<'a> {
+    path: &'a Path,
+    text: &'a str,
+}
+
+impl Cx<'_> {
+    /// The line of `field` (`table.key`): the key's line inside its table, else the table's.
+    fn line_of(&self, field: &str) -> usize {
+        let (table, key) = field.split_once('.').unwrap_or((field, ""));
+        let header = format!("[{table}]");
+        let lines: Vec<&str> = self.text.lines().map(str::trim_start).collect();
+        let Some(start) = lines.iter().position(|l| l.starts_with(&header)) else {
+            return 1;
+        };
+        let in_table = lines[start + 1..]
+            .iter()
+            .take_while(|l| !l.starts_with('['))
+            .position(|l| {
+                !key.is_empty()
+                    && l.strip_prefix(key)
+                        .is_some_and(|rest| rest.trim_start().starts_with('='))
+            });
+        in_table.map_or(start + 1, |i| start + 2 + i)
+    }
+
+    fn invalid(&self, field: &str, expected: &str, found: impl std::fmt::Display) -> SceneError {
+        SceneError::InvalidValue {
+            path: self.path.to_owned(),
+            line: self.line_of(field),
+            field: field.to_owned(),
+            expected: expected.to_owned(),
+            found: found.to_string(),
+        }
+    }
+
+    fn missing(&self, what: &str) -> SceneError {
+        SceneError::Missing {
+            path: self.path.to_owned(),
+            line: self.line_of("volume"),
+            element: "[volume] of a raw file".into(),
+            what: what.into(),
+        }
+    }
+}
+
+/// Loads a TOML scene file and the volume and transfer function it names.
+pub fn load(path: &Path, params: &[(String, String)]) -> Result<SceneDescription, SceneError> {
+    let (file, text) = parse_with_text(path)?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    assemble(&Cx { path, text: &text }, dir, file, params)
+}
+
+/// The scene of a TOML file whose only entry is `[volume] file = path`: a grid file rendered with
+/// every default.
+pub fn load_volume_only(
+    path: &Path,
+    params: &[(String, String)],
+) -> Result<SceneDescription, SceneError> {
+    let file = SceneFile {
+        defaults: BTreeMap::new(),
+        volume: VolumeSpec {
+            file: path.display().to_string(),
+            format: None,
+            resolution: None,
+            scalar: None,
+            byte_order: None,
+            header_bytes: 0,
+            bounds: None,
+            array: None,
+            normalise: None,
+            scale: 1.0,
+        },
+        albedo: AlbedoSpec::default(),
+        phase: PhaseSpec::default(),
+        boundary: BoundarySpec::default(),
+        camera: CameraSpec::default(),
+        film: FilmSpec::default(),
+        sampler: SamplerSpec::default(),
+        integrator: IntegratorSpec::default(),
+        environment: EnvironmentSpec::default(),
+    };
+    assemble(&Cx { path, text: "" }, Path::new(""), file, params)
+}
+
+fn assemble(
+    cx: &Cx<'_>,
+    dir: &Path,
+    file: SceneFile,
+    params: &[(String, String)],
+) -> Result<SceneDescription, SceneError> {
+    let resolve = |value: &str, field: &str| resolve_path(cx, dir, value, field, &file, params);
+    let v = &file.volume;
+
+    let volume_path = resolve(&v.file, "volume.file")?;
+    let mut grid = read_volume(cx, &volume_path, v)?;
+    if let Some(target) = v.normalise {
+        if !(target.is_finite() && target > 0.0) {
+            return Err(cx.invalid("volume.normalise", "a positive density", target));
+        }
+        grid = normalise(grid, target);
+    }
+    if !(v.scale.is_finite() && v.scale >= 0.0) {
+        return Err(cx.invalid("volume.scale", "a finite scale >= 0", v.scale));
+    }
+
+    let albedo = match (&file.albedo.transfer_function, file.albedo.value) {
+        (Some(_), Some(_)) => {
+            return Err(cx.invalid("albedo", "either transfer_function or value", "both"))
+        }
+        (Some(tf), None) => {
+            let tf = TransferFunction::read(&resolve(tf, "albedo.transfer_function")?)?;
+            AlbedoDesc::Grid(tf.apply(&grid))
+        }
+        (None, value) => {
+            let rgb = value.map_or([0.9; 3], OneOrThree::rgb);
+            if rgb.iter().any(|c| !(0.0..=1.0).contains(c)) {
+                return Err(cx.invalid("albedo.value", "components in [0, 1]", format!("{rgb:?}")));
+            }
+            AlbedoDesc::Constant(rgb)
+        }
+    };
+    let phase = match file.phase.g {
+        None => PhaseDesc::Isotropic,
+        Some(g) if g > -1.0 && g < 1.0 => PhaseDesc::HenyeyGreenstein { g },
+        Some(g) => return Err(cx.invalid("phase.g", "a value in (-1, 1)", g)),
+    };
+
+    let b = &file.boundary;
+    let ior = |ior: &Ior, field: &str| match ior {
+        Ior::Value(v) if v.is_finite() && *v > 0.0 => Ok(*v),
+        Ior::Value(v) => Err(cx.invalid(field, "a positive index of refraction", v)),
+        Ior::Named(name) => {
+            named_ior(name).ok_or_else(|| cx.invalid(field, "a number or a Mitsuba IOR name", name))
+        }
+    };
+    let bsdf = match b.bsdf.as_str() {
+        "null" => BsdfDesc::Null,
+        "dielectric" => BsdfDesc::Dielectric {
+            int_ior: ior(&b.int_ior, "boundary.int_ior")?,
+            ext_ior: ior(&b.ext_ior, "boundary.ext_ior")?,
+        },
+        "roughdielectric" => {
+            if !(b.alpha.is_finite() && b.alpha > 0.0) {
+                return Err(cx.invalid("boundary.alpha", "a positive roughness", b.alpha));
+            }
+            BsdfDesc::RoughDielectric {
+                alpha: b.alpha,
+                int_ior: ior(&b.int_ior, "boundary.int_ior")?,
+                ext_ior: ior(&b.ext_ior, "boundary.ext_ior")?,
+            }
+        }
+        other => {
+            return Err(cx.invalid(
+                "boundary.bsdf",
+                "null, dielectric or roughdielectric",
+                other,
+            ))
+        }
+    };
+    let bounds = match b.bounds {
+        Some(box_) => checked_box(cx, "boundary.bounds", box_)?,
+        None => grid.bounds,
+    };
+
+    let c = &file.camera;
+    let fov_axis = match c.fov_axis.as_str() {
+        "x" => FovAxis::X,
+        "y" => FovAxis::Y,
+        "smaller" => FovAxis::Smaller,
+        "larger" => FovAxis::Larger,
+        "diagonal" => FovAxis::Diagonal,
+        other => {
+            return Err(cx.invalid(
+                "camera.fov_axis",
+                "x, y, smaller, larger or diagonal",
+                other,
+            ))
+        }
+    };
+    if !(c.fov > 0.0 && c.fov < 180.0) {
+        return Err(cx.invalid("camera.fov", "degrees in (0, 180)", c.fov));
+    }
+    let to_world = look_at(c.origin, c.target, c.up).ok_or_else(|| {
+        cx.invalid(
+            "camera",
+            "an origin apart from the target and an up vector not along the view",
+            format!(
+                "origin {:?}, target {:?}, up {:?}",
+                c.origin, c.target, c.up
+            ),
+        )
+    })?;
+    if file.film.width == 0 || file.film.height == 0 {
+        return Err(cx.invalid(
+            "film",
+            "a width and height of at least 1",
+            format!("{}x{}", file.film.width, file.film.height),
+        ));
+    }
+    let depth = |d: i64, field: &str| match d {
+        -1 => Ok(None),
+        d if d >= 0 && d <= u32::MAX as i64 => Ok(Some(d as u32)),
+        d => Err(cx.invalid(field, "-1 (unlimited) or a depth >= 0", d)),
+    };
+    Ok(SceneDescription {
+        camera: CameraDesc {
+            to_world,
+            fov_degrees: c.fov,
+            fov_axis,
+        },
+        film: FilmDesc {
+            width: file.film.width,
+            height: file.film.height,
+        },
+        spp: file.sampler.spp,
+        integrator: IntegratorDesc {
+            max_depth: depth(file.integrator.max_depth, "integrator.max_depth")?,
+            rr_depth: depth(file.integrator.rr_depth, "integrator.rr_depth")?,
+        },
+        boundary: BoundaryDesc { bounds, bsdf },
+        medium: MediumDesc {
+            density: DensityDesc::Grid(grid),
+            scale: v.scale,
+            albedo,
+            phase,
+        },
+        environment: EnvironmentDesc::Constant(file.environment.radiance.rgb()),
+    })
+}
+
+/// `value` with `$name`s replaced (from `params`, then `[defaults]`), relative to `dir`.
+fn resolve_path(
+    cx: &Cx<'_>,
+    dir: &Path,
+    value: &str,
+    field: &str,
+    file: &SceneFile,
+    params: &[(String, String)],
+) -> Result<PathBuf, SceneError> {
+    let mut out = String::new();
+    let mut rest = value;
+    while let Some(at) = rest.find('$') {
+        out.push_str(&rest[..at]);
+        let after = &rest[at + 1..];
+        let len = after
+            .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+            .unwrap_or(after.len());
+        let name = &after[..len];
+        let found = params
+            .iter()
+            .rev()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| v.as_str())
+            .or_else(|| file.defaults.get(name).map(String::as_str));
+        match found {
+            Some(v) if !name.is_empty() => out.push_str(v),
+            _ => {
+                return Err(cx.invalid(
+                    field,
+                    "parameters defined in [defaults] or by -D name=value",
+                    format!("undefined ${name} in {value:?}"),
+                ))
+            }
+        }
+        rest = &after[len..];
+    }
+    out.push_str(rest);
+    Ok(dir.join(out))
+}
+
+fn checked_box(cx: &Cx<'_>, field: &str, [min, max]: [[f32; 3]; 2]) -> Result<Bounds, SceneError> {
+    let ok = (0..3).all(|i| min[i].is_finite() && max[i].is_finite() && min[i] < max[i]);
+    if !ok {
+        return Err(cx.invalid(
+            field,
+            "[[min x, y, z], [max x, y, z]] with min < max on every axis",
+            format!("{min:?} .. {max:?}"),
+        ));
+    }
+    Ok(Bounds { min, max })
+}
+
+fn read_volume(cx: &Cx<'_>, file: &Path, v: &VolumeSpec) -> Result<GridDesc, SceneError> {
+    let extension = file
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let format = match (&v.format, extension.as_deref()) {
+        (Some(f), _) => f.as_str(),
+        (None, Some("mha" | "mhd")) => "metaimage",
+        (None, Some("vtk" | "vti")) => "vtk",
+        (None, Some("vol")) => "vol",
+        (None, _) => {
+            return Err(cx.invalid(
+                "volume.format",
+                "raw, metaimage, vtk or vol (needed when the extension does not say)",
+                file.display(),
+            ))
+        }
+    };
+    let bounds = v
+        .bounds
+        .map(|b| checked_box(cx, "volume.bounds", b))
+        .transpose()?;
+    let mut grid = match format {
+        "raw" => {
+            let resolution = v
+                .resolution
+                .ok_or_else(|| cx.missing("resolution = [x, y, z]"))?;
+            let scalar = match v.scalar.as_deref() {
+                Some(name) => ScalarType::ALL
+                    .into_iter()
+                    .find(|s| s.name() == name)
+                    .ok_or_else(|| {
+                        cx.invalid(
+                            "volume.type",
+                            "u8, i8, u16, i16, u32, i32, u64, i64, f32 or f64",
+                            name,
+                        )
+                    })?,
+                None => return Err(cx.missing("type (e.g. \"u8\")")),
+            };
+            let byte_order = match v.byte_order.as_deref() {
+                None | Some("little") => ByteOrder::Little,
+                Some("big") => ByteOrder::Big,
+                Some(other) => return Err(cx.invalid("volume.byte_order", "little or big", other)),
+            };
+            let bounds = bounds.ok_or_else(|| cx.missing("bounds = [[min], [max]]"))?;
+            let layout = RawLayout {
+                resolution,
+                channels: 1,
+                scalar,
+                byte_order,
+                header_bytes: v.header_bytes,
+            };
+            return read_raw(file, &layout, bounds);
+        }
+        "metaimage" => read_metaimage(file)?,
+        "vtk" => read_vtk(file, v.array.as_deref())?,
+        "vol" => {
+            let vol = read_vol(file)?;
+            vol.check_density(file)?;
+            GridDesc {
+                resolution: vol.resolution,
+                channels: vol.channels,
+                bounds: vol.bbox,
+                // Mitsuba 0.6's convention for its own format.
+                convention: GridConvention::Vertex,
+                data: vol.data,
+            }
+        }
+        other => return Err(cx.invalid("volume.format", "raw, metaimage, vtk or vol", other)),
+    };
+    if grid.channels != 1 {
+        return Err(cx.invalid(
+            "volume.file",
+            "a one-channel density grid",
+            format!("{} channels in {}", grid.channels, file.display()),
+        ));
+    }
+    if let Some(bounds) = bounds {
+        grid.bounds = bounds;
+    }
+    Ok(grid)
+}
+
+/// Mitsuba's `lookat`: camera +z towards the target, +y up, +x to the left of the image.
+pub fn look_at(origin: [f32; 3], target: [f32; 3], up: [f32; 3]) -> Option<Matrix4> {
+    let sub = |a: [f32; 3], b: [f32; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let cross = |a: [f32; 3], b: [f32; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let normalize = |v: [f32; 3]| {
+        let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        (len > 1e-12 && len.is_finite()).then(|| v.map(|c| c / len))
+    };
+    let dir = normalize(sub(target, origin))?;
+    let left = normalize(cross(normalize(up)?, dir))?;
+    let new_up = cross(dir, left);
+    Some([
+        [left[0], new_up[0], dir[0], origin[0]],
+        [left[1], new_up[1], dir[1], origin[1]],
+        [left[2], new_up[2], dir[2], origin[2]],
+        [0.0, 0.0, 0.0, 1.0],
+    ])
+}

@@ -1,0 +1,162 @@
+//! volpt TOML scene files: what they load to, and one clear error per kind of mistake.
+
+use std::path::{Path, PathBuf};
+
+use volpt_scene::{
+    builder_for, AlbedoDesc, BsdfDesc, Config, DensityDesc, PhaseDesc, SceneAssembler, SceneError,
+};
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, text).expect("write fixture");
+    path
+}
+
+/// A 2x2x2 `u8` raw grid and a scene around it; `extra` is appended to the scene text.
+fn scene(extra: &str) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().expect("temp dir");
+    std::fs::write(
+        dir.path().join("g.raw"),
+        [0u8, 50, 100, 150, 200, 250, 255, 0],
+    )
+    .unwrap();
+    let text = format!(
+        "[volume]\nfile = \"g.raw\"\nformat = \"raw\"\nresolution = [2, 2, 2]\ntype = \"u8\"\n\
+         bounds = [[0.0, 0.0, 0.0], [1.0, 2.0, 3.0]]\n{extra}"
+    );
+    let path = write(dir.path(), "scene.toml", &text);
+    (dir, path)
+}
+
+fn load(path: &Path, config: Config) -> Result<volpt_scene::SceneDescription, SceneError> {
+    SceneAssembler::new(config).assemble(builder_for(path)?.as_ref())
+}
+
+fn error(extra: &str) -> String {
+    let (_dir, path) = scene(extra);
+    load(&path, Config::default()).unwrap_err().to_string()
+}
+
+#[test]
+fn defaults_are_the_thesis_setup() {
+    let (_dir, path) = scene("");
+    let desc = load(&path, Config::default()).unwrap();
+    let DensityDesc::Grid(grid) = &desc.medium.density else {
+        panic!("grid density expected")
+    };
+    assert_eq!(
+        grid.data,
+        vec![0.0, 50.0, 100.0, 150.0, 200.0, 250.0, 255.0, 0.0]
+    );
+    assert_eq!(desc.boundary.bounds.max, [1.0, 2.0, 3.0]);
+    assert_eq!(
+        desc.boundary.bsdf,
+        BsdfDesc::RoughDielectric {
+            alpha: 0.1,
+            int_ior: 1.05,
+            ext_ior: 1.01
+        }
+    );
+    assert_eq!(desc.medium.albedo, AlbedoDesc::Constant([0.9; 3]));
+    assert_eq!(desc.medium.phase, PhaseDesc::Isotropic);
+    assert_eq!(
+        (desc.film.width, desc.film.height, desc.spp),
+        (400, 400, 100)
+    );
+    assert_eq!(desc.integrator.max_depth, None);
+    assert_eq!(desc.camera.to_world[2][3], 100.0);
+}
+
+#[test]
+fn config_overrides_and_parameters_apply() {
+    let dir = tempfile::tempdir().unwrap();
+    let sub = dir.path().join("data");
+    std::fs::create_dir(&sub).unwrap();
+    std::fs::write(sub.join("g.raw"), [10u8; 8]).unwrap();
+    let path = write(
+        dir.path(),
+        "scene.toml",
+        "[defaults]\nwhere = \"nowhere\"\n[volume]\nfile = \"$where/g.raw\"\nformat = \"raw\"\n\
+         resolution = [2, 2, 2]\ntype = \"u8\"\nbounds = [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]]\n\
+         normalise = 4.0\n",
+    );
+    let config = Config {
+        params: vec![("where".into(), "data".into())],
+        spp: Some(3),
+        resolution: Some((7, 5)),
+        max_depth: Some(Some(9)),
+        rr_depth: Some(None),
+    };
+    let desc = load(&path, config).unwrap();
+    let DensityDesc::Grid(grid) = &desc.medium.density else {
+        panic!()
+    };
+    assert_eq!(grid.max_value(), 4.0);
+    assert_eq!((desc.film.width, desc.film.height, desc.spp), (7, 5, 3));
+    assert_eq!(desc.integrator.max_depth, Some(9));
+    // Without the parameter the default names a directory that does not exist.
+    let err = load(&path, Config::default()).unwrap_err().to_string();
+    assert!(err.contains("nowhere/g.raw"), "{err}");
+}
+
+#[test]
+fn malformed_toml_names_the_line() {
+    let err = error("[phase\ng = 0.5\n");
+    assert!(err.contains("scene.toml:7"), "{err}");
+}
+
+#[test]
+fn unknown_key_is_an_error() {
+    let err = error("[camera]\nfov_degrees = 3.0\n");
+    assert!(err.contains("unknown field `fov_degrees`"), "{err}");
+}
+
+#[test]
+fn raw_without_bounds_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("g.raw"), [0u8; 8]).unwrap();
+    let path = write(
+        dir.path(),
+        "scene.toml",
+        "[volume]\nfile = \"g.raw\"\nformat = \"raw\"\nresolution = [2, 2, 2]\ntype = \"u8\"\n",
+    );
+    let err = load(&path, Config::default()).unwrap_err().to_string();
+    assert!(err.contains("missing bounds"), "{err}");
+}
+
+#[test]
+fn out_of_range_values_name_field_and_line() {
+    let err = error("[phase]\ng = 1.0\n");
+    assert!(
+        err.contains("scene.toml:8: phase.g") && err.contains("(-1, 1)"),
+        "{err}"
+    );
+    let err = error("[boundary]\nbsdf = \"plastic\"\n");
+    assert!(
+        err.contains("boundary.bsdf") && err.contains("plastic"),
+        "{err}"
+    );
+    let err = error("[boundary]\nint_ior = \"unobtainium\"\n");
+    assert!(err.contains("boundary.int_ior"), "{err}");
+    let err = error("[albedo]\nvalue = 1.5\n");
+    assert!(err.contains("albedo.value"), "{err}");
+    let err = error("[camera]\norigin = [0.0, 0.0, 0.0]\n");
+    assert!(err.contains("camera"), "{err}");
+    let err = error("[integrator]\nmax_depth = -7\n");
+    assert!(err.contains("integrator.max_depth"), "{err}");
+}
+
+#[test]
+fn both_albedo_sources_is_an_error() {
+    let err = error("[albedo]\nvalue = 0.5\ntransfer_function = \"t.tf\"\n");
+    assert!(err.contains("either transfer_function or value"), "{err}");
+}
+
+#[test]
+fn unknown_extension_is_an_error() {
+    let err = builder_for(Path::new("scene.blend"))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(err.contains(".toml"), "{err}");
+}
