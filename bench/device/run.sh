@@ -35,14 +35,14 @@ log "ptxas -arch=$ARCH: $(grep -c 'Used' "$OUT/ptxas-$ARCH.txt") kernels reporte
 
 "$VOLPT" scene generate scenes >"$OUT/generate.log" 2>&1 || { log "FAIL generate"; failures=$((failures + 1)); }
 
-# name : scene file : extra -D parameters
+# name : scene file : extra parameters (the benchmark uses each scene's own spp: 100, bucky 300)
 SCENES=(
-    "homogeneous-cube:scenes/homogeneous-cube/scene.xml:"
-    "homogeneous-cube-null:scenes/homogeneous-cube/scene.xml:-Dboundary=null"
+    "homogeneous-cube:scenes/homogeneous-cube/scene.xml:-Dspp=100"
+    "homogeneous-cube-null:scenes/homogeneous-cube/scene.xml:-Dspp=100 -Dboundary=null"
     "cgg-logo:scenes/cgg-logo/scene.xml:"
     "ad:scenes/ad/scene.xml:"
     "smoke:scenes/smoke/scene.xml:-Ddata=$DATA"
-    "bucky:scenes/bucky/scene.xml:-Ddata=$DATA"
+    "bucky:scenes/bucky/scene.toml:-Ddata=$DATA"
 )
 
 for entry in "${SCENES[@]}"; do
@@ -76,6 +76,14 @@ if [ -z "${QUICK:-}" ]; then
     for entry in "${SCENES[@]}"; do
         IFS=: read -r name file params <<<"$entry"
         [ -f "$file" ] || continue
+        # The device's CPU, in the same units, at fewer samples per pixel.
+        # shellcheck disable=SC2086
+        if "$VOLPT" bench "$file" $params --spp 8 --trials 2 --json \
+            >"$OUT/bench-$name-cpu.json" 2>"$OUT/bench-$name-cpu.log"; then
+            log "bench $name cpu: $(grep -E '"(time_mean_s|segments_per_s)"' "$OUT/bench-$name-cpu.json" | tr -d ' \n')"
+        else
+            log "FAIL bench $name cpu"; failures=$((failures + 1))
+        fi
         for s in "${STRATEGIES[@]}"; do
             # shellcheck disable=SC2086
             if "$VOLPT" bench "$file" $params --backend cuda --strategy "$s" --trials "$TRIALS" --json \
@@ -87,5 +95,9 @@ if [ -z "${QUICK:-}" ]; then
         done
     done
 fi
+# Few files come back from the device: pack images and logs.
+(cd "$OUT" && tar czf images.tar.gz ./*.exr ./*.png && rm -f ./*.exr ./*.png)
+(cd "$OUT" && tar czf logs.tar.gz ./*.log && rm -f ./*.log)
+(cd "$OUT" && tar czf bench.tar.gz ./bench-*.json && rm -f ./bench-*.json)
 log "failures: $failures"
 exit $((failures > 0))

@@ -123,7 +123,10 @@ fn device_bundle() -> Result<()> {
         std::fs::remove_dir_all(&bundle)?;
     }
     std::fs::create_dir_all(bundle.join("bin"))?;
-    std::fs::copy(root.join("target/release/volpt"), bundle.join("bin/volpt"))?;
+    let target = std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), PathBuf::from);
+    std::fs::copy(target.join("release/volpt"), bundle.join("bin/volpt"))?;
+    // Debug info is most of the binary; the device carries at most 64 MiB.
+    run(Command::new("strip").arg(bundle.join("bin/volpt")))?;
     std::fs::copy(&ptx, bundle.join("volpt_kernels.ptx"))?;
     // Generated grids are large and are regenerated on the device by `volpt scene generate`.
     copy_dir(&root.join("scenes"), &bundle.join("scenes"), &|p| {

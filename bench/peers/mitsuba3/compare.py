@@ -47,7 +47,8 @@ def read_exr(mi, path):
     h, w = bmp.height(), bmp.width()
     if stats.np is not None:
         return stats.np.array(bmp, copy=True).reshape(-1), h, w
-    return list(mi.TensorXf(bmp).array), h, w
+    import drjit as dr  # host-side tensor whatever the variant, so no device round trips
+    return list(dr.scalar.TensorXf(bmp).array), h, w
 
 
 class Mitsuba:

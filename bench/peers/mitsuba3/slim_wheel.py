@@ -12,6 +12,7 @@ file). The wheel keeps its name, so pip installs it as mitsuba 3.9.1.
 """
 
 import argparse
+import ast
 import base64
 import hashlib
 import os
@@ -31,7 +32,12 @@ def slim(src, dst, keep, drop_spectral_data):
     variant_so = re.compile(r"^mitsuba/([a-z0-9_]+)\.cpython-[^/]*\.so$")
     zin = zipfile.ZipFile(src)
     names = zin.namelist()
-    known = {m.group(1) for n in names if (m := variant_so.match(n))}
+    config = zin.read("mitsuba/config.py").decode()
+    listed = re.search(r"^MI_VARIANTS = (\[.*\])$", config, flags=re.M)
+    if not listed:
+        raise SystemExit(f"{src}: mitsuba/config.py has no MI_VARIANTS line")
+    variants = set(ast.literal_eval(listed.group(1)))
+    known = {m.group(1) for n in names if (m := variant_so.match(n)) and m.group(1) in variants}
     missing = set(keep) - known
     if missing:
         raise SystemExit(f"{src}: no module for variant(s) {sorted(missing)}; it has {sorted(known)}")
@@ -41,7 +47,7 @@ def slim(src, dst, keep, drop_spectral_data):
         for info in zin.infolist():
             n = info.filename
             m = variant_so.match(n)
-            if (m and m.group(1) not in keep) or n.startswith("mitsuba/include/") or \
+            if (m and m.group(1) in variants and m.group(1) not in keep) or n.startswith("mitsuba/include/") or \
                     (drop_spectral_data and n == "mitsuba/data/srgb.coeff"):
                 dropped.append(n)
                 continue
