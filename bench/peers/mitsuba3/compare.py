@@ -60,7 +60,7 @@ class Mitsuba:
 
     def render(self, xml_path, params, spp, seed, out):
         mi, dr = self.mi, self.dr
-        scene = mi.load_file(xml_path, **params)
+        scene = mi.load_file(xml_path, **used_params(xml_path, params))
         dr.sync_thread()
         t0 = time.perf_counter()
         img = mi.render(scene, spp=spp, seed=seed)
@@ -97,10 +97,19 @@ def fmt(x, nd=3):
     return f"{x:.{nd}f}" if isinstance(x, float) else str(x)
 
 
+def used_params(xml_path, params):
+    """The parameters the converted XML still refers to: Mitsuba 3 rejects unused ones, and the
+    conversion has already substituted those it needed (grid paths, for one)."""
+    with open(xml_path) as f:
+        text = f.read()
+    return {k: v for k, v in params.items() if "$" + k in text}
+
+
 def run_scene(args, mit, path):
     name = args.name or scene_name(path)
     params = dict(args.define)
-    _, _, declared = mi3scene.convert(path, {})
+    # The -D values are needed already here: converting reads the grids the scene names.
+    _, _, declared = mi3scene.convert(path, dict(params))
     for key, val in (("resolution", args.resolution),):
         if val is not None:
             if key not in declared:
@@ -113,7 +122,8 @@ def run_scene(args, mit, path):
         f.write(xml)
     spp = args.spp
     if spp is None:
-        spp = int(mit.mi.load_file(xml_path, **params).sensors()[0].sampler().sample_count())
+        spp = int(mit.mi.load_file(xml_path, **used_params(xml_path, params))
+                  .sensors()[0].sampler().sample_count())
     seeds = args.seeds
     res = {"scene": path, "name": name, "spp": spp, "params": params, "notes": notes,
            "peer": {"renderer": "mitsuba " + mit.mi.__version__, "variant": mit.variant, "times_s": []},
