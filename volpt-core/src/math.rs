@@ -74,13 +74,21 @@ pub fn sin_cos_2pi(u: f32) -> (f32, f32) {
         0.00091926026,
         -2.5202042e-05,
     ];
-    let q = 4.0 * (u - libm::floorf(u));
-    let k = libm::roundf(q);
-    let r = q - k;
+    // Samplers pass u in [0, 1); anything else is first wrapped into it.
+    let u = if (0.0..1.0).contains(&u) {
+        u
+    } else {
+        u - libm::floorf(u)
+    };
+    let q = 4.0 * u;
+    // Nearest quadrant by truncation (q + 0.5 is exact or rounds within its integer interval):
+    // one conversion instruction, where libm's roundf is a software routine on baseline x86-64.
+    let k = (q + 0.5) as u32;
+    let r = q - k as f32;
     let r2 = r * r;
     let sin = r * (S[0] + r2 * (S[1] + r2 * (S[2] + r2 * (S[3] + r2 * S[4]))));
     let cos = C[0] + r2 * (C[1] + r2 * (C[2] + r2 * (C[3] + r2 * (C[4] + r2 * C[5]))));
-    match k as u32 & 3 {
+    match k & 3 {
         0 => (sin, cos),
         1 => (cos, -sin),
         2 => (-sin, -cos),
