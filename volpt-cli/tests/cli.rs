@@ -209,5 +209,8 @@ fn cuda_backend_without_a_gpu_is_a_clear_error() {
 fn strategy_on_the_cpu_is_a_clear_error() {
     let scene = example();
     let out = volpt(&["render", scene.to_str().unwrap(), "--strategy", "naive-sk"]);
-    assert_clean_error(&out, &["--strategy naive-sk", "CPU backend has no strategies"]);
+    assert_clean_error(
+        &out,
+        &["--strategy naive-sk", "CPU backend has no strategies"],
+    );
 }

@@ -123,7 +123,8 @@ fn device_bundle() -> Result<()> {
         std::fs::remove_dir_all(&bundle)?;
     }
     std::fs::create_dir_all(bundle.join("bin"))?;
-    let target = std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), PathBuf::from);
+    let target =
+        std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), PathBuf::from);
     std::fs::copy(target.join("release/volpt"), bundle.join("bin/volpt"))?;
     // Debug info is most of the binary; the device carries at most 64 MiB.
     run(Command::new("strip").arg(bundle.join("bin/volpt")))?;
