@@ -84,7 +84,13 @@ pub fn describe(path: &Path, desc: &SceneDescription) -> String {
         PhaseDesc::HenyeyGreenstein { g } => format!("Henyey-Greenstein, g {g}"),
     };
     let _ = writeln!(s, "phase      {phase}");
-    let EnvironmentDesc::Constant(rgb) = desc.environment;
-    let _ = writeln!(s, "light      constant environment, radiance {rgb:?}");
+    let light = match &desc.environment {
+        EnvironmentDesc::Constant(rgb) => format!("constant environment, radiance {rgb:?}"),
+        EnvironmentDesc::LatLong(map) => format!(
+            "lat-long environment map {}x{}, scale {}, rows {:?}",
+            map.width, map.height, map.scale, map.rows
+        ),
+    };
+    let _ = writeln!(s, "light      {light}");
     s
 }

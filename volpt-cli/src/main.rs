@@ -44,7 +44,8 @@ enum Command {
 
 #[derive(Subcommand)]
 enum SceneCommand {
-    /// Write the generated grids of the thesis scenes (cgg-logo, ad) under DIR.
+    /// Write the generated inputs of the included scenes (the grids of cgg-logo and ad, the sky map
+    /// of envmap-cube) under DIR.
     Generate {
         /// The `scenes/` directory of a volpt checkout or bundle.
         #[arg(default_value = "scenes")]
@@ -165,7 +166,7 @@ fn main() -> Result<()> {
             Ok(())
         }
         Command::Scene(SceneCommand::Generate { dir }) => {
-            for path in volpt_scene::generate::generate_thesis_grids(&dir)? {
+            for path in volpt_scene::generate::generate_scene_inputs(&dir)? {
                 println!("wrote {}", path.display());
             }
             Ok(())

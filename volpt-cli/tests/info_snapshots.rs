@@ -50,12 +50,13 @@ fn included_scenes() {
     );
 }
 
-/// cgg-logo and ad read generated grids: generate them into a copy of their directories.
+/// cgg-logo and ad read generated grids, envmap-cube a generated sky: generate them into a copy of
+/// their directories.
 #[test]
 fn generated_thesis_scenes() {
     let dir = tempfile::tempdir().expect("temp dir");
     let scenes = dir.path().join("scenes");
-    for name in ["cgg-logo", "ad"] {
+    for name in ["cgg-logo", "ad", "envmap-cube"] {
         std::fs::create_dir_all(scenes.join(name)).expect("mkdir");
         std::fs::copy(
             root().join("scenes").join(name).join("scene.xml"),
@@ -63,12 +64,16 @@ fn generated_thesis_scenes() {
         )
         .expect("copy scene");
     }
-    volpt_scene::generate::generate_thesis_grids(&scenes).expect("generate grids");
+    volpt_scene::generate::generate_scene_inputs(&scenes).expect("generate grids");
     insta::assert_snapshot!(
         "cgg-logo",
         info(dir.path(), "scenes/cgg-logo/scene.xml", &[])
     );
     insta::assert_snapshot!("ad", info(dir.path(), "scenes/ad/scene.xml", &[]));
+    insta::assert_snapshot!(
+        "envmap-cube",
+        info(dir.path(), "scenes/envmap-cube/scene.xml", &[])
+    );
 }
 
 #[test]

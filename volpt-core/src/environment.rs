@@ -18,24 +18,71 @@ impl Environment for ConstantEnvironment {
     }
 }
 
+/// Where the rows of a latitude-longitude map sit between the poles. Columns are the same in every
+/// Mitsuba generation (pixel centres at `u = (i + 0.5) / width`, wrapping around); rows are not.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LatLongRows {
+    /// Mitsuba 0.5/0.6 (a MIP map lookup): row `j` at `v = (j + 0.5) / height`, the outer rows held
+    /// constant up to the poles.
+    CellCentred,
+    /// Mitsuba 3: row `j` at `v = j / (height - 1)`, so the first and last rows lie on the poles.
+    PoleToPole,
+}
+
 /// An environment map in latitude-longitude layout (Mitsuba's `envmap`): the look direction `v` in the
 /// map's local frame maps to `u = atan2(v.x, -v.z) / 2 pi`, `v = acos(v.y) / pi`, so the image's top
-/// row is the +y pole. Pixels are bilinearly interpolated around their centres, wrapping in `u`.
+/// row is the +y pole and its centre column looks along -z. Pixels are bilinearly interpolated,
+/// wrapping in `u`; where the rows sit is [`LatLongRows`], applied as `row = v * row_scale + row_offset`
+/// (like [`crate::GridMapping`], so that a GPU receives the very same two numbers).
 #[derive(Clone, Copy, Debug)]
 pub struct LatLongEnvironment<'a> {
-    /// RGB, row-major from the top-left pixel.
+    /// RGB, row-major from the top-left pixel: `3 * width * height` values.
     pub rgb: &'a [f32],
     pub width: u32,
     pub height: u32,
     /// Rows of the world-to-map rotation.
     pub world_to_map: [Vec3; 3],
+    /// Multiplies every texel (Mitsuba's `scale`).
     pub scale: f32,
+    pub row_scale: f32,
+    pub row_offset: f32,
 }
 
-impl LatLongEnvironment<'_> {
+impl<'a> LatLongEnvironment<'a> {
+    /// `rgb.len()` must be `3 * width * height`, with `width` and `height` at least 1; lookups index
+    /// within that.
+    pub fn new(
+        rgb: &'a [f32],
+        width: u32,
+        height: u32,
+        rows: LatLongRows,
+        world_to_map: [Vec3; 3],
+        scale: f32,
+    ) -> Self {
+        assert!(width > 0 && height > 0, "empty environment map");
+        assert_eq!(
+            rgb.len(),
+            3 * width as usize * height as usize,
+            "environment map data does not match its resolution"
+        );
+        let (row_scale, row_offset) = match rows {
+            LatLongRows::CellCentred => (height as f32, -0.5),
+            LatLongRows::PoleToPole => ((height - 1) as f32, 0.0),
+        };
+        Self {
+            rgb,
+            width,
+            height,
+            world_to_map,
+            scale,
+            row_scale,
+            row_offset,
+        }
+    }
+
     #[inline]
     fn texel(&self, x: u32, y: u32) -> Spectrum {
-        let i = 3 * (y * self.width + x) as usize;
+        let i = 3 * (y as usize * self.width as usize + x as usize);
         Spectrum::new(self.rgb[i], self.rgb[i + 1], self.rgb[i + 2])
     }
 }
@@ -52,7 +99,11 @@ impl Environment for LatLongEnvironment<'_> {
         let u = u - libm::floorf(u);
         let t = libm::acosf(clamp(v.y, -1.0, 1.0)) * INV_PI;
         let x = u * self.width as f32 - 0.5;
-        let y = clamp(t * self.height as f32 - 0.5, 0.0, (self.height - 1) as f32);
+        let y = clamp(
+            t * self.row_scale + self.row_offset,
+            0.0,
+            (self.height - 1) as f32,
+        );
         let (x0f, y0f) = (libm::floorf(x), libm::floorf(y));
         let (fx, fy) = (x - x0f, y - y0f);
         let wrap = |i: i32| i.rem_euclid(self.width as i32) as u32;

@@ -12,7 +12,7 @@
 
 use crate::bsdf::{NullBoundary, RoughDielectric, SmoothDielectric};
 use crate::camera::PerspectiveCamera;
-use crate::environment::ConstantEnvironment;
+use crate::environment::{ConstantEnvironment, LatLongEnvironment};
 use crate::grid::{Grid, GridMapping};
 use crate::medium::{ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium};
 use crate::microfacet::Ggx;
@@ -181,7 +181,29 @@ impl SettingsParams {
     }
 }
 
-/// Everything a kernel needs to rebuild any scene variant.
+/// The environment: a constant reads `radiance` only, a lat-long map everything else.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct EnvironmentParams {
+    /// Constant environment radiance.
+    pub radiance: [f32; 3],
+    /// Lat-long: the map's `scale`.
+    pub scale: f32,
+    /// Lat-long: rows of the world-to-map rotation.
+    pub world_to_map: [[f32; 3]; 3],
+    pub width: u32,
+    pub height: u32,
+    pub row_scale: f32,
+    pub row_offset: f32,
+    /// Explicit, so that no byte of the struct is uninitialised padding when it is copied.
+    pub padding: u32,
+    /// Device address of the map's `len` RGB `f32` values.
+    pub texels: u64,
+    pub len: u64,
+}
+
+/// Everything a kernel needs to rebuild any scene variant. Fields are ordered so that every one
+/// is aligned without implicit padding.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SceneParams {
@@ -189,13 +211,10 @@ pub struct SceneParams {
     pub bounds_min: [f32; 3],
     pub bounds_max: [f32; 3],
     pub medium: MediumParams,
+    pub environment: EnvironmentParams,
     pub boundary: BoundaryParams,
     pub phase: PhaseParams,
-    /// Constant environment radiance.
-    pub environment: [f32; 3],
     pub settings: SettingsParams,
-    /// Explicit, so that no byte of the struct is uninitialised padding when it is copied.
-    pub padding: u32,
 }
 
 /// One launch: the scene, the sampling, and the device buffers the kernel writes.
@@ -224,8 +243,9 @@ pub struct LaunchParams {
 const _: () = assert!(core::mem::size_of::<CameraParams>() == 64);
 const _: () = assert!(core::mem::size_of::<GridParams>() == 16 + 4 * 4 + 4 * 12);
 const _: () = assert!(core::mem::size_of::<MediumParams>() == 24 + 2 * 80);
-const _: () = assert!(core::mem::size_of::<SceneParams>() == 64 + 24 + 184 + 8 + 4 + 12 + 12 + 4);
-const _: () = assert!(core::mem::size_of::<LaunchParams>() == 312 + 16 + 4 * 8);
+const _: () = assert!(core::mem::size_of::<EnvironmentParams>() == 16 + 36 + 20 + 16);
+const _: () = assert!(core::mem::size_of::<SceneParams>() == 64 + 24 + 184 + 88 + 8 + 4 + 12);
+const _: () = assert!(core::mem::size_of::<LaunchParams>() == 384 + 16 + 4 * 8);
 
 /// Number of `u64` counters a launch reduces: paths, segments, tracking steps, truncated paths.
 pub const COUNTERS: usize = 4;
@@ -234,7 +254,7 @@ pub const COUNTERS: usize = 4;
 pub trait FromParams<'a>: Sized {
     /// # Safety
     /// The grid addresses in `p` that this component reads must satisfy [`GridParams::grid`]'s
-    /// contract for `'a`.
+    /// contract for `'a`, and so must an environment map's `texels` and `len`.
     unsafe fn from_params(p: &'a SceneParams) -> Self;
 }
 
@@ -320,7 +340,24 @@ impl FromParams<'_> for HenyeyGreenstein {
 impl FromParams<'_> for ConstantEnvironment {
     #[inline]
     unsafe fn from_params(p: &SceneParams) -> Self {
-        ConstantEnvironment(Spectrum::from_array(p.environment))
+        ConstantEnvironment(Spectrum::from_array(p.environment.radiance))
+    }
+}
+
+impl<'a> FromParams<'a> for LatLongEnvironment<'a> {
+    #[inline]
+    unsafe fn from_params(p: &'a SceneParams) -> Self {
+        let e = &p.environment;
+        Self {
+            // SAFETY: the caller guarantees the address range.
+            rgb: unsafe { core::slice::from_raw_parts(e.texels as *const f32, e.len as usize) },
+            width: e.width,
+            height: e.height,
+            world_to_map: e.world_to_map.map(Vec3::from_array),
+            scale: e.scale,
+            row_scale: e.row_scale,
+            row_offset: e.row_offset,
+        }
     }
 }
 
@@ -353,7 +390,7 @@ where
 
 /// The host side of [`FromParams`]: writes a scene component into launch parameters.
 ///
-/// `upload` copies a grid's values to device memory and returns their device address; the caller
+/// `upload` copies a grid's (or an environment map's) values to device memory and returns their device address; the caller
 /// keeps that memory alive for as long as the parameters are used.
 pub trait ToParams {
     fn to_params(&self, p: &mut SceneParams, upload: &mut dyn FnMut(&[f32]) -> u64);
@@ -413,7 +450,23 @@ impl ToParams for HenyeyGreenstein {
 
 impl ToParams for ConstantEnvironment {
     fn to_params(&self, p: &mut SceneParams, _upload: &mut dyn FnMut(&[f32]) -> u64) {
-        p.environment = self.0.to_array();
+        p.environment.radiance = self.0.to_array();
+    }
+}
+
+impl ToParams for LatLongEnvironment<'_> {
+    fn to_params(&self, p: &mut SceneParams, upload: &mut dyn FnMut(&[f32]) -> u64) {
+        p.environment = EnvironmentParams {
+            scale: self.scale,
+            world_to_map: self.world_to_map.map(|row| row.to_array()),
+            width: self.width,
+            height: self.height,
+            row_scale: self.row_scale,
+            row_offset: self.row_offset,
+            texels: upload(self.rgb),
+            len: self.rgb.len() as u64,
+            ..EnvironmentParams::default()
+        };
     }
 }
 

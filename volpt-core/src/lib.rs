@@ -26,7 +26,7 @@ pub mod tracking;
 
 pub use bsdf::{Bsdf, BsdfSample, NullBoundary, RoughDielectric, SmoothDielectric};
 pub use camera::PerspectiveCamera;
-pub use environment::{ConstantEnvironment, Environment, LatLongEnvironment};
+pub use environment::{ConstantEnvironment, Environment, LatLongEnvironment, LatLongRows};
 pub use geometry::{Aabb, Ray};
 pub use grid::{Grid, GridMapping};
 pub use medium::{AlbedoField, ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium, Medium};

@@ -2,8 +2,9 @@
 //! [`VolumeScene`] that simulates exactly those.
 //!
 //! Each axis of the decision is a type parameter of the scene: constant or grid extinction, constant
-//! or grid albedo, index-matched, smooth or rough boundary, isotropic or Henyey-Greenstein phase. A
-//! backend receives the scene through [`SceneVisitor`], so one generic function serves every variant.
+//! or grid albedo, index-matched, smooth or rough boundary, isotropic or Henyey-Greenstein phase,
+//! constant or lat-long environment. A backend receives the scene through [`SceneVisitor`], so one
+//! generic function serves every variant.
 
 use std::fmt;
 
@@ -13,12 +14,12 @@ use volpt_core::math::tan;
 use volpt_core::microfacet::Ggx;
 use volpt_core::{
     Aabb, ConstantAlbedo, ConstantEnvironment, GridAlbedo, GridMedium, HenyeyGreenstein,
-    HomogeneousMedium, Isotropic, NullBoundary, PathSettings, PerspectiveCamera, RoughDielectric,
-    Scene, SmoothDielectric, Spectrum, Vec2, Vec3, VolumeScene,
+    HomogeneousMedium, Isotropic, LatLongEnvironment, LatLongRows, NullBoundary, PathSettings,
+    PerspectiveCamera, RoughDielectric, Scene, SmoothDielectric, Spectrum, Vec2, Vec3, VolumeScene,
 };
 use volpt_scene::description::{
     AlbedoDesc, Bounds, BsdfDesc, CameraDesc, DensityDesc, EnvironmentDesc, FilmDesc, FovAxis,
-    GridConvention, GridDesc, PhaseDesc, SceneDescription,
+    GridConvention, GridDesc, LatLongDesc, PhaseDesc, SceneDescription,
 };
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -44,12 +45,21 @@ pub enum PhaseKind {
     HenyeyGreenstein,
 }
 
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum EnvironmentKind {
+    /// The same radiance from every direction: no lookup.
+    Constant,
+    /// A latitude-longitude map, bilinearly interpolated.
+    LatLong,
+}
+
 /// The monomorphised variant a scene renders with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Variant {
     pub medium: MediumKind,
     pub boundary: BoundaryKind,
     pub phase: PhaseKind,
+    pub environment: EnvironmentKind,
 }
 
 impl Variant {
@@ -69,10 +79,15 @@ impl Variant {
             PhaseDesc::Isotropic => PhaseKind::Isotropic,
             PhaseDesc::HenyeyGreenstein { .. } => PhaseKind::HenyeyGreenstein,
         };
+        let environment = match desc.environment {
+            EnvironmentDesc::Constant(_) => EnvironmentKind::Constant,
+            EnvironmentDesc::LatLong(_) => EnvironmentKind::LatLong,
+        };
         Self {
             medium,
             boundary,
             phase,
+            environment,
         }
     }
 }
@@ -93,7 +108,13 @@ impl fmt::Display for Variant {
             PhaseKind::Isotropic => "isotropic",
             PhaseKind::HenyeyGreenstein => "hg",
         };
-        write!(f, "{medium}/{boundary}/{phase}")
+        write!(f, "{medium}/{boundary}/{phase}")?;
+        // Only the lat-long map is named, so that the names of constant-environment variants (and
+        // the GPU kernels derived from them) stay what they were before environment maps existed.
+        match self.environment {
+            EnvironmentKind::Constant => Ok(()),
+            EnvironmentKind::LatLong => f.write_str("/envmap"),
+        }
     }
 }
 
@@ -111,14 +132,55 @@ pub fn with_scene<V: SceneVisitor>(
     settings: PathSettings,
     visitor: V,
 ) -> V::Output {
-    let parts = Parts {
-        camera: camera(&desc.camera, &desc.film),
-        bounds: aabb(&desc.boundary.bounds),
-        settings,
-        environment: match desc.environment {
-            EnvironmentDesc::Constant(rgb) => ConstantEnvironment(Spectrum::from_array(rgb)),
-        },
+    let camera = camera(&desc.camera, &desc.film);
+    let bounds = aabb(&desc.boundary.bounds);
+    match &desc.environment {
+        EnvironmentDesc::Constant(rgb) => {
+            let environment = ConstantEnvironment(Spectrum::from_array(*rgb));
+            let parts = Parts {
+                camera,
+                bounds,
+                settings,
+                environment,
+            };
+            with_medium(desc, parts, visitor)
+        }
+        EnvironmentDesc::LatLong(map) => {
+            let parts = Parts {
+                camera,
+                bounds,
+                settings,
+                environment: lat_long(map),
+            };
+            with_medium(desc, parts, visitor)
+        }
+    }
+}
+
+/// The map's world-to-map rotation is the transpose of its `to_world`'s linear part (a rotation,
+/// as the loader checks); the translation does not matter for light from infinitely far away.
+fn lat_long(map: &LatLongDesc) -> LatLongEnvironment<'_> {
+    let m = map.to_world;
+    let column = |j: usize| Vec3::new(m[0][j], m[1][j], m[2][j]);
+    let rows = match map.rows {
+        volpt_scene::description::LatLongRows::CellCentred => LatLongRows::CellCentred,
+        volpt_scene::description::LatLongRows::PoleToPole => LatLongRows::PoleToPole,
     };
+    LatLongEnvironment::new(
+        &map.rgb,
+        map.width,
+        map.height,
+        rows,
+        [column(0), column(1), column(2)],
+        map.scale,
+    )
+}
+
+fn with_medium<E, V>(desc: &SceneDescription, parts: Parts<E>, visitor: V) -> V::Output
+where
+    E: volpt_core::Environment + Sync + ToParams,
+    V: SceneVisitor,
+{
     let medium = &desc.medium;
     let one_voxel;
     let density_grid = match &medium.density {
@@ -168,16 +230,22 @@ pub fn with_scene<V: SceneVisitor>(
     }
 }
 
-/// The parts every variant shares.
-struct Parts {
+/// The parts every variant shares, and the environment, chosen first.
+struct Parts<E> {
     camera: PerspectiveCamera,
     bounds: Aabb,
     settings: PathSettings,
-    environment: ConstantEnvironment,
+    environment: E,
 }
 
-fn with_boundary<M, V>(desc: &SceneDescription, parts: Parts, medium: M, visitor: V) -> V::Output
+fn with_boundary<E, M, V>(
+    desc: &SceneDescription,
+    parts: Parts<E>,
+    medium: M,
+    visitor: V,
+) -> V::Output
 where
+    E: volpt_core::Environment + Sync + ToParams,
     M: volpt_core::Medium + Sync + ToParams,
     V: SceneVisitor,
 {
@@ -203,14 +271,15 @@ where
     }
 }
 
-fn with_phase<M, B, V>(
+fn with_phase<E, M, B, V>(
     desc: &SceneDescription,
-    parts: Parts,
+    parts: Parts<E>,
     medium: M,
     boundary: B,
     visitor: V,
 ) -> V::Output
 where
+    E: volpt_core::Environment + Sync + ToParams,
     M: volpt_core::Medium + Sync + ToParams,
     B: volpt_core::Bsdf + Sync + ToParams,
     V: SceneVisitor,
@@ -223,12 +292,12 @@ where
     }
 }
 
-fn assemble<M, B, P>(
-    parts: Parts,
+fn assemble<E, M, B, P>(
+    parts: Parts<E>,
     medium: M,
     boundary: B,
     phase: P,
-) -> VolumeScene<M, B, P, ConstantEnvironment> {
+) -> VolumeScene<M, B, P, E> {
     VolumeScene {
         camera: parts.camera,
         bounds: parts.bounds,

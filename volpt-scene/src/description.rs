@@ -145,8 +145,37 @@ impl GridDesc {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum EnvironmentDesc {
     /// Constant radiance from every direction.
     Constant([f32; 3]),
+    /// A latitude-longitude environment map (Mitsuba's `envmap`).
+    LatLong(LatLongDesc),
+}
+
+/// A latitude-longitude environment map. The look direction `d`, taken to the map's frame by the
+/// inverse of `to_world`, is found at `u = atan2(d.x, -d.z) / 2 pi` (wrapping around) and
+/// `v = acos(d.y) / pi`: the top row is the +y pole and the centre column looks along -z.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LatLongDesc {
+    pub width: u32,
+    pub height: u32,
+    /// Linear RGB radiance, `3 * width * height` values, row-major from the top-left pixel.
+    pub rgb: Vec<f32>,
+    /// Map-to-world transform; its linear part is a rotation (possibly a mirroring), and its
+    /// translation does not matter for light from infinitely far away.
+    pub to_world: Matrix4,
+    /// Multiplies every texel.
+    pub scale: f32,
+    pub rows: LatLongRows,
+}
+
+/// Where a latitude-longitude map's rows sit between the poles; columns sit at
+/// `u = (i + 0.5) / width` in every Mitsuba generation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LatLongRows {
+    /// Mitsuba 0.5/0.6: row `j` at `v = (j + 0.5) / height`.
+    CellCentred,
+    /// Mitsuba 3: row `j` at `v = j / (height - 1)`, the first and last rows on the poles.
+    PoleToPole,
 }

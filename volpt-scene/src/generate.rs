@@ -3,6 +3,8 @@
 //! `cgg-logo` and `ad` are solid blocks of constant density whose albedo is white except for a
 //! coloured logo printed a few voxels deep into the face the camera sees (+z), like a full-colour 3D
 //! print. The letters come from a 5x7 bitmap font, scaled to span most of the face.
+//!
+//! `envmap-cube` is lit by a small procedural sky ([`SKY`]), written as an OpenEXR lat-long map.
 
 use std::path::{Path, PathBuf};
 
@@ -135,8 +137,9 @@ impl PrintedBlock {
     }
 }
 
-/// Generates the grids of the included scenes under `scenes_dir` (`cgg-logo/` and `ad/`).
-pub fn generate_thesis_grids(scenes_dir: &Path) -> Result<Vec<PathBuf>, SceneError> {
+/// Generates the inputs of the included scenes under `scenes_dir`: the grids of `cgg-logo/` and
+/// `ad/`, and the sky map of `envmap-cube/`.
+pub fn generate_scene_inputs(scenes_dir: &Path) -> Result<Vec<PathBuf>, SceneError> {
     let unit = Bounds {
         min: [-0.5; 3],
         max: [0.5; 3],
@@ -148,5 +151,98 @@ pub fn generate_thesis_grids(scenes_dir: &Path) -> Result<Vec<PathBuf>, SceneErr
     let mut written = Vec::new();
     written.extend(CGG_LOGO.write(&scenes_dir.join("cgg-logo"), unit)?);
     written.extend(AD.write(&scenes_dir.join("ad"), slab)?);
+    written.push(SKY.write(&scenes_dir.join("envmap-cube"))?);
     Ok(written)
+}
+
+/// A lat-long sky for Mitsuba 3's `envmap` (rows pole to pole: row `j` at polar angle
+/// `pi j / (height - 1)`, column `i` at azimuth `2 pi (i + 0.5) / width`, with the map's look
+/// direction `(sin t sin p, cos t, -sin t cos p)`): a blue sky brightening towards the horizon,
+/// dark warm ground, and a small warm sun `sun_elevation` degrees above the horizon towards +x.
+#[derive(Clone, Copy, Debug)]
+pub struct Sky {
+    pub width: u32,
+    pub height: u32,
+    pub zenith: [f32; 3],
+    pub horizon: [f32; 3],
+    pub ground: [f32; 3],
+    pub sun: [f32; 3],
+    pub sun_elevation: f32,
+    /// Angular radius (radians) at which the sun has fallen to `1/e` of its peak.
+    pub sun_radius: f32,
+}
+
+/// The sky of `scenes/envmap-cube`: 64x32 texels.
+pub const SKY: Sky = Sky {
+    width: 64,
+    height: 32,
+    zenith: [0.25, 0.45, 0.9],
+    horizon: [0.85, 0.9, 1.0],
+    ground: [0.12, 0.09, 0.06],
+    sun: [60.0, 50.0, 35.0],
+    sun_elevation: 30.0,
+    sun_radius: 0.08,
+};
+
+impl Sky {
+    /// Linear RGB, row-major from the top-left texel.
+    pub fn texels(&self) -> Vec<f32> {
+        use std::f32::consts::PI;
+        let (sin_e, cos_e) = self.sun_elevation.to_radians().sin_cos();
+        let sun_dir = [cos_e, sin_e, 0.0];
+        let mut rgb = Vec::with_capacity(3 * (self.width * self.height) as usize);
+        for j in 0..self.height {
+            let theta = PI * j as f32 / (self.height - 1) as f32;
+            for i in 0..self.width {
+                let phi = 2.0 * PI * (i as f32 + 0.5) / self.width as f32;
+                let d = [
+                    theta.sin() * phi.sin(),
+                    theta.cos(),
+                    -theta.sin() * phi.cos(),
+                ];
+                let base = if d[1] >= 0.0 {
+                    let t = d[1].sqrt();
+                    [0, 1, 2].map(|c| self.horizon[c] + (self.zenith[c] - self.horizon[c]) * t)
+                } else {
+                    self.ground
+                };
+                let cos_angle = d[0] * sun_dir[0] + d[1] * sun_dir[1] + d[2] * sun_dir[2];
+                let angle = cos_angle.clamp(-1.0, 1.0).acos();
+                let glow = (-(angle / self.sun_radius).powi(2)).exp();
+                rgb.extend([0, 1, 2].map(|c| base[c] + self.sun[c] * glow));
+            }
+        }
+        rgb
+    }
+
+    /// Writes `sky.exr` (half-float RGB) into `dir`, returning its path.
+    pub fn write(&self, dir: &Path) -> Result<PathBuf, SceneError> {
+        use exr::prelude::f16;
+        std::fs::create_dir_all(dir).map_err(|error| SceneError::Io {
+            path: dir.to_owned(),
+            error,
+        })?;
+        let path = dir.join("sky.exr");
+        let rgb = self.texels();
+        let width = self.width as usize;
+        exr::prelude::write_rgb_file(&path, width, self.height as usize, |x, y| {
+            let i = 3 * (y * width + x);
+            (
+                f16::from_f32(rgb[i]),
+                f16::from_f32(rgb[i + 1]),
+                f16::from_f32(rgb[i + 2]),
+            )
+        })
+        .map_err(|e| match e {
+            exr::error::Error::Io(error) => SceneError::Io {
+                path: path.clone(),
+                error,
+            },
+            other => SceneError::Io {
+                path: path.clone(),
+                error: std::io::Error::other(other.to_string()),
+            },
+        })?;
+        Ok(path)
+    }
 }

@@ -455,13 +455,13 @@ fn second_emitter_is_unsupported() {
 }
 
 #[test]
-fn envmap_is_unsupported() {
+fn emitter_other_than_an_environment_is_unsupported() {
     let text = bsdf_scene(r#"<bsdf type="null"/>"#).replace(
         "<shape",
-        "<emitter type=\"envmap\"><string name=\"filename\" value=\"sky.exr\"/></emitter>\n<shape",
+        "<emitter type=\"point\"><point name=\"position\" x=\"0\" y=\"2\" z=\"0\"/></emitter>\n<shape",
     );
-    let err = error_at(&text, "envmap");
-    message_of(&err, &["<emitter type=\"envmap\">", "constant"]);
+    let err = error_at(&text, "type=\"point\"");
+    message_of(&err, &["<emitter type=\"point\">", "constant", "envmap"]);
 }
 
 #[test]

@@ -4,8 +4,10 @@
 //! A kernel takes one argument, the device address of a [`volpt_core::launch::LaunchParams`]. It
 //! copies the parameters, rebuilds the very `VolumeScene` type the CPU renders that variant with (see
 //! [`volpt_core::launch::FromParams`]) and runs a strategy from [`strategy`] on it. Kernel names are
-//! `<strategy>__<medium>__<boundary>__<phase>`, e.g. `naive_sk__homogeneous__rough_dielectric__hg`:
-//! the host derives them from the render factory's `Variant`.
+//! `<strategy>__<medium>__<boundary>__<phase>`, e.g. `naive_sk__homogeneous__rough_dielectric__hg`,
+//! with `__envmap` appended for a lat-long environment: the host derives them from the render
+//! factory's `Variant`. Every combination of the axes is instantiated (3 media x 3 boundaries x 2
+//! phases x 2 environments x 2 strategies = 72 kernels) by the macros below, one module per axis.
 //!
 //! On any target but nvptx64 this crate is empty, so that host builds of the workspace pass.
 #![cfg_attr(target_arch = "nvptx64", no_std)]
@@ -20,19 +22,21 @@ mod device;
 pub mod strategy;
 
 /// One kernel: strategy `$strategy` (a generic function of [`strategy`]) on the scene type
-/// `VolumeScene<$medium, $boundary, $phase, ConstantEnvironment>`, exported as `$name`.
+/// `VolumeScene<$medium, $boundary, $phase, $environment>`, exported as `$name`.
 #[cfg(target_arch = "nvptx64")]
 macro_rules! kernel {
-    ($name:expr, $entry:ident, $strategy:ident, $medium:ty, $boundary:ty, $phase:ty) => {
+    ($name:expr, $entry:ident, $strategy:ident, $medium:ty, $boundary:ty, $phase:ty,
+     $environment:ty) => {
         /// # Safety
-        /// `params` must be the device address of an initialised `LaunchParams` whose buffers and
-        /// grids stay allocated until the kernel ends.
+        /// `params` must be the device address of an initialised `LaunchParams` whose buffers,
+        /// grids and environment map stay allocated until the kernel ends.
         #[export_name = $name]
         pub unsafe extern "ptx-kernel" fn $entry(params: *const LaunchParams) {
             // SAFETY: the caller's contract.
             let lp = unsafe { *params };
-            // SAFETY: the grid addresses in `lp` are device allocations the host keeps alive.
-            let scene: VolumeScene<$medium, $boundary, $phase, ConstantEnvironment> =
+            // SAFETY: the grid and map addresses in `lp` are device allocations the host keeps
+            // alive.
+            let scene: VolumeScene<$medium, $boundary, $phase, $environment> =
                 unsafe { FromParams::from_params(&lp.scene) };
             // SAFETY: `lp`'s buffers are sized for this launch.
             unsafe { crate::strategy::$strategy(&scene, &lp) }
@@ -40,47 +44,87 @@ macro_rules! kernel {
     };
 }
 
-/// Instantiates every strategy for each listed variant: `<name>: <medium>, <boundary>, <phase>;`.
-/// A new strategy is one more `kernel!` line here, never a copied kernel body.
+/// The cartesian product of the variant axes, one nested module per axis value (`macro_rules!`
+/// cannot paste identifiers, so modules keep the entry points apart), ending in one `kernel!` per
+/// strategy. Each level takes its own axis as `{name: Type, ...}` and passes the remaining axes on
+/// untouched as token trees. A new strategy is one more `kernel!` line in the last level; a new
+/// axis value is one more entry in the `kernels!` invocation.
 #[cfg(target_arch = "nvptx64")]
 macro_rules! kernels {
-    ($($variant:ident: $medium:ty, $boundary:ty, $phase:ty;)*) => {$(
-        #[allow(non_snake_case)]
-        pub mod $variant {
-            use volpt_core::launch::{FromParams, LaunchParams};
-            use volpt_core::{ConstantEnvironment, VolumeScene};
-            #[allow(unused_imports)]
-            use volpt_core::{
-                ConstantAlbedo, GridAlbedo, GridMedium, HenyeyGreenstein, HomogeneousMedium,
-                Isotropic, NullBoundary, RoughDielectric, SmoothDielectric,
-            };
-
-            kernel!(concat!("naive_sk__", stringify!($variant)), naive_sk, naive,
-                $medium, $boundary, $phase);
-            kernel!(concat!("regeneration_sk__", stringify!($variant)), regeneration_sk,
-                regeneration, $medium, $boundary, $phase);
+    (medium: {$($m:ident: $mt:ty),* $(,)?} boundary: $b:tt phase: $p:tt environment: $e:tt) => {$(
+        pub mod $m {
+            by_boundary!(($m: $mt) $b $p $e);
         }
     )*};
 }
 
 #[cfg(target_arch = "nvptx64")]
+macro_rules! by_boundary {
+    (($m:ident: $mt:ty) {$($b:ident: $bt:ty),* $(,)?} $p:tt $e:tt) => {$(
+        pub mod $b {
+            by_phase!(($m: $mt) ($b: $bt) $p $e);
+        }
+    )*};
+}
+
+#[cfg(target_arch = "nvptx64")]
+macro_rules! by_phase {
+    (($m:ident: $mt:ty) ($b:ident: $bt:ty) {$($p:ident: $pt:ty),* $(,)?} $e:tt) => {$(
+        pub mod $p {
+            by_environment!(($m: $mt) ($b: $bt) ($p: $pt) $e);
+        }
+    )*};
+}
+
+/// The last axis: `$suffix` ends the exported name (empty for the constant environment, whose
+/// kernels keep their names from before environment maps).
+#[cfg(target_arch = "nvptx64")]
+macro_rules! by_environment {
+    (($m:ident: $mt:ty) ($b:ident: $bt:ty) ($p:ident: $pt:ty)
+     {$($e:ident: $et:ty => $suffix:literal),* $(,)?}) => {$(
+        pub mod $e {
+            use volpt_core::launch::{FromParams, LaunchParams};
+            use volpt_core::VolumeScene;
+            #[allow(unused_imports)]
+            use volpt_core::{
+                ConstantAlbedo, ConstantEnvironment, GridAlbedo, GridMedium, HenyeyGreenstein,
+                HomogeneousMedium, Isotropic, LatLongEnvironment, NullBoundary, RoughDielectric,
+                SmoothDielectric,
+            };
+
+            kernel!(
+                concat!("naive_sk__", stringify!($m), "__", stringify!($b), "__",
+                    stringify!($p), $suffix),
+                naive_sk, naive, $mt, $bt, $pt, $et
+            );
+            kernel!(
+                concat!("regeneration_sk__", stringify!($m), "__", stringify!($b), "__",
+                    stringify!($p), $suffix),
+                regeneration_sk, regeneration, $mt, $bt, $pt, $et
+            );
+        }
+    )*};
+}
+
+// Axis value names are the render factory's `Variant` names with '-' as '_'.
+#[cfg(target_arch = "nvptx64")]
 kernels! {
-    homogeneous__index_matched__isotropic: HomogeneousMedium, NullBoundary, Isotropic;
-    homogeneous__index_matched__hg: HomogeneousMedium, NullBoundary, HenyeyGreenstein;
-    homogeneous__smooth_dielectric__isotropic: HomogeneousMedium, SmoothDielectric, Isotropic;
-    homogeneous__smooth_dielectric__hg: HomogeneousMedium, SmoothDielectric, HenyeyGreenstein;
-    homogeneous__rough_dielectric__isotropic: HomogeneousMedium, RoughDielectric, Isotropic;
-    homogeneous__rough_dielectric__hg: HomogeneousMedium, RoughDielectric, HenyeyGreenstein;
-    grid_density__index_matched__isotropic: GridMedium<'_, ConstantAlbedo>, NullBoundary, Isotropic;
-    grid_density__index_matched__hg: GridMedium<'_, ConstantAlbedo>, NullBoundary, HenyeyGreenstein;
-    grid_density__smooth_dielectric__isotropic: GridMedium<'_, ConstantAlbedo>, SmoothDielectric, Isotropic;
-    grid_density__smooth_dielectric__hg: GridMedium<'_, ConstantAlbedo>, SmoothDielectric, HenyeyGreenstein;
-    grid_density__rough_dielectric__isotropic: GridMedium<'_, ConstantAlbedo>, RoughDielectric, Isotropic;
-    grid_density__rough_dielectric__hg: GridMedium<'_, ConstantAlbedo>, RoughDielectric, HenyeyGreenstein;
-    grid_density_albedo__index_matched__isotropic: GridMedium<'_, GridAlbedo<'_>>, NullBoundary, Isotropic;
-    grid_density_albedo__index_matched__hg: GridMedium<'_, GridAlbedo<'_>>, NullBoundary, HenyeyGreenstein;
-    grid_density_albedo__smooth_dielectric__isotropic: GridMedium<'_, GridAlbedo<'_>>, SmoothDielectric, Isotropic;
-    grid_density_albedo__smooth_dielectric__hg: GridMedium<'_, GridAlbedo<'_>>, SmoothDielectric, HenyeyGreenstein;
-    grid_density_albedo__rough_dielectric__isotropic: GridMedium<'_, GridAlbedo<'_>>, RoughDielectric, Isotropic;
-    grid_density_albedo__rough_dielectric__hg: GridMedium<'_, GridAlbedo<'_>>, RoughDielectric, HenyeyGreenstein;
+    medium: {
+        homogeneous: HomogeneousMedium,
+        grid_density: GridMedium<'_, ConstantAlbedo>,
+        grid_density_albedo: GridMedium<'_, GridAlbedo<'_>>,
+    }
+    boundary: {
+        index_matched: NullBoundary,
+        smooth_dielectric: SmoothDielectric,
+        rough_dielectric: RoughDielectric,
+    }
+    phase: {
+        isotropic: Isotropic,
+        hg: HenyeyGreenstein,
+    }
+    environment: {
+        constant: ConstantEnvironment => "",
+        envmap: LatLongEnvironment<'_> => "__envmap",
+    }
 }

@@ -1,8 +1,9 @@
 //! Mitsuba scene files (0.5/0.6 and 3 dialects) to a [`SceneDescription`].
 //!
 //! volpt renders one kind of scene: a camera looking at a box-bounded participating medium under
-//! a constant or lat-long (`envmap`) environment. Whatever else a Mitsuba file says is either harmless and ignored (with
-//! a warning when it might change the image) or an error that names the element and its line.
+//! a constant or lat-long (`envmap`) environment. Whatever else a Mitsuba file says is either
+//! harmless and ignored (with a warning when it might change the image) or an error that names the
+//! element and its line.
 //!
 //! Layers, bottom up: `xml` (element tree with lines) -> `preprocess` (`<default>`, `$name`,
 //! `<include>`, the dialect) -> `plugin` (typed parameter access, `<ref>`) -> one builder per
