@@ -5,7 +5,7 @@ mod bench;
 mod compare;
 mod info;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand};
@@ -50,6 +50,19 @@ enum SceneCommand {
         /// The `scenes/` directory of a volpt checkout or bundle.
         #[arg(default_value = "scenes")]
         dir: PathBuf,
+    },
+    /// Write the scene as volpt loads it (after -D, --spp, --resolution, ...) as a Mitsuba 3 scene:
+    /// OUT/NAME.xml with its grids (.vol) and environment map (.exr) beside it.
+    Export {
+        #[command(flatten)]
+        scene: SceneArgs,
+        /// Directory to write into (created if missing).
+        #[arg(short, long)]
+        out: PathBuf,
+        /// Base name of the written files (default: the scene's directory name, or its file stem
+        /// when that is not `scene`).
+        #[arg(long)]
+        name: Option<String>,
     },
 }
 
@@ -165,6 +178,14 @@ fn main() -> Result<()> {
             print!("{}", info::describe(&args.scene, &desc));
             Ok(())
         }
+        Command::Scene(SceneCommand::Export { scene, out, name }) => {
+            let desc = load(&scene)?;
+            let name = name.unwrap_or_else(|| export_name(&scene.scene));
+            for path in volpt_scene::mitsuba::write_mitsuba3(&desc, &out, &name)? {
+                println!("wrote {}", path.display());
+            }
+            Ok(())
+        }
         Command::Scene(SceneCommand::Generate { dir }) => {
             for path in volpt_scene::generate::generate_scene_inputs(&dir)? {
                 println!("wrote {}", path.display());
@@ -172,6 +193,22 @@ fn main() -> Result<()> {
             Ok(())
         }
         Command::Compare(args) => compare::run(&args),
+    }
+}
+
+/// `scenes/bucky/scene.toml` -> `bucky`, `scenes/smoke/scene-mi3.xml` -> `scene-mi3`.
+fn export_name(scene: &Path) -> String {
+    let stem = scene
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("scene");
+    let parent = scene
+        .canonicalize()
+        .ok()
+        .and_then(|p| Some(p.parent()?.file_name()?.to_str()?.to_owned()));
+    match parent {
+        Some(parent) if stem == "scene" => parent,
+        _ => stem.to_owned(),
     }
 }
 

@@ -78,6 +78,10 @@ pub enum SceneError {
         problem: EnvmapProblem,
     },
 
+    /// A scene that cannot be written in the requested format without changing it.
+    #[error("{}: cannot write this scene: {reason}", path.display())]
+    Export { path: PathBuf, reason: String },
+
     /// An error in a file that a scene file refers to (a grid, a mesh): says which element
     /// referred to it, then the error itself (which names the referred-to file).
     #[error("{}:{line}: {element}: {error}", path.display())]

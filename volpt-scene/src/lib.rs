@@ -7,7 +7,7 @@
 //! - [`error`]: what can go wrong loading one ([`SceneError`]); every message names the file and,
 //!   for XML, the line.
 //! - [`vol`]: Mitsuba's `.vol` grid files, read and written.
-//! - [`mitsuba`]: Mitsuba 0.5/0.6 and Mitsuba 3 XML scene files.
+//! - [`mitsuba`]: Mitsuba 0.5/0.6 and Mitsuba 3 XML scene files, read; Mitsuba 3 scenes, written.
 //! - [`generate`]: the thesis's printed-block grids (`cgg-logo`, `ad`), generated rather than stored.
 //! - [`raw`]: raw voxel files with a caller-given layout (such as `Bucky.raw`), read and written.
 //! - [`metaimage`]: MetaImage `.mha`/`.mhd` grids, read and written.

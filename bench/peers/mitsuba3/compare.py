@@ -11,6 +11,11 @@ second ones. Mitsuba's time is `mi.render` plus evaluation and synchronisation o
 loading excluded); volpt's is the render time it prints (scene loading and EXR writing excluded;
 the process's wall time is recorded too). Writes OUT/<name>.json, OUT/<name>-{volpt,mi3}-s{1,2}.exr,
 OUT/<name>-mi3.xml (what Mitsuba rendered) and appends a row to OUT/results.md.
+
+A scene that is not Mitsuba XML (a volpt TOML scene, a grid file) is first written as a Mitsuba 3
+scene by `volpt scene export` (into OUT/<name>-export/), so that both renderers read the very grids
+volpt assembles (after normalisation and transfer functions); volpt itself renders the original
+file. `--resolution N` becomes volpt's `--resolution NxN` for such scenes.
 """
 
 import argparse
@@ -73,8 +78,8 @@ class Mitsuba:
         return seconds, list(film.size())
 
 
-def volpt_render(volpt, scene, params, spp, seed, out, backend, threads):
-    cmd = [volpt, "render", scene, "-o", out, "--spp", str(spp), "--seed", str(seed)]
+def volpt_render(volpt, scene, params, spp, seed, out, backend, threads, extra):
+    cmd = [volpt, "render", scene, "-o", out, "--spp", str(spp), "--seed", str(seed)] + extra
     for k, v in params.items():
         cmd += ["-D", f"{k}={v}"]
     if backend != "cpu":
@@ -105,18 +110,41 @@ def used_params(xml_path, params):
     return {k: v for k, v in params.items() if "$" + k in text}
 
 
+def export(args, path, name, params, extra):
+    """`volpt scene export` of a non-XML scene; returns the Mitsuba 3 XML it wrote."""
+    out_dir = os.path.join(args.out, f"{name}-export")
+    cmd = [args.volpt, "scene", "export", path, "-o", out_dir, "--name", name] + extra
+    for k, v in params.items():
+        cmd += ["-D", f"{k}={v}"]
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    if p.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} failed:\n{p.stdout}\n{p.stderr}")
+    return os.path.join(out_dir, f"{name}.xml")
+
+
 def run_scene(args, mit, path):
     name = args.name or scene_name(path)
     params = dict(args.define)
-    # The -D values are needed already here: converting reads the grids the scene names.
-    _, _, declared = mi3scene.convert(path, dict(params))
-    for key, val in (("resolution", args.resolution),):
-        if val is not None:
-            if key not in declared:
-                raise ValueError(f"{path} declares no <default name=\"{key}\">: cannot override it")
-            params[key] = str(val)
-    xml, notes, _ = mi3scene.convert(path, params)
     os.makedirs(args.out, exist_ok=True)
+    extra = []  # volpt options that stand in for Mitsuba parameters
+    if path.endswith(".xml"):
+        # The -D values are needed already here: converting reads the grids the scene names.
+        _, _, declared = mi3scene.convert(path, dict(params))
+        for key, val in (("resolution", args.resolution),):
+            if val is not None:
+                if key not in declared:
+                    raise ValueError(f"{path} declares no <default name=\"{key}\">: cannot override it")
+                params[key] = str(val)
+        xml, notes, _ = mi3scene.convert(path, params)
+        volpt_params = params
+    else:
+        if args.resolution is not None:
+            extra = ["--resolution", f"{args.resolution}x{args.resolution}"]
+        exported = export(args, path, name, params, extra)
+        # The export has consumed the parameters (they named volpt's input files).
+        xml, notes, _ = mi3scene.convert(exported, {})
+        notes = [f"written as Mitsuba 3 by `volpt scene export` ({exported})"] + notes
+        volpt_params, params = params, {}
     xml_path = os.path.join(args.out, f"{name}-mi3.xml")
     with open(xml_path, "w") as f:
         f.write(xml)
@@ -125,7 +153,7 @@ def run_scene(args, mit, path):
         spp = int(mit.mi.load_file(xml_path, **used_params(xml_path, params))
                   .sensors()[0].sampler().sample_count())
     seeds = args.seeds
-    res = {"scene": path, "name": name, "spp": spp, "params": params, "notes": notes,
+    res = {"scene": path, "name": name, "spp": spp, "params": volpt_params, "volpt_options": extra, "notes": notes,
            "peer": {"renderer": "mitsuba " + mit.mi.__version__, "variant": mit.variant, "times_s": []},
            "volpt": {"backend": args.backend, "times_s": [], "wall_s": []},
            "machine": args.machine or f"{platform.node()} ({os.cpu_count()} cores)",
@@ -140,8 +168,8 @@ def run_scene(args, mit, path):
         print(f"[{name}] mitsuba {mit.variant} seed {s}: {t:.3f} s", flush=True)
     for s in seeds:
         out = os.path.join(args.out, f"{name}-volpt-s{s}.exr")
-        t, wall, variant, trunc, cmd = volpt_render(args.volpt, path, params, spp, s, out, args.backend,
-                                                   args.threads)
+        t, wall, variant, trunc, cmd = volpt_render(args.volpt, path, volpt_params, spp, s, out, args.backend,
+                                                   args.threads, extra)
         res["volpt"]["times_s"].append(t)
         res["volpt"]["wall_s"].append(wall)
         res["volpt"]["variant"] = variant

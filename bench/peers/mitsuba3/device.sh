@@ -7,7 +7,7 @@
 #   MODE=gpu bash bench/peers/mitsuba3/device.sh   # only the GPU rows; MODE=cpu only the CPU rows
 #
 # Settings: GPU_RES/GPU_SPP (default 400/100, the thesis settings), CPU_RES/CPU_SPP (default 100/64:
-# Mitsuba's LLVM backend is slow on these dense scenes), SCENES (names, default all five).
+# Mitsuba's LLVM backend is slow on these dense scenes), SCENES (names, default all seven).
 # Everything lands under $OUT/peers: results.md (one Markdown row per scene and device), <name>.json,
 # the EXR images, the Mitsuba 3 XML each scene was rendered from, and the logs.
 #
@@ -26,7 +26,7 @@ MODE=${MODE:-all}
 PEER_SITE=${PEER_SITE:-/tmp/volpt-peer-site}
 GPU_RES=${GPU_RES:-400}; GPU_SPP=${GPU_SPP:-100}
 CPU_RES=${CPU_RES:-100}; CPU_SPP=${CPU_SPP:-64}
-SCENES=${SCENES:-"homogeneous-cube homogeneous-cube-null cgg-logo ad smoke"}
+SCENES=${SCENES:-"homogeneous-cube homogeneous-cube-null cgg-logo ad smoke bucky envmap-cube"}
 log() { echo "== $*" | tee -a "$RES_DIR/device-summary.txt"; }
 
 # --- python 3.12 --------------------------------------------------------------------------------
@@ -83,6 +83,8 @@ scene_args() { # name -> file and -D parameters
         cgg-logo) echo "bundle/scenes/cgg-logo/scene.xml" ;;
         ad) echo "bundle/scenes/ad/scene.xml" ;;
         smoke) echo "bundle/scenes/smoke/scene.xml -D data=$DATA" ;;
+        bucky) echo "bundle/scenes/bucky/scene.toml -D data=$DATA" ;;
+        envmap-cube) echo "bundle/scenes/envmap-cube/scene.xml" ;;
         *) echo "" ;;
     esac
 }

@@ -1,4 +1,5 @@
-//! Mitsuba scene files (0.5/0.6 and 3 dialects) to a [`SceneDescription`].
+//! Mitsuba scene files (0.5/0.6 and 3 dialects) to a [`SceneDescription`], and back to Mitsuba 3
+//! ([`write_mitsuba3`]).
 //!
 //! volpt renders one kind of scene: a camera looking at a box-bounded participating medium under
 //! a constant or lat-long (`envmap`) environment. Whatever else a Mitsuba file says is either
@@ -12,6 +13,7 @@
 mod boxes;
 mod bsdf;
 mod emitter;
+mod export;
 mod integrator;
 pub(crate) mod ior;
 mod medium;
@@ -28,6 +30,7 @@ mod xml;
 
 use std::path::Path;
 
+pub use export::{write_mitsuba3, NO_ROULETTE_DEPTH};
 pub use ior::named_ior;
 
 use self::emitter::environment;

@@ -1,0 +1,266 @@
+//! A [`SceneDescription`] written out as a Mitsuba 3 scene: the XML, its grids as `.vol` files and
+//! its environment map as OpenEXR, beside each other in one directory.
+//!
+//! The written scene is the same estimator in Mitsuba 3's `volpath`, whatever source the description
+//! came from (a volpt TOML scene with a raw grid and a transfer function, a MetaImage or VTK file, a
+//! Mitsuba 0.6 scene): this is how those scenes are compared with Mitsuba 3 (`docs/peers.md`), and how
+//! a user takes a volume prepared by volpt to Mitsuba. What Mitsuba 3 spells differently:
+//! - **Grids** are placed by `to_world` on cell centres over `[0,1]^3`. A vertex-centred (Mitsuba
+//!   0.6) grid is written on its box grown by half a sample spacing `h = extent / (n - 1)` on every
+//!   side, which puts the cell centres on the 0.6 sample positions: inside the original box, the
+//!   only place the medium is looked up, the trilinear fields are identical.
+//! - **No Russian roulette** (`rr_depth` unset) is `rr_depth = 10^9`: Mitsuba 3 refuses values below
+//!   1, and no path of a finite render reaches that depth.
+//! - **Environment maps** are written with Mitsuba 3's row convention (rows from pole to pole). A
+//!   Mitsuba 0.6 map (cell-centred rows) would move by half a row, so it is refused rather than
+//!   silently changed.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use crate::description::{
+    AlbedoDesc, Bounds, BsdfDesc, DensityDesc, EnvironmentDesc, FovAxis, GridConvention, GridDesc,
+    LatLongRows, Matrix4, PhaseDesc, SceneDescription,
+};
+use crate::error::SceneError;
+use crate::vol::{write_vol, VolGrid};
+
+/// `rr_depth` for "no Russian roulette", which Mitsuba 3 cannot spell as -1.
+pub const NO_ROULETTE_DEPTH: u32 = 1_000_000_000;
+
+/// Writes `desc` as `dir/<name>.xml`, with `<name>-density.vol`, `<name>-albedo.vol` and
+/// `<name>-envmap.exr` beside it where the scene has grids or a map. Returns every path written,
+/// the XML first.
+pub fn write_mitsuba3(
+    desc: &SceneDescription,
+    dir: &Path,
+    name: &str,
+) -> Result<Vec<PathBuf>, SceneError> {
+    std::fs::create_dir_all(dir).map_err(|error| SceneError::Io {
+        path: dir.to_owned(),
+        error,
+    })?;
+    let xml_path = dir.join(format!("{name}.xml"));
+    let mut written = vec![xml_path.clone()];
+    let mut grid = |grid: &GridDesc, what: &str| -> Result<String, SceneError> {
+        let file = format!("{name}-{what}.vol");
+        let (bbox, to_world) = cell_centred_box(grid);
+        let path = dir.join(&file);
+        write_vol(
+            &path,
+            &VolGrid {
+                resolution: grid.resolution,
+                channels: grid.channels,
+                bbox,
+                data: grid.data.clone(),
+            },
+        )?;
+        written.push(path);
+        Ok(grid_volume(what_param(what), &file, &to_world))
+    };
+
+    let medium = &desc.medium;
+    let (medium_type, sigma_t) = match &medium.density {
+        DensityDesc::Constant(d) => (
+            "homogeneous",
+            format!("<float name=\"sigma_t\" value=\"{d}\"/>"),
+        ),
+        DensityDesc::Grid(g) => ("heterogeneous", grid(g, "density")?),
+    };
+    let albedo = match &medium.albedo {
+        AlbedoDesc::Constant(rgb) => rgb_element("albedo", rgb),
+        AlbedoDesc::Grid(g) => grid(g, "albedo")?,
+    };
+    let phase = match medium.phase {
+        PhaseDesc::Isotropic => "<phase type=\"isotropic\"/>".to_owned(),
+        PhaseDesc::HenyeyGreenstein { g } => {
+            format!("<phase type=\"hg\">\n                <float name=\"g\" value=\"{g}\"/>\n            </phase>")
+        }
+    };
+    let bsdf = match desc.boundary.bsdf {
+        BsdfDesc::Null => "<bsdf type=\"null\"/>".to_owned(),
+        BsdfDesc::Dielectric { int_ior, ext_ior } => format!(
+            "<bsdf type=\"dielectric\">\n            <float name=\"int_ior\" value=\"{int_ior}\"/>\n            \
+             <float name=\"ext_ior\" value=\"{ext_ior}\"/>\n        </bsdf>"
+        ),
+        BsdfDesc::RoughDielectric {
+            alpha,
+            int_ior,
+            ext_ior,
+        } => format!(
+            "<bsdf type=\"roughdielectric\">\n            <string name=\"distribution\" value=\"ggx\"/>\n            \
+             <float name=\"alpha\" value=\"{alpha}\"/>\n            <float name=\"int_ior\" value=\"{int_ior}\"/>\n            \
+             <float name=\"ext_ior\" value=\"{ext_ior}\"/>\n        </bsdf>"
+        ),
+    };
+    let emitter = match &desc.environment {
+        EnvironmentDesc::Constant(rgb) => format!(
+            "<emitter type=\"constant\">\n        {}\n    </emitter>",
+            rgb_element("radiance", rgb)
+        ),
+        EnvironmentDesc::LatLong(map) => {
+            if map.rows != LatLongRows::PoleToPole {
+                return Err(SceneError::Export {
+                    path: xml_path,
+                    reason:
+                        "the environment map has Mitsuba 0.6's cell-centred rows, which Mitsuba 3 \
+                             would read half a row apart; load the scene in Mitsuba 3 spelling"
+                            .into(),
+                });
+            }
+            let file = format!("{name}-envmap.exr");
+            let path = dir.join(&file);
+            write_exr(&path, map.width as usize, map.height as usize, &map.rgb)?;
+            written.push(path);
+            format!(
+                "<emitter type=\"envmap\">\n        <string name=\"filename\" value=\"{file}\"/>\n        \
+                 <float name=\"scale\" value=\"{}\"/>\n        {}\n    </emitter>",
+                map.scale,
+                matrix_transform(&map.to_world)
+            )
+        }
+    };
+    let depth = |d: Option<u32>, none: i64| d.map_or(none, i64::from);
+    let fov_axis = match desc.camera.fov_axis {
+        FovAxis::X => "x",
+        FovAxis::Y => "y",
+        FovAxis::Smaller => "smaller",
+        FovAxis::Larger => "larger",
+        FovAxis::Diagonal => "diagonal",
+    };
+    let b = desc.boundary.bounds;
+    let cube_to_world = box_transform(&b, [0.5; 3], [-1.0; 3]);
+
+    let mut xml = String::new();
+    let _ = write!(
+        xml,
+        r#"<?xml version="1.0" encoding="utf-8"?>
+<!-- Written by volpt (`volpt scene export`): the scene volpt renders, in Mitsuba 3 spelling. -->
+<scene version="3.0.0">
+    <integrator type="volpath">
+        <integer name="max_depth" value="{max_depth}"/>
+        <integer name="rr_depth" value="{rr_depth}"/>
+    </integrator>
+
+    <sensor type="perspective">
+        <float name="fov" value="{fov}"/>
+        <string name="fov_axis" value="{fov_axis}"/>
+        {camera}
+        <sampler type="independent">
+            <integer name="sample_count" value="{spp}"/>
+        </sampler>
+        <film type="hdrfilm">
+            <integer name="width" value="{width}"/>
+            <integer name="height" value="{height}"/>
+            <rfilter type="box"/>
+        </film>
+    </sensor>
+
+    {emitter}
+
+    <shape type="cube">
+        {cube}
+        {bsdf}
+        <medium type="{medium_type}" name="interior">
+            {sigma_t}
+            <float name="scale" value="{scale}"/>
+            {albedo}
+            {phase}
+        </medium>
+    </shape>
+</scene>
+"#,
+        max_depth = depth(desc.integrator.max_depth, -1),
+        rr_depth = depth(desc.integrator.rr_depth, i64::from(NO_ROULETTE_DEPTH)),
+        fov = desc.camera.fov_degrees,
+        camera = matrix_transform(&desc.camera.to_world),
+        spp = desc.spp,
+        width = desc.film.width,
+        height = desc.film.height,
+        cube = matrix_transform(&cube_to_world),
+        scale = medium.scale,
+    );
+    std::fs::write(&xml_path, xml).map_err(|error| SceneError::Io {
+        path: xml_path,
+        error,
+    })?;
+    Ok(written)
+}
+
+/// Mitsuba 3's parameter name of a grid.
+fn what_param(what: &str) -> &str {
+    match what {
+        "density" => "sigma_t",
+        other => other,
+    }
+}
+
+/// The box whose cells' centres are the grid's samples, and the transform that takes `[0,1]^3` to it.
+fn cell_centred_box(grid: &GridDesc) -> (Bounds, Matrix4) {
+    let b = grid.bounds;
+    let bounds = match grid.convention {
+        GridConvention::Cell => b,
+        GridConvention::Vertex => {
+            let mut grown = b;
+            for axis in 0..3 {
+                let extent = b.max[axis] - b.min[axis];
+                // One sample along an axis is constant along it: any cell around it will do.
+                let h = extent / (grid.resolution[axis].max(2) - 1) as f32;
+                grown.min[axis] = b.min[axis] - 0.5 * h;
+                grown.max[axis] = b.max[axis] + 0.5 * h;
+            }
+            grown
+        }
+    };
+    (bounds, box_transform(&bounds, [1.0; 3], [0.0; 3]))
+}
+
+/// The affine map taking a canonical box with corner `origin` and edge `1 / scale_per_unit` onto
+/// `b`: Mitsuba's cube `[-1,1]^3` is origin -1, scale 0.5; a grid's `[0,1]^3` is origin 0, scale 1.
+fn box_transform(b: &Bounds, scale_per_unit: [f32; 3], origin: [f32; 3]) -> Matrix4 {
+    let mut m = [[0.0; 4]; 4];
+    for axis in 0..3 {
+        let s = (b.max[axis] - b.min[axis]) * scale_per_unit[axis];
+        m[axis][axis] = s;
+        m[axis][3] = b.min[axis] - origin[axis] * s;
+    }
+    m[3][3] = 1.0;
+    m
+}
+
+fn matrix_transform(m: &Matrix4) -> String {
+    let values: Vec<String> = m.iter().flatten().map(|v| v.to_string()).collect();
+    format!(
+        "<transform name=\"to_world\">\n            <matrix value=\"{}\"/>\n        </transform>",
+        values.join(" ")
+    )
+}
+
+fn rgb_element(name: &str, rgb: &[f32; 3]) -> String {
+    format!(
+        "<rgb name=\"{name}\" value=\"{}, {}, {}\"/>",
+        rgb[0], rgb[1], rgb[2]
+    )
+}
+
+fn grid_volume(param: &str, file: &str, to_world: &Matrix4) -> String {
+    format!(
+        "<volume type=\"gridvolume\" name=\"{param}\">\n                <string name=\"filename\" value=\"{file}\"/>\n                \
+         <string name=\"filter_type\" value=\"trilinear\"/>\n                {}\n            </volume>",
+        matrix_transform(to_world).replace("\n        ", "\n                ")
+    )
+}
+
+fn write_exr(path: &Path, width: usize, height: usize, rgb: &[f32]) -> Result<(), SceneError> {
+    exr::prelude::write_rgb_file(path, width, height, |x, y| {
+        let i = 3 * (y * width + x);
+        (rgb[i], rgb[i + 1], rgb[i + 2])
+    })
+    .map_err(|e| SceneError::Io {
+        path: path.to_owned(),
+        error: match e {
+            exr::error::Error::Io(error) => error,
+            other => std::io::Error::other(other.to_string()),
+        },
+    })
+}
