@@ -6,8 +6,10 @@ warm-up render, and test whether the images agree statistically. See docs/peers.
       --resolution 100 --spp 64 --volpt target/release/volpt --out out/peers
 
 Per scene: two Mitsuba renders (seeds 1, 2; the first is the warm-up, which compiles and caches the
-kernels) and two volpt renders (seeds 1, 2; the first is the warm-up); the timed renders are the
-second ones. Mitsuba's time is `mi.render` plus evaluation and synchronisation of the image (scene
+kernels) and two volpt renders (seeds 1, 2; the first is the warm-up), whose images are compared;
+then `--timed N` - 1 more renders of each (seeds 3, 4, ...). The time reported is the median of the
+N renders after the warm-up: one render can include work the warm-up did not cache (a 1.7x outlier
+of Mitsuba's second render was seen once on the GPU), and a median of several is robust to that. Mitsuba's time is `mi.render` plus evaluation and synchronisation of the image (scene
 loading excluded); volpt's is the render time it prints (scene loading and EXR writing excluded;
 the process's wall time is recorded too). Writes OUT/<name>.json, OUT/<name>-{volpt,mi3}-s{1,2}.exr,
 OUT/<name>-mi3.xml (what Mitsuba rendered) and appends a row to OUT/results.md.
@@ -24,6 +26,7 @@ import json
 import os
 import platform
 import re
+import statistics
 import subprocess
 import sys
 import time
@@ -159,14 +162,18 @@ def run_scene(args, mit, path):
            "machine": args.machine or f"{platform.node()} ({os.cpu_count()} cores)",
            "date": args.date or datetime.date.today().isoformat()}
     peer_imgs, volpt_imgs = [], []
-    for s in seeds:
+    timing_seeds = list(range(max(seeds) + 1, max(seeds) + args.timed))
+    for s in seeds + timing_seeds:
         out = os.path.join(args.out, f"{name}-mi3-s{s}.exr")
         t, size = mit.render(xml_path, params, spp, s, out)
         res["peer"]["times_s"].append(t)
         res["resolution"] = size
-        peer_imgs.append(out)
+        if s in seeds:
+            peer_imgs.append(out)
+        else:
+            os.remove(out)
         print(f"[{name}] mitsuba {mit.variant} seed {s}: {t:.3f} s", flush=True)
-    for s in seeds:
+    for s in seeds + timing_seeds:
         out = os.path.join(args.out, f"{name}-volpt-s{s}.exr")
         t, wall, variant, trunc, cmd = volpt_render(args.volpt, path, volpt_params, spp, s, out, args.backend,
                                                    args.threads, extra)
@@ -175,7 +182,11 @@ def run_scene(args, mit, path):
         res["volpt"]["variant"] = variant
         res["volpt"]["truncated_paths"] = res["volpt"].get("truncated_paths", 0) + trunc
         res["volpt"]["command"] = cmd
-        volpt_imgs.append(out)
+        if s in seeds:
+            volpt_imgs.append(out)
+        else:
+            os.remove(out)
+            os.remove(os.path.splitext(out)[0] + ".png")
         print(f"[{name}] volpt {args.backend} seed {s}: {t:.3f} s (wall {wall:.3f} s)", flush=True)
     imgs = [read_exr(mit.mi, p) for p in volpt_imgs + peer_imgs]
     h, w = imgs[0][1], imgs[0][2]
@@ -183,8 +194,8 @@ def run_scene(args, mit, path):
         raise RuntimeError(f"image sizes differ: {[(i[1], i[2]) for i in imgs]}")
     agreement = stats.compare(*(i[0] for i in imgs), h, w, block=args.block)
     res["agreement"] = agreement
-    # Timed = the render after the warm-up.
-    tp, tv = res["peer"]["times_s"][-1], res["volpt"]["times_s"][-1]
+    # Timed = the renders after the warm-up.
+    tp, tv = (statistics.median(res[who]["times_s"][1:]) for who in ("peer", "volpt"))
     res["peer"]["time_s"], res["volpt"]["time_s"] = tp, tv
     res["speedup"] = tp / tv if tv > 0 else None
     with open(os.path.join(args.out, f"{name}.json"), "w") as f:
@@ -219,6 +230,8 @@ def main():
     ap.add_argument("-D", dest="define", action="append", default=[], type=lambda s: tuple(s.split("=", 1)),
                     metavar="NAME=VALUE", help="scene parameter for both renderers")
     ap.add_argument("--seeds", type=int, nargs=2, default=[1, 2], help="two seeds; the first render is the warm-up")
+    ap.add_argument("--timed", type=int, default=3,
+                    help="timed renders per renderer after the warm-up (median reported; at least 1)")
     ap.add_argument("--block", type=int, default=10, help="block size in pixels")
     ap.add_argument("--threads", type=int, help="volpt CPU threads (default: all)")
     ap.add_argument("--name", help="result name (one scene only)")
@@ -226,6 +239,8 @@ def main():
     ap.add_argument("--date", help="date for the table (default: today)")
     ap.add_argument("--out", default="out/peers")
     args = ap.parse_args()
+    if args.timed < 1:
+        ap.error("--timed must be at least 1")
     variant = args.variant or ("cuda_ad_rgb" if args.backend == "cuda" else "llvm_ad_rgb")
     mit = Mitsuba(variant)
     results, failed = [], 0
