@@ -3,10 +3,10 @@
 //! is bathed in.
 
 use volpt_core::path::{trace, PathState};
-use volpt_core::{Medium, PathSettings, Scene};
+use volpt_core::{PathSettings, Scene};
 use volpt_render::{with_scene, Image, SceneVisitor};
 use volpt_scene::description::*;
-use volpt_tests::{cube_scene, homogeneous, render_cpu, render_with};
+use volpt_tests::{camera_ray_transmittance, cube_scene, homogeneous, render_cpu, render_with};
 
 const SPP: u32 = 256;
 
@@ -30,23 +30,7 @@ impl SceneVisitor for ExpectedTransmittance {
             for x in 0..camera.width {
                 let (mut m, mut v) = (0.0f64, 0.0f64);
                 for s in 0..self.spp {
-                    let ray = PathState::from_camera(scene, x, y, s, self.seed).ray;
-                    let t = match scene.bounds().entry(&ray) {
-                        None => 1.0,
-                        Some(hit) => {
-                            let inner = volpt_core::Ray::new(hit.point, ray.dir);
-                            let exit = scene.bounds().exit(&inner);
-                            let n = 4000;
-                            let dt = exit.t / n as f32;
-                            let tau: f64 = (0..n)
-                                .map(|i| {
-                                    let p = inner.at((i as f32 + 0.5) * dt);
-                                    scene.medium().sigma_t(p) as f64 * dt as f64
-                                })
-                                .sum();
-                            (-tau).exp()
-                        }
-                    };
+                    let (_, t) = camera_ray_transmittance(scene, (x, y), s, self.seed, 4000);
                     m += t;
                     v += t * (1.0 - t);
                 }

@@ -3,12 +3,11 @@
 //! direction sees which texel (Mitsuba's uv convention, both row conventions).
 
 use volpt_core::launch::{FromParams, SceneParams, ToParams};
-use volpt_core::path::PathState;
-use volpt_core::{Environment, LatLongEnvironment, Medium, Scene, Vec3};
+use volpt_core::{Environment, LatLongEnvironment, Scene, Vec3};
 use volpt_render::factory::EnvironmentKind;
 use volpt_render::{with_scene, Image, SceneVisitor, Variant};
 use volpt_scene::description::*;
-use volpt_tests::{cube_scene, homogeneous, render_cpu};
+use volpt_tests::{camera_ray_transmittance, cube_scene, homogeneous, render_cpu};
 
 /// A `width` x `height` map whose texel `(x, y)` is `f(x, y)`.
 fn map(width: u32, height: u32, f: impl Fn(u32, u32) -> [f32; 3]) -> LatLongDesc {
@@ -95,23 +94,7 @@ impl SceneVisitor for ExpectedTransmittance {
             for x in 0..camera.width {
                 let (mut mean, mut var) = ([0.0f64; 3], [0.0f64; 3]);
                 for s in 0..self.spp {
-                    let ray = PathState::from_camera(scene, x, y, s, self.seed).ray;
-                    let t = match scene.bounds().entry(&ray) {
-                        None => 1.0,
-                        Some(hit) => {
-                            let inner = volpt_core::Ray::new(hit.point, ray.dir);
-                            let exit = scene.bounds().exit(&inner);
-                            let n = 2000;
-                            let dt = exit.t / n as f32;
-                            let tau: f64 = (0..n)
-                                .map(|i| {
-                                    let p = inner.at((i as f32 + 0.5) * dt);
-                                    scene.medium().sigma_t(p) as f64 * dt as f64
-                                })
-                                .sum();
-                            (-tau).exp()
-                        }
-                    };
+                    let (ray, t) = camera_ray_transmittance(scene, (x, y), s, self.seed, 2000);
                     let l = scene.background(ray.dir).to_array();
                     for c in 0..3 {
                         let l = l[c] as f64;
