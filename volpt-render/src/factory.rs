@@ -132,27 +132,13 @@ pub fn with_scene<V: SceneVisitor>(
     settings: PathSettings,
     visitor: V,
 ) -> V::Output {
-    let camera = camera(&desc.camera, &desc.film);
-    let bounds = aabb(&desc.boundary.bounds);
     match &desc.environment {
         EnvironmentDesc::Constant(rgb) => {
-            let environment = ConstantEnvironment(Spectrum::from_array(*rgb));
-            let parts = Parts {
-                camera,
-                bounds,
-                settings,
-                environment,
-            };
-            with_medium(desc, parts, visitor)
+            let constant = ConstantEnvironment(Spectrum::from_array(*rgb));
+            with_medium(desc, Parts::new(desc, settings, constant), visitor)
         }
         EnvironmentDesc::LatLong(map) => {
-            let parts = Parts {
-                camera,
-                bounds,
-                settings,
-                environment: lat_long(map),
-            };
-            with_medium(desc, parts, visitor)
+            with_medium(desc, Parts::new(desc, settings, lat_long(map)), visitor)
         }
     }
 }
@@ -236,6 +222,17 @@ struct Parts<E> {
     bounds: Aabb,
     settings: PathSettings,
     environment: E,
+}
+
+impl<E> Parts<E> {
+    fn new(desc: &SceneDescription, settings: PathSettings, environment: E) -> Self {
+        Self {
+            camera: camera(&desc.camera, &desc.film),
+            bounds: aabb(&desc.boundary.bounds),
+            settings,
+            environment,
+        }
+    }
 }
 
 fn with_boundary<E, M, V>(

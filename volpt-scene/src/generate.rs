@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 
 use crate::description::Bounds;
 use crate::error::SceneError;
+use crate::output::{create_dir, write_rgb_exr};
 use crate::vol::{write_vol, VolGrid};
 
 /// One printed block: its voxel resolution, the text printed on it and how deep the ink goes.
@@ -125,10 +126,7 @@ impl PrintedBlock {
 
     /// Writes `density.vol` and `albedo.vol` into `dir`, returning their paths.
     pub fn write(&self, dir: &Path, bounds: Bounds) -> Result<[PathBuf; 2], SceneError> {
-        std::fs::create_dir_all(dir).map_err(|error| SceneError::Io {
-            path: dir.to_owned(),
-            error,
-        })?;
+        create_dir(dir)?;
         let (density, albedo) = self.grids(bounds);
         let paths = [dir.join("density.vol"), dir.join("albedo.vol")];
         write_vol(&paths[0], &density)?;
@@ -218,30 +216,17 @@ impl Sky {
     /// Writes `sky.exr` (half-float RGB) into `dir`, returning its path.
     pub fn write(&self, dir: &Path) -> Result<PathBuf, SceneError> {
         use exr::prelude::f16;
-        std::fs::create_dir_all(dir).map_err(|error| SceneError::Io {
-            path: dir.to_owned(),
-            error,
-        })?;
+        create_dir(dir)?;
         let path = dir.join("sky.exr");
         let rgb = self.texels();
         let width = self.width as usize;
-        exr::prelude::write_rgb_file(&path, width, self.height as usize, |x, y| {
+        write_rgb_exr(&path, width, self.height as usize, |x, y| {
             let i = 3 * (y * width + x);
             (
                 f16::from_f32(rgb[i]),
                 f16::from_f32(rgb[i + 1]),
                 f16::from_f32(rgb[i + 2]),
             )
-        })
-        .map_err(|e| match e {
-            exr::error::Error::Io(error) => SceneError::Io {
-                path: path.clone(),
-                error,
-            },
-            other => SceneError::Io {
-                path: path.clone(),
-                error: std::io::Error::other(other.to_string()),
-            },
         })?;
         Ok(path)
     }

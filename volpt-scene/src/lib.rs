@@ -22,6 +22,7 @@ pub mod generate;
 pub mod metaimage;
 pub mod mitsuba;
 pub mod normalise;
+mod output;
 pub mod raw;
 pub mod toml_scene;
 pub mod transfer;

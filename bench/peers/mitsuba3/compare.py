@@ -9,7 +9,8 @@ Per scene: two Mitsuba renders (seeds 1, 2; the first is the warm-up, which comp
 kernels) and two volpt renders (seeds 1, 2; the first is the warm-up), whose images are compared;
 then `--timed N` - 1 more renders of each (seeds 3, 4, ...). The time reported is the median of the
 N renders after the warm-up: one render can include work the warm-up did not cache (a 1.7x outlier
-of Mitsuba's second render was seen once on the GPU), and a median of several is robust to that. Mitsuba's time is `mi.render` plus evaluation and synchronisation of the image (scene
+of Mitsuba's second render was seen once on the GPU), and a median of several is robust to that.
+Mitsuba's time is `mi.render` plus evaluation and synchronisation of the image (scene
 loading excluded); volpt's is the render time it prints (scene loading and EXR writing excluded;
 the process's wall time is recorded too). Writes OUT/<name>.json, OUT/<name>-{volpt,mi3}-s{1,2}.exr,
 OUT/<name>-mi3.xml (what Mitsuba rendered) and appends a row to OUT/results.md.

@@ -23,6 +23,7 @@ use crate::description::{
     LatLongRows, Matrix4, PhaseDesc, SceneDescription,
 };
 use crate::error::SceneError;
+use crate::output::{create_dir, write_rgb_exr};
 use crate::vol::{write_vol, VolGrid};
 
 /// `rr_depth` for "no Russian roulette", which Mitsuba 3 cannot spell as -1.
@@ -36,13 +37,11 @@ pub fn write_mitsuba3(
     dir: &Path,
     name: &str,
 ) -> Result<Vec<PathBuf>, SceneError> {
-    std::fs::create_dir_all(dir).map_err(|error| SceneError::Io {
-        path: dir.to_owned(),
-        error,
-    })?;
+    create_dir(dir)?;
     let xml_path = dir.join(format!("{name}.xml"));
     let mut written = vec![xml_path.clone()];
-    let mut grid = |grid: &GridDesc, what: &str| -> Result<String, SceneError> {
+    // Writes `<name>-<what>.vol` and returns the `gridvolume` that reads it as Mitsuba's `param`.
+    let mut grid = |grid: &GridDesc, what: &str, param: &str| -> Result<String, SceneError> {
         let file = format!("{name}-{what}.vol");
         let (bbox, to_world) = cell_centred_box(grid);
         let path = dir.join(&file);
@@ -56,7 +55,7 @@ pub fn write_mitsuba3(
             },
         )?;
         written.push(path);
-        Ok(grid_volume(what_param(what), &file, &to_world))
+        Ok(grid_volume(param, &file, &to_world))
     };
 
     let medium = &desc.medium;
@@ -65,11 +64,11 @@ pub fn write_mitsuba3(
             "homogeneous",
             format!("<float name=\"sigma_t\" value=\"{d}\"/>"),
         ),
-        DensityDesc::Grid(g) => ("heterogeneous", grid(g, "density")?),
+        DensityDesc::Grid(g) => ("heterogeneous", grid(g, "density", "sigma_t")?),
     };
     let albedo = match &medium.albedo {
         AlbedoDesc::Constant(rgb) => rgb_element("albedo", rgb),
-        AlbedoDesc::Grid(g) => grid(g, "albedo")?,
+        AlbedoDesc::Grid(g) => grid(g, "albedo", "albedo")?,
     };
     let phase = match medium.phase {
         PhaseDesc::Isotropic => "<phase type=\"isotropic\"/>".to_owned(),
@@ -110,13 +109,17 @@ pub fn write_mitsuba3(
             }
             let file = format!("{name}-envmap.exr");
             let path = dir.join(&file);
-            write_exr(&path, map.width as usize, map.height as usize, &map.rgb)?;
+            let width = map.width as usize;
+            write_rgb_exr(&path, width, map.height as usize, |x, y| {
+                let i = 3 * (y * width + x);
+                (map.rgb[i], map.rgb[i + 1], map.rgb[i + 2])
+            })?;
             written.push(path);
             format!(
                 "<emitter type=\"envmap\">\n        <string name=\"filename\" value=\"{file}\"/>\n        \
                  <float name=\"scale\" value=\"{}\"/>\n        {}\n    </emitter>",
                 map.scale,
-                matrix_transform(&map.to_world)
+                matrix_transform(&map.to_world, "        ")
             )
         }
     };
@@ -129,7 +132,12 @@ pub fn write_mitsuba3(
         FovAxis::Diagonal => "diagonal",
     };
     let b = desc.boundary.bounds;
-    let cube_to_world = box_transform(&b, [0.5; 3], [-1.0; 3]);
+    // Mitsuba's `cube` is [-1,1]^3.
+    let cube = Bounds {
+        min: [-1.0; 3],
+        max: [1.0; 3],
+    };
+    let cube_to_world = box_transform(&cube, &b);
 
     let mut xml = String::new();
     let _ = write!(
@@ -173,11 +181,11 @@ pub fn write_mitsuba3(
         max_depth = depth(desc.integrator.max_depth, -1),
         rr_depth = depth(desc.integrator.rr_depth, i64::from(NO_ROULETTE_DEPTH)),
         fov = desc.camera.fov_degrees,
-        camera = matrix_transform(&desc.camera.to_world),
+        camera = matrix_transform(&desc.camera.to_world, "        "),
         spp = desc.spp,
         width = desc.film.width,
         height = desc.film.height,
-        cube = matrix_transform(&cube_to_world),
+        cube = matrix_transform(&cube_to_world, "        "),
         scale = medium.scale,
     );
     std::fs::write(&xml_path, xml).map_err(|error| SceneError::Io {
@@ -185,14 +193,6 @@ pub fn write_mitsuba3(
         error,
     })?;
     Ok(written)
-}
-
-/// Mitsuba 3's parameter name of a grid.
-fn what_param(what: &str) -> &str {
-    match what {
-        "density" => "sigma_t",
-        other => other,
-    }
 }
 
 /// The box whose cells' centres are the grid's samples, and the transform that takes `[0,1]^3` to it.
@@ -212,26 +212,31 @@ fn cell_centred_box(grid: &GridDesc) -> (Bounds, Matrix4) {
             grown
         }
     };
-    (bounds, box_transform(&bounds, [1.0; 3], [0.0; 3]))
+    let unit = Bounds {
+        min: [0.0; 3],
+        max: [1.0; 3],
+    };
+    (bounds, box_transform(&unit, &bounds))
 }
 
-/// The affine map taking a canonical box with corner `origin` and edge `1 / scale_per_unit` onto
-/// `b`: Mitsuba's cube `[-1,1]^3` is origin -1, scale 0.5; a grid's `[0,1]^3` is origin 0, scale 1.
-fn box_transform(b: &Bounds, scale_per_unit: [f32; 3], origin: [f32; 3]) -> Matrix4 {
+/// The axis-aligned affine map taking the box `from` onto the box `to`.
+fn box_transform(from: &Bounds, to: &Bounds) -> Matrix4 {
     let mut m = [[0.0; 4]; 4];
-    for axis in 0..3 {
-        let s = (b.max[axis] - b.min[axis]) * scale_per_unit[axis];
-        m[axis][axis] = s;
-        m[axis][3] = b.min[axis] - origin[axis] * s;
+    for (axis, row) in m.iter_mut().take(3).enumerate() {
+        let s = (to.max[axis] - to.min[axis]) / (from.max[axis] - from.min[axis]);
+        row[axis] = s;
+        row[3] = to.min[axis] - from.min[axis] * s;
     }
     m[3][3] = 1.0;
     m
 }
 
-fn matrix_transform(m: &Matrix4) -> String {
+/// `<transform name="to_world">` holding `m`, for an element whose children are indented by
+/// `indent`.
+fn matrix_transform(m: &Matrix4, indent: &str) -> String {
     let values: Vec<String> = m.iter().flatten().map(|v| v.to_string()).collect();
     format!(
-        "<transform name=\"to_world\">\n            <matrix value=\"{}\"/>\n        </transform>",
+        "<transform name=\"to_world\">\n{indent}    <matrix value=\"{}\"/>\n{indent}</transform>",
         values.join(" ")
     )
 }
@@ -247,20 +252,6 @@ fn grid_volume(param: &str, file: &str, to_world: &Matrix4) -> String {
     format!(
         "<volume type=\"gridvolume\" name=\"{param}\">\n                <string name=\"filename\" value=\"{file}\"/>\n                \
          <string name=\"filter_type\" value=\"trilinear\"/>\n                {}\n            </volume>",
-        matrix_transform(to_world).replace("\n        ", "\n                ")
+        matrix_transform(to_world, "                ")
     )
-}
-
-fn write_exr(path: &Path, width: usize, height: usize, rgb: &[f32]) -> Result<(), SceneError> {
-    exr::prelude::write_rgb_file(path, width, height, |x, y| {
-        let i = 3 * (y * width + x);
-        (rgb[i], rgb[i + 1], rgb[i + 2])
-    })
-    .map_err(|e| SceneError::Io {
-        path: path.to_owned(),
-        error: match e {
-            exr::error::Error::Io(error) => error,
-            other => std::io::Error::other(other.to_string()),
-        },
-    })
 }
