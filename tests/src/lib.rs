@@ -70,7 +70,7 @@ struct Cpu(RenderOptions);
 
 impl SceneVisitor for Cpu {
     type Output = (Image, RenderStats);
-    fn visit<S: Scene + Sync + volpt_core::launch::ToParams>(self, scene: &S) -> Self::Output {
+    fn visit<S: volpt_render::RenderScene>(self, scene: &S) -> Self::Output {
         render(scene, &self.0, &|_, _| {}).expect("render")
     }
 }

@@ -3,7 +3,7 @@
 //! is bathed in.
 
 use volpt_core::path::{trace, PathState};
-use volpt_core::{PathSettings, Scene};
+use volpt_core::PathSettings;
 use volpt_render::{with_scene, Image, SceneVisitor};
 use volpt_scene::description::*;
 use volpt_tests::{camera_ray_transmittance, cube_scene, homogeneous, render_cpu, render_with};
@@ -23,7 +23,7 @@ struct ExpectedTransmittance {
 impl SceneVisitor for ExpectedTransmittance {
     type Output = (Vec<f64>, Vec<f64>);
 
-    fn visit<S: Scene + Sync + volpt_core::launch::ToParams>(self, scene: &S) -> Self::Output {
+    fn visit<S: volpt_render::RenderScene>(self, scene: &S) -> Self::Output {
         let camera = scene.camera();
         let (mut mean, mut var) = (Vec::new(), Vec::new());
         for y in 0..camera.height {
@@ -262,7 +262,7 @@ struct FurnaceSampleMean {
 
 impl SceneVisitor for FurnaceSampleMean {
     type Output = (f64, f64, u64);
-    fn visit<S: Scene + Sync + volpt_core::launch::ToParams>(self, scene: &S) -> Self::Output {
+    fn visit<S: volpt_render::RenderScene>(self, scene: &S) -> Self::Output {
         let (mut sum, mut sum2, mut killed) = (0.0, 0.0, 0);
         for s in 0..self.paths {
             let mut path = PathState::from_camera(scene, 8, 8, s, 9);

@@ -2,8 +2,8 @@
 //! the map seen along each camera ray, white furnaces in a map of constant radiance, and which
 //! direction sees which texel (Mitsuba's uv convention, both row conventions).
 
-use volpt_core::launch::{FromParams, SceneParams, ToParams};
-use volpt_core::{Environment, LatLongEnvironment, Scene, Vec3};
+use volpt_core::Component;
+use volpt_core::{Environment, LatLongEnvironment, Vec3};
 use volpt_render::factory::EnvironmentKind;
 use volpt_render::{with_scene, Image, SceneVisitor, Variant};
 use volpt_scene::description::*;
@@ -87,7 +87,7 @@ struct ExpectedTransmittance {
 impl SceneVisitor for ExpectedTransmittance {
     type Output = Vec<([f64; 3], [f64; 3])>;
 
-    fn visit<S: Scene + Sync + ToParams>(self, scene: &S) -> Self::Output {
+    fn visit<S: volpt_render::RenderScene>(self, scene: &S) -> Self::Output {
         let camera = scene.camera();
         let mut out = Vec::new();
         for y in 0..camera.height {
@@ -341,9 +341,8 @@ fn launch_parameters_carry_the_map() {
         to_map,
         1.5,
     );
-    let mut params = SceneParams::default();
     let mut uploads = 0;
-    env.to_params(&mut params, &mut |values| {
+    let params = env.to_params(&mut |values| {
         uploads += 1;
         values.as_ptr() as u64
     });

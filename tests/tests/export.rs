@@ -5,8 +5,7 @@
 
 use std::path::Path;
 
-use volpt_core::launch::ToParams;
-use volpt_core::{Medium, Scene, Vec3};
+use volpt_core::{Medium, Vec3};
 use volpt_render::SceneVisitor;
 use volpt_scene::description::*;
 use volpt_scene::mitsuba::{write_mitsuba3, NO_ROULETTE_DEPTH};
@@ -139,7 +138,7 @@ struct Probe(Vec<Vec3>);
 
 impl SceneVisitor for Probe {
     type Output = Vec<(f32, [f32; 3])>;
-    fn visit<S: Scene + Sync + ToParams>(self, scene: &S) -> Self::Output {
+    fn visit<S: volpt_render::RenderScene>(self, scene: &S) -> Self::Output {
         self.0
             .iter()
             .map(|&p| {

@@ -5,10 +5,11 @@ use std::time::Duration;
 use anyhow::Result;
 use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressStyle};
-use volpt_core::launch::ToParams;
-use volpt_core::{PathSettings, Scene};
+use volpt_core::PathSettings;
 use volpt_cuda::{CudaRenderer, Strategy};
-use volpt_render::{render, with_scene, Image, RenderOptions, RenderStats, SceneVisitor, Variant};
+use volpt_render::{
+    render, with_scene, Image, RenderOptions, RenderScene, RenderStats, SceneVisitor,
+};
 use volpt_scene::SceneDescription;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -38,7 +39,7 @@ pub enum Backend {
 
 impl Backend {
     /// Opens `kind`; `strategy` is the GPU scheduling strategy (regeneration-sk by default).
-    pub fn open(kind: BackendKind, strategy: Option<&str>) -> Result<Self> {
+    pub fn open(kind: BackendKind, strategy: Option<Strategy>) -> Result<Self> {
         match kind {
             BackendKind::Cpu => {
                 if let Some(strategy) = strategy {
@@ -49,16 +50,10 @@ impl Backend {
                 }
                 Ok(Backend::Cpu)
             }
-            BackendKind::Cuda => {
-                let strategy = match strategy {
-                    Some(name) => name.parse()?,
-                    None => Strategy::RegenerationSk,
-                };
-                Ok(Backend::Cuda {
-                    renderer: CudaRenderer::new(0)?,
-                    strategy,
-                })
-            }
+            BackendKind::Cuda => Ok(Backend::Cuda {
+                renderer: CudaRenderer::new(0)?,
+                strategy: strategy.unwrap_or(Strategy::RegenerationSk),
+            }),
         }
     }
 
@@ -83,7 +78,6 @@ impl Backend {
     pub fn render(&self, job: &RenderJob) -> Result<(Image, RenderStats)> {
         let visitor = Render {
             backend: self,
-            variant: Variant::of(job.desc),
             options: job.options,
             progress: progress_bar(job.show_progress),
         };
@@ -93,7 +87,6 @@ impl Backend {
 
 struct Render<'a> {
     backend: &'a Backend,
-    variant: Variant,
     options: RenderOptions,
     progress: ProgressBar,
 }
@@ -101,7 +94,7 @@ struct Render<'a> {
 impl SceneVisitor for Render<'_> {
     type Output = Result<(Image, RenderStats)>;
 
-    fn visit<S: Scene + Sync + ToParams>(self, scene: &S) -> Self::Output {
+    fn visit<S: RenderScene>(self, scene: &S) -> Self::Output {
         let bar = &self.progress;
         let report = |done, total| {
             bar.set_length(total);
@@ -109,13 +102,9 @@ impl SceneVisitor for Render<'_> {
         };
         let result = match self.backend {
             Backend::Cpu => render(scene, &self.options, &report)?,
-            Backend::Cuda { renderer, strategy } => renderer.render(
-                scene,
-                &self.variant.to_string(),
-                *strategy,
-                &self.options,
-                &report,
-            )?,
+            Backend::Cuda { renderer, strategy } => {
+                renderer.render(scene, *strategy, &self.options, &report)?
+            }
         };
         bar.finish_and_clear();
         Ok(result)

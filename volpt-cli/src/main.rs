@@ -15,6 +15,7 @@ use volpt_render::{path_settings, Image, RenderOptions, RenderStats, Variant};
 use volpt_scene::{Config, SceneAssembler, SceneDescription};
 
 use backend::{Backend, BackendKind, RenderJob};
+use volpt_cuda::Strategy;
 
 #[derive(Parser)]
 #[command(
@@ -111,9 +112,9 @@ struct SamplingArgs {
     /// Where to render.
     #[arg(long, value_enum, default_value_t = BackendKind::Cpu)]
     backend: BackendKind,
-    /// GPU scheduling strategy: naive-sk or regeneration-sk (default).
-    #[arg(long)]
-    strategy: Option<String>,
+    /// GPU scheduling strategy (default: regeneration-sk).
+    #[arg(long, value_enum)]
+    strategy: Option<Strategy>,
 }
 
 #[derive(Args)]
@@ -236,7 +237,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
         options: options(&desc, &args.sampling)?,
         show_progress: true,
     };
-    let backend = Backend::open(args.sampling.backend, args.sampling.strategy.as_deref())?;
+    let backend = Backend::open(args.sampling.backend, args.sampling.strategy)?;
     let variant = Variant::of(&desc);
     tracing::info!(
         scene = %args.scene.scene.display(),
@@ -294,7 +295,7 @@ fn bench_command(args: BenchArgs) -> Result<()> {
         options: options(&desc, &args.sampling)?,
         show_progress: false,
     };
-    let backend = Backend::open(args.sampling.backend, args.sampling.strategy.as_deref())?;
+    let backend = Backend::open(args.sampling.backend, args.sampling.strategy)?;
     let mut trials = Vec::with_capacity(args.trials);
     let mut last = None;
     for trial in 0..=args.trials {

@@ -4,6 +4,9 @@
 //! it reaches the boundary, from either side. The sample is the new propagation direction. `eta` is
 //! `n_inside / n_outside`.
 
+use bytemuck::{Pod, Zeroable};
+
+use crate::abi::{Component, NoParams, Upload};
 use crate::frame::Frame;
 use crate::fresnel::fresnel_dielectric_cos;
 use crate::microfacet::Ggx;
@@ -133,4 +136,60 @@ fn scatter_off_microfacet(
         transmitted: !reflected,
         eta: relative_eta,
     })
+}
+
+impl Component for NullBoundary {
+    const NAME: &'static str = "index_matched";
+    type Params = NoParams;
+
+    fn to_params(&self, _upload: &mut Upload<'_>) {}
+    #[inline]
+    unsafe fn from_params(_p: &NoParams) -> Self {
+        NullBoundary
+    }
+}
+
+/// Device parameters of a dielectric boundary; `alpha` is read by the rough one only.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct DielectricParams {
+    /// `n_inside / n_outside`.
+    pub eta: f32,
+    /// GGX roughness.
+    pub alpha: f32,
+}
+
+impl Component for SmoothDielectric {
+    const NAME: &'static str = "smooth_dielectric";
+    type Params = DielectricParams;
+
+    fn to_params(&self, _upload: &mut Upload<'_>) -> DielectricParams {
+        DielectricParams {
+            eta: self.eta,
+            alpha: 0.0,
+        }
+    }
+    #[inline]
+    unsafe fn from_params(p: &DielectricParams) -> Self {
+        Self { eta: p.eta }
+    }
+}
+
+impl Component for RoughDielectric {
+    const NAME: &'static str = "rough_dielectric";
+    type Params = DielectricParams;
+
+    fn to_params(&self, _upload: &mut Upload<'_>) -> DielectricParams {
+        DielectricParams {
+            eta: self.eta,
+            alpha: self.distribution.alpha,
+        }
+    }
+    #[inline]
+    unsafe fn from_params(p: &DielectricParams) -> Self {
+        Self {
+            eta: p.eta,
+            distribution: Ggx { alpha: p.alpha },
+        }
+    }
 }

@@ -1,5 +1,8 @@
 //! Light arriving from infinitely far away.
 
+use bytemuck::{Pod, Zeroable};
+
+use crate::abi::{Component, Upload};
 use crate::math::{clamp, INV_PI};
 use crate::{Spectrum, Vec3};
 
@@ -113,5 +116,77 @@ impl Environment for LatLongEnvironment<'_> {
         let top = self.texel(x0, y0) * (1.0 - fx) + self.texel(x1, y0) * fx;
         let bottom = self.texel(x0, y1) * (1.0 - fx) + self.texel(x1, y1) * fx;
         (top * (1.0 - fy) + bottom * fy) * self.scale
+    }
+}
+
+/// Device parameters of a constant environment, padded to a multiple of 8 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ConstantEnvironmentParams {
+    pub radiance: [f32; 3],
+    pub padding: u32,
+}
+
+impl Component for ConstantEnvironment {
+    const NAME: &'static str = "constant";
+    type Params = ConstantEnvironmentParams;
+
+    fn to_params(&self, _upload: &mut Upload<'_>) -> ConstantEnvironmentParams {
+        ConstantEnvironmentParams {
+            radiance: self.0.to_array(),
+            padding: 0,
+        }
+    }
+    #[inline]
+    unsafe fn from_params(p: &ConstantEnvironmentParams) -> Self {
+        ConstantEnvironment(Spectrum::from_array(p.radiance))
+    }
+}
+
+/// Device parameters of a lat-long map: its texels' address and every number [`LatLongEnvironment`]
+/// holds.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct LatLongParams {
+    /// Device address of the map's `len` RGB `f32` values.
+    pub texels: u64,
+    pub len: u64,
+    /// Rows of the world-to-map rotation.
+    pub world_to_map: [[f32; 3]; 3],
+    pub scale: f32,
+    pub width: u32,
+    pub height: u32,
+    pub row_scale: f32,
+    pub row_offset: f32,
+}
+
+impl Component for LatLongEnvironment<'_> {
+    const NAME: &'static str = "lat_long";
+    type Params = LatLongParams;
+
+    fn to_params(&self, upload: &mut Upload<'_>) -> LatLongParams {
+        LatLongParams {
+            texels: upload(self.rgb),
+            len: self.rgb.len() as u64,
+            world_to_map: self.world_to_map.map(|row| row.to_array()),
+            scale: self.scale,
+            width: self.width,
+            height: self.height,
+            row_scale: self.row_scale,
+            row_offset: self.row_offset,
+        }
+    }
+    #[inline]
+    unsafe fn from_params(p: &LatLongParams) -> Self {
+        Self {
+            // SAFETY: the caller guarantees the address range.
+            rgb: unsafe { core::slice::from_raw_parts(p.texels as *const f32, p.len as usize) },
+            width: p.width,
+            height: p.height,
+            world_to_map: p.world_to_map.map(Vec3::from_array),
+            scale: p.scale,
+            row_scale: p.row_scale,
+            row_offset: p.row_offset,
+        }
     }
 }

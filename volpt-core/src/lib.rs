@@ -1,11 +1,14 @@
 //! volpt's physics, generic over the scene's parts and free of `std`, so that the same source is
 //! monomorphised into the CPU renderer and into GPU kernels.
 //!
-//! Read [`path`] first: one step of a volumetric path, the algorithm every backend runs.
+//! Read [`path`] first: one step of a volumetric path, the algorithm every backend runs. Then
+//! [`variant`], the registry of scene parts every backend is instantiated for, and [`abi`], how a
+//! scene travels to a GPU kernel.
 #![no_std]
 // Inline PTX for exact hardware instructions (math::sqrt); nvptx builds already need nightly features.
 #![cfg_attr(target_arch = "nvptx64", feature(asm_experimental_arch))]
 
+pub mod abi;
 pub mod bsdf;
 pub mod camera;
 pub mod environment;
@@ -13,7 +16,6 @@ pub mod frame;
 pub mod fresnel;
 pub mod geometry;
 pub mod grid;
-pub mod launch;
 pub mod math;
 pub mod medium;
 pub mod microfacet;
@@ -23,7 +25,9 @@ pub mod rng;
 pub mod sampling;
 pub mod scene;
 pub mod tracking;
+pub mod variant;
 
+pub use abi::{Component, SceneAbi};
 pub use bsdf::{Bsdf, BsdfSample, NullBoundary, RoughDielectric, SmoothDielectric};
 pub use camera::PerspectiveCamera;
 pub use environment::{ConstantEnvironment, Environment, LatLongEnvironment, LatLongRows};

@@ -3,6 +3,9 @@
 //! Extinction is grey (one `sigma_t` for all channels); albedo is RGB. Delta tracking then needs one
 //! majorant and no spectral MIS, and coloured albedo only scales the path throughput.
 
+use bytemuck::{Pod, Zeroable};
+
+use crate::abi::{Component, GridParams, Upload};
 use crate::grid::Grid;
 use crate::{Spectrum, Vec3};
 
@@ -43,6 +46,9 @@ impl Medium for HomogeneousMedium {
 
 /// Where a grid medium's albedo comes from: a constant never reads memory.
 pub trait AlbedoField {
+    /// The name of a [`GridMedium`] with this albedo, in kernel entry points.
+    const GRID_MEDIUM_NAME: &'static str;
+
     fn albedo(&self, p: Vec3) -> Spectrum;
 }
 
@@ -50,6 +56,8 @@ pub trait AlbedoField {
 pub struct ConstantAlbedo(pub Spectrum);
 
 impl AlbedoField for ConstantAlbedo {
+    const GRID_MEDIUM_NAME: &'static str = "grid_density";
+
     #[inline]
     fn albedo(&self, _p: Vec3) -> Spectrum {
         self.0
@@ -60,6 +68,8 @@ impl AlbedoField for ConstantAlbedo {
 pub struct GridAlbedo<'a>(pub Grid<'a, 3>);
 
 impl AlbedoField for GridAlbedo<'_> {
+    const GRID_MEDIUM_NAME: &'static str = "grid_density_albedo";
+
     #[inline]
     fn albedo(&self, p: Vec3) -> Spectrum {
         Spectrum::from_array(self.0.lookup(p))
@@ -92,5 +102,121 @@ impl<A: AlbedoField> Medium for GridMedium<'_, A> {
     #[inline]
     fn albedo(&self, p: Vec3) -> Spectrum {
         self.albedo.albedo(p)
+    }
+}
+
+/// Device parameters of a homogeneous medium.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct HomogeneousParams {
+    pub sigma_t: f32,
+    pub albedo: [f32; 3],
+}
+
+impl Component for HomogeneousMedium {
+    const NAME: &'static str = "homogeneous";
+    type Params = HomogeneousParams;
+
+    fn to_params(&self, _upload: &mut Upload<'_>) -> HomogeneousParams {
+        HomogeneousParams {
+            sigma_t: self.sigma_t,
+            albedo: self.albedo.to_array(),
+        }
+    }
+    #[inline]
+    unsafe fn from_params(p: &HomogeneousParams) -> Self {
+        Self {
+            sigma_t: p.sigma_t,
+            albedo: Spectrum::from_array(p.albedo),
+        }
+    }
+}
+
+/// Device parameters of a constant albedo, padded to a multiple of 8 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ConstantAlbedoParams {
+    pub albedo: [f32; 3],
+    pub padding: u32,
+}
+
+impl Component for ConstantAlbedo {
+    const NAME: &'static str = "constant";
+    type Params = ConstantAlbedoParams;
+
+    fn to_params(&self, _upload: &mut Upload<'_>) -> ConstantAlbedoParams {
+        ConstantAlbedoParams {
+            albedo: self.0.to_array(),
+            padding: 0,
+        }
+    }
+    #[inline]
+    unsafe fn from_params(p: &ConstantAlbedoParams) -> Self {
+        Self(Spectrum::from_array(p.albedo))
+    }
+}
+
+impl Component for GridAlbedo<'_> {
+    const NAME: &'static str = "grid";
+    type Params = GridParams;
+
+    fn to_params(&self, upload: &mut Upload<'_>) -> GridParams {
+        GridParams::new(&self.0, upload)
+    }
+    #[inline]
+    unsafe fn from_params(p: &GridParams) -> Self {
+        // SAFETY: forwarded to the caller.
+        Self(unsafe { p.grid::<3>() })
+    }
+}
+
+/// Device parameters of a grid medium with albedo parameters `A`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GridMediumParams<A> {
+    pub density: GridParams,
+    pub scale: f32,
+    pub majorant: f32,
+    pub albedo: A,
+}
+
+impl<A: Pod> GridMediumParams<A> {
+    /// `GridParams` and the two scalars are 88 bytes; an albedo of a multiple of 8 bytes follows
+    /// without padding.
+    const LAYOUT: () = assert!(
+        core::mem::size_of::<A>().is_multiple_of(8)
+            && core::mem::size_of::<Self>() == 88 + core::mem::size_of::<A>()
+    );
+}
+
+// SAFETY: `repr(C)` of `Pod` fields without padding, as `LAYOUT` (evaluated in `to_params`) proves.
+unsafe impl<A: Pod> Zeroable for GridMediumParams<A> {}
+// SAFETY: as above.
+unsafe impl<A: Pod> Pod for GridMediumParams<A> {}
+
+impl<A: AlbedoField + Component> Component for GridMedium<'_, A> {
+    const NAME: &'static str = A::GRID_MEDIUM_NAME;
+    type Params = GridMediumParams<A::Params>;
+
+    fn to_params(&self, upload: &mut Upload<'_>) -> Self::Params {
+        #[allow(clippy::let_unit_value)]
+        let () = GridMediumParams::<A::Params>::LAYOUT;
+        GridMediumParams {
+            density: GridParams::new(&self.density, upload),
+            scale: self.scale,
+            majorant: self.majorant,
+            albedo: self.albedo.to_params(upload),
+        }
+    }
+    #[inline]
+    unsafe fn from_params(p: &Self::Params) -> Self {
+        Self {
+            // SAFETY: forwarded to the caller.
+            density: unsafe { p.density.grid::<1>() },
+            scale: p.scale,
+            majorant: p.majorant,
+            // SAFETY: forwarded to the caller.
+            albedo: unsafe { A::from_params(&p.albedo) },
+        }
     }
 }

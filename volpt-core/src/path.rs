@@ -20,6 +20,8 @@
 //! after at most `max_depth - 1` of them, and from `rr_depth` on it survives with probability
 //! `min(max(throughput) * eta^2, 0.95)`.
 
+use core::ops::Range;
+
 use crate::bsdf::Bsdf;
 use crate::geometry::BoxHit;
 use crate::medium::Medium;
@@ -160,6 +162,29 @@ pub fn step<S: Scene>(scene: &S, path: &mut PathState) {
 pub fn trace<S: Scene>(scene: &S, path: &mut PathState) {
     while path.alive {
         step(scene, path);
+    }
+}
+
+/// Traces samples `samples` of pixel `(px, py)` in order and adds their radiance to `sum` in `f64`.
+///
+/// This is the per-pixel loop of the CPU renderer and of the GPU's naive strategy: one loop, one
+/// summation order, so their images agree bit for bit.
+#[inline]
+pub fn sample_pixel<S: Scene>(
+    scene: &S,
+    (px, py): (u32, u32),
+    samples: Range<u32>,
+    seed: u32,
+    sum: &mut [f64; 3],
+    counters: &mut PathCounters,
+) {
+    for sample in samples {
+        let mut path = PathState::from_camera(scene, px, py, sample, seed);
+        trace(scene, &mut path);
+        counters.record(&path);
+        for (s, r) in sum.iter_mut().zip(path.radiance.to_array()) {
+            *s += r as f64;
+        }
     }
 }
 

@@ -1,6 +1,9 @@
 //! Phase functions. Directions are *propagation* directions: `wi` is the direction the light travelled
 //! before the scattering event and `wo` after it, so `cos_theta = wi . wo` and `g > 0` scatters forward.
 
+use bytemuck::{Pod, Zeroable};
+
+use crate::abi::{Component, NoParams, Upload};
 use crate::math::{clamp, INV_4PI};
 use crate::sampling::{direction_about, sample_uniform_sphere};
 use crate::{Vec2, Vec3};
@@ -81,5 +84,40 @@ impl PhaseFunction for HenyeyGreenstein {
             wo: direction_about(wi, cos_theta, u.y),
             pdf: self.eval_cos(cos_theta),
         }
+    }
+}
+
+impl Component for Isotropic {
+    const NAME: &'static str = "isotropic";
+    type Params = NoParams;
+
+    fn to_params(&self, _upload: &mut Upload<'_>) {}
+    #[inline]
+    unsafe fn from_params(_p: &NoParams) -> Self {
+        Isotropic
+    }
+}
+
+/// Device parameters of Henyey-Greenstein, padded to a multiple of 8 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct HenyeyGreensteinParams {
+    pub g: f32,
+    pub padding: u32,
+}
+
+impl Component for HenyeyGreenstein {
+    const NAME: &'static str = "henyey_greenstein";
+    type Params = HenyeyGreensteinParams;
+
+    fn to_params(&self, _upload: &mut Upload<'_>) -> HenyeyGreensteinParams {
+        HenyeyGreensteinParams {
+            g: self.g,
+            padding: 0,
+        }
+    }
+    #[inline]
+    unsafe fn from_params(p: &HenyeyGreensteinParams) -> Self {
+        Self { g: p.g }
     }
 }

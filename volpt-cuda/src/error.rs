@@ -19,11 +19,10 @@ pub enum CudaError {
         source: std::io::Error,
     },
     #[error(
-        "the GPU kernels have no entry point `{0}`: the PTX is out of date, run `cargo xtask ptx`"
+        "the GPU kernels have no entry point `{0}`: the PTX is out of date (run `cargo xtask ptx`), \
+         or no kernels crate exports this scene type (`volpt_device::export_kernels!`)"
     )]
     MissingKernel(String),
-    #[error("unknown GPU strategy `{given}`; choose one of: {known}")]
-    UnknownStrategy { given: String, known: String },
     #[error("nothing to render: the image is {width}x{height} with {spp} samples per pixel")]
     Empty { width: u32, height: u32, spp: u32 },
     #[error("CUDA driver call failed while {doing}: {source}")]

@@ -1,24 +1,30 @@
 //! volpt's CUDA backend: the generic `volpt-core` path step, compiled to PTX by `cargo xtask ptx`
 //! (see the `kernels` crate), loaded through the CUDA driver and run on the GPU.
 //!
-//! - [`strategy`]: the GPU scheduling strategies (who traces which path), selectable at run time.
-//! - [`renderer`]: device volumes, the device film, launching a strategy's kernel for a scene.
+//! - [`renderer`]: device volumes, the device film, launching a strategy's kernel for a scene type.
+//! - [`entry`]: the kernel entry point of a scene type, derived from its parts' names.
+//! - [`Strategy`]: the GPU scheduling strategies, selectable at run time (`volpt_device`).
 //! - [`error`]: what can go wrong, from "no GPU here" to a failed launch.
 //!
 //! The CUDA driver is loaded at run time, so a binary with this crate builds and runs on machines
 //! without CUDA; only `CudaRenderer::new` needs a GPU.
 
+pub mod entry;
 pub mod error;
 pub mod renderer;
-pub mod strategy;
 
 pub use error::CudaError;
 pub use renderer::CudaRenderer;
-pub use strategy::Strategy;
+pub use volpt_device::Strategy;
 
 /// The kernels' PTX, if `cargo xtask ptx` wrote it before this crate was built.
 mod ptx {
     include!(concat!(env!("OUT_DIR"), "/ptx.rs"));
+}
+
+/// The PTX of the workspace's kernels, if this build carries them.
+pub fn kernels_ptx() -> Option<&'static str> {
+    ptx::PTX
 }
 
 /// Whether this build carries GPU kernels.

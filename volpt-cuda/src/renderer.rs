@@ -2,7 +2,7 @@
 //!
 //! The scene's grids are copied to device memory once per render, the film (`f64` sums, as on the
 //! CPU) lives on the device for the whole render, and only the final sums come back. The kernel is
-//! chosen by name from the scene's variant, so the GPU simulates exactly the effects the CPU would.
+//! the scene type's own ([`entry_name`]), so the GPU simulates exactly the effects the CPU would.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -11,13 +11,14 @@ use cudarc::driver::{
     sys, CudaContext, CudaModule, CudaSlice, CudaStream, DevicePtr, LaunchConfig, PushKernelArg,
 };
 use cudarc::nvrtc::Ptx;
-use volpt_core::launch::{LaunchParams, SceneParams, ToParams, COUNTERS};
+use volpt_core::abi::SceneAbi;
 use volpt_core::path::PathCounters;
-use volpt_core::Scene;
-use volpt_render::{Image, RenderOptions, RenderStats};
+use volpt_device::launch::{BLOCK_SIZE, COUNTERS};
+use volpt_device::{LaunchParams, Strategy};
+use volpt_film::{Film, Image, RenderOptions, RenderStats};
 
+use crate::entry::entry_name;
 use crate::error::{CudaError, Doing};
-use crate::strategy::{Strategy, BLOCK_SIZE};
 
 /// One GPU with volpt's kernels loaded.
 pub struct CudaRenderer {
@@ -28,13 +29,9 @@ pub struct CudaRenderer {
 }
 
 impl CudaRenderer {
-    /// Opens GPU `ordinal` and loads the kernels (the driver JIT-compiles the PTX for this GPU on
-    /// first use and caches the result).
+    /// Opens GPU `ordinal` and loads the workspace's kernels (the driver JIT-compiles the PTX for
+    /// this GPU on first use and caches the result).
     pub fn new(ordinal: usize) -> Result<Self, CudaError> {
-        // SAFETY: only probes whether the driver library can be opened.
-        if !unsafe { sys::is_culib_present() } {
-            return Err(CudaError::NoDriver);
-        }
         // `VOLPT_PTX=file.ptx` runs other kernels with this binary: A/B measurements of a kernel
         // change in one device session.
         let ptx = match std::env::var_os("VOLPT_PTX") {
@@ -42,8 +39,18 @@ impl CudaRenderer {
                 path: path.into(),
                 source,
             })?,
-            None => crate::ptx::PTX.ok_or(CudaError::NoKernels)?.to_owned(),
+            None => crate::kernels_ptx().ok_or(CudaError::NoKernels)?.to_owned(),
         };
+        Self::with_ptx(ordinal, ptx)
+    }
+
+    /// Opens GPU `ordinal` with kernels of the caller's own, e.g. a library user's kernels crate
+    /// that exports its scene types with `volpt_device::export_kernels!`.
+    pub fn with_ptx(ordinal: usize, ptx: String) -> Result<Self, CudaError> {
+        // SAFETY: only probes whether the driver library can be opened.
+        if !unsafe { sys::is_culib_present() } {
+            return Err(CudaError::NoDriver);
+        }
         let ctx = CudaContext::new(ordinal).doing("opening the GPU")?;
         let device_name = ctx.name().doing("reading the GPU's name")?;
         let multiprocessors = ctx
@@ -66,12 +73,11 @@ impl CudaRenderer {
         &self.device_name
     }
 
-    /// Renders `scene` (of render-factory variant `variant`, e.g. `homogeneous/null/hg`) with
-    /// `strategy`, calling `progress(done, total)` in paths after each launch.
-    pub fn render<S: Scene + ToParams>(
+    /// Renders `scene` with `strategy` and the kernel of `S`, calling `progress(done, total)` in
+    /// paths after each launch.
+    pub fn render<S: SceneAbi>(
         &self,
         scene: &S,
-        variant: &str,
         strategy: Strategy,
         options: &RenderOptions,
         progress: &dyn Fn(u64, u64),
@@ -84,7 +90,7 @@ impl CudaRenderer {
                 spp: options.spp,
             });
         }
-        let name = strategy.kernel_name(variant);
+        let name = entry_name::<S>(strategy);
         let kernel = self
             .module
             .load_function(&name)
@@ -94,21 +100,17 @@ impl CudaRenderer {
         // The scene: grids to the device, everything else by value.
         let mut grids: Vec<CudaSlice<f32>> = Vec::new();
         let mut upload_error = None;
-        let mut scene_params = SceneParams::default();
-        scene.to_params(
-            &mut scene_params,
-            &mut |values| match stream.clone_htod(values) {
-                Ok(slice) => {
-                    let (address, _) = slice.device_ptr(stream);
-                    grids.push(slice);
-                    address
-                }
-                Err(e) => {
-                    upload_error.get_or_insert(e);
-                    0
-                }
-            },
-        );
+        let scene_params = scene.to_params(&mut |values| match stream.clone_htod(values) {
+            Ok(slice) => {
+                let (address, _) = slice.device_ptr(stream);
+                grids.push(slice);
+                address
+            }
+            Err(e) => {
+                upload_error.get_or_insert(e);
+                0
+            }
+        });
         if let Some(e) = upload_error {
             return Err(e).doing("copying the volume to the GPU");
         }
@@ -122,16 +124,10 @@ impl CudaRenderer {
             .doing("allocating the counters")?;
         let mut next_path: CudaSlice<u64> =
             stream.alloc_zeros(1).doing("allocating the path counter")?;
-        let blocks = match strategy {
-            Strategy::NaiveSk => pixels.div_ceil(BLOCK_SIZE as u64) as u32,
-            // Persistent threads: exactly as many blocks as the GPU keeps resident at once.
-            Strategy::RegenerationSk => {
-                let per_sm = kernel
-                    .occupancy_max_active_blocks_per_multiprocessor(BLOCK_SIZE, 0, None)
-                    .doing("querying the kernel's occupancy")?;
-                per_sm.max(1) * self.multiprocessors
-            }
-        };
+        let per_sm = kernel
+            .occupancy_max_active_blocks_per_multiprocessor(BLOCK_SIZE, 0, None)
+            .doing("querying the kernel's occupancy")?;
+        let blocks = strategy.blocks(pixels, per_sm * self.multiprocessors);
         let config = LaunchConfig {
             grid_dim: (blocks, 1, 1),
             block_dim: (BLOCK_SIZE, 1, 1),
@@ -145,20 +141,24 @@ impl CudaRenderer {
             film: film.device_ptr(stream).0,
             counters: counters.device_ptr(stream).0,
             next_path: next_path.device_ptr(stream).0,
-            ..LaunchParams::default()
+            first_sample: 0,
+            samples: 0,
+            padding: 0,
+            total_paths: 0,
         };
         let total = pixels * options.spp as u64;
         stream.synchronize().doing("copying the scene")?;
         let start = Instant::now();
-        while params.first_sample < options.spp {
-            params.samples = strategy.samples_per_launch(pixels, options.spp - params.first_sample);
-            params.total_paths = pixels * params.samples as u64;
+        for (first_sample, samples) in strategy.launches(pixels, options.spp) {
+            params.first_sample = first_sample;
+            params.samples = samples;
+            params.total_paths = pixels * samples as u64;
             stream
                 .memset_zeros(&mut next_path)
                 .doing("resetting the path counter")?;
             // The kernel reads its parameters from device memory, copied once per launch.
             let params_device = stream
-                .clone_htod(as_bytes(&params))
+                .clone_htod(params.as_bytes())
                 .doing("copying the launch parameters")?;
             let address = params_device.device_ptr(stream).0;
             // SAFETY: the kernel takes one pointer to a `LaunchParams` whose film, counters, path
@@ -166,44 +166,24 @@ impl CudaRenderer {
             unsafe { stream.launch_builder(&kernel).arg(&address).launch(config) }
                 .doing("launching the kernel")?;
             stream.synchronize().doing("running the kernel")?;
-            params.first_sample += params.samples;
-            progress(pixels * params.first_sample as u64, total);
+            progress(pixels * (first_sample + samples) as u64, total);
         }
         let elapsed = start.elapsed();
 
         let sums = stream.clone_dtoh(&film).doing("reading the film")?;
         let totals = stream.clone_dtoh(&counters).doing("reading the counters")?;
         drop(grids);
-        let inv_spp = 1.0 / options.spp as f64;
-        let pixels = sums
-            .chunks_exact(3)
-            .map(|s| [s[0], s[1], s[2]].map(|c| (c * inv_spp) as f32))
-            .collect();
+        let film = Film {
+            width,
+            height,
+            sums: sums.chunks_exact(3).map(|s| [s[0], s[1], s[2]]).collect(),
+        };
         let counters = PathCounters {
             paths: totals[0],
             segments: totals[1],
             tracking_steps: totals[2],
             truncated: totals[3],
         };
-        Ok((
-            Image {
-                width,
-                height,
-                pixels,
-            },
-            RenderStats { elapsed, counters },
-        ))
-    }
-}
-
-/// The bytes of a plain `repr(C)` value, for copying to the device.
-fn as_bytes(params: &LaunchParams) -> &[u8] {
-    // SAFETY: `LaunchParams` is `repr(C)`, `Copy`, made of integers and floats, and has no implicit
-    // padding (asserted in `volpt_core::launch`), so every byte is initialised.
-    unsafe {
-        std::slice::from_raw_parts(
-            (params as *const LaunchParams).cast::<u8>(),
-            std::mem::size_of::<LaunchParams>(),
-        )
+        Ok((film.image(options.spp), RenderStats { elapsed, counters }))
     }
 }

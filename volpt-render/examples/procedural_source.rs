@@ -5,8 +5,6 @@
 
 use std::path::PathBuf;
 
-use volpt_core::launch::ToParams;
-use volpt_core::Scene;
 use volpt_render::{path_settings, render, with_scene, Image, RenderOptions, SceneVisitor};
 use volpt_scene::{
     AlbedoDesc, BoundaryDesc, Bounds, BsdfDesc, CameraDesc, Config, DensityDesc, EnvironmentDesc,
@@ -82,7 +80,7 @@ struct Cpu(RenderOptions);
 
 impl SceneVisitor for Cpu {
     type Output = Result<Image, volpt_render::RenderError>;
-    fn visit<S: Scene + Sync + ToParams>(self, scene: &S) -> Self::Output {
+    fn visit<S: volpt_render::RenderScene>(self, scene: &S) -> Self::Output {
         render(scene, &self.0, &|_, _| {}).map(|(image, _)| image)
     }
 }

@@ -2,43 +2,17 @@
 //!
 //! Samples are taken in passes over the image, so the film always holds an equal number of samples per
 //! pixel and a render stopped early is still unbiased. Each pass splits the image into rows for rayon;
-//! sums are kept in f64, so that millions of f32 samples per pixel do not lose low bits.
+//! a pixel's samples are traced and summed by the core's `sample_pixel`, the very loop the GPU's
+//! naive strategy runs, so that the two agree bit for bit.
 
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use rayon::prelude::*;
 use thiserror::Error;
-use volpt_core::path::{trace, PathCounters, PathState};
+use volpt_core::path::{sample_pixel, PathCounters};
 use volpt_core::Scene;
-
-use crate::image::Image;
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct RenderOptions {
-    pub spp: u32,
-    pub seed: u32,
-    /// Worker threads; `None` uses every core.
-    pub threads: Option<usize>,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RenderStats {
-    pub elapsed: Duration,
-    pub counters: PathCounters,
-}
-
-impl RenderStats {
-    pub fn paths_per_second(&self) -> f64 {
-        self.counters.paths as f64 / self.elapsed.as_secs_f64()
-    }
-    pub fn segments_per_second(&self) -> f64 {
-        self.counters.segments as f64 / self.elapsed.as_secs_f64()
-    }
-    pub fn tracking_steps_per_second(&self) -> f64 {
-        self.counters.tracking_steps as f64 / self.elapsed.as_secs_f64()
-    }
-}
+use volpt_film::{Film, Image, RenderOptions, RenderStats};
 
 #[derive(Debug, Error)]
 pub enum RenderError {
@@ -75,7 +49,7 @@ pub fn render<S: Scene + Sync>(
         .build()
         .map_err(|source| RenderError::ThreadPool { threads, source })?;
 
-    let mut film = vec![[0.0f64; 3]; (width * height) as usize];
+    let mut film = Film::new(width, height);
     let total = width as u64 * height as u64 * options.spp as u64;
     let done = AtomicU64::new(0);
     let start = Instant::now();
@@ -85,25 +59,15 @@ pub fn render<S: Scene + Sync>(
         while first < options.spp {
             let samples = first..(first + SAMPLES_PER_PASS).min(options.spp);
             let pass = film
+                .sums
                 .par_chunks_mut(width as usize)
                 .enumerate()
                 .map(|(y, row)| {
                     let mut row_counters = PathCounters::default();
                     for (x, sum) in row.iter_mut().enumerate() {
-                        for sample in samples.clone() {
-                            let mut path = PathState::from_camera(
-                                scene,
-                                x as u32,
-                                y as u32,
-                                sample,
-                                options.seed,
-                            );
-                            trace(scene, &mut path);
-                            row_counters.record(&path);
-                            for (s, r) in sum.iter_mut().zip(path.radiance.to_array()) {
-                                *s += r as f64;
-                            }
-                        }
+                        let pixel = (x as u32, y as u32);
+                        let seed = options.seed;
+                        sample_pixel(scene, pixel, samples.clone(), seed, sum, &mut row_counters);
                     }
                     let n = done.fetch_add(width as u64 * samples.len() as u64, Ordering::Relaxed);
                     progress(n + width as u64 * samples.len() as u64, total);
@@ -117,17 +81,5 @@ pub fn render<S: Scene + Sync>(
     });
     let elapsed = start.elapsed();
 
-    let inv_spp = 1.0 / options.spp as f64;
-    let pixels = film
-        .iter()
-        .map(|sum| sum.map(|c| (c * inv_spp) as f32))
-        .collect();
-    Ok((
-        Image {
-            width,
-            height,
-            pixels,
-        },
-        RenderStats { elapsed, counters },
-    ))
+    Ok((film.image(options.spp), RenderStats { elapsed, counters }))
 }

@@ -6,10 +6,21 @@
 //! constant or lat-long environment. A backend receives the scene through [`SceneVisitor`], so one
 //! generic function serves every variant.
 
+//! The render factory: decides which effects a scene needs and builds the monomorphised
+//! [`VolumeScene`] that simulates exactly those.
+//!
+//! Each axis of the decision is a type parameter of the scene: constant or grid extinction, constant
+//! or grid albedo, index-matched, smooth or rough boundary, isotropic or Henyey-Greenstein phase,
+//! constant or lat-long environment. The axes and their values are the variant registry's
+//! ([`volpt_core::variant`]): from it this module generates one enum per axis ([`MediumPart`], ...,
+//! holding the built part) and the one exhaustive `match` that turns four built parts into a scene
+//! type. The description is read once, by one function per axis ([`Parts::of`]); a backend receives
+//! the scene through [`SceneVisitor`], so one generic function serves every variant.
+
 use std::fmt;
 
+use volpt_core::abi::SceneAbi;
 use volpt_core::grid::{Grid, GridMapping};
-use volpt_core::launch::ToParams;
 use volpt_core::math::tan;
 use volpt_core::microfacet::Ggx;
 use volpt_core::{
@@ -22,38 +33,101 @@ use volpt_scene::description::{
     GridConvention, GridDesc, LatLongDesc, PhaseDesc, SceneDescription,
 };
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum MediumKind {
-    /// Constant extinction and albedo: delta tracking samples one exponential and reads no memory.
-    Homogeneous,
-    /// Extinction from a grid, one albedo for the whole medium.
-    GridDensity,
-    /// Extinction and RGB albedo from grids.
-    GridDensityAlbedo,
+/// What a backend can render: the CPU needs a [`Scene`] it can share between threads, a GPU backend
+/// also ships it to its kernels through the device ABI.
+pub trait RenderScene: Scene + Sync + SceneAbi {}
+
+impl<S: Scene + Sync + SceneAbi> RenderScene for S {}
+
+/// A computation over a render-ready scene of any variant.
+pub trait SceneVisitor {
+    type Output;
+    fn visit<S: RenderScene>(self, scene: &S) -> Self::Output;
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum BoundaryKind {
-    IndexMatched,
-    SmoothDielectric,
-    RoughDielectric,
+/// One axis: the enum of its built parts and the enum of its kinds (the part without its data).
+/// Axes whose parts borrow grids or maps from the description take its lifetime `'a`.
+macro_rules! axis {
+    ($(#[$doc:meta])* $part:ident $(<$lt:lifetime>)?, $kind:ident,
+     [$(($camel:ident, $snake:ident, $ty:ty))*]) => {
+        $(#[$doc])*
+        pub enum $part $(<$lt>)? {
+            $($camel($ty),)*
+        }
+
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        pub enum $kind {
+            $($camel,)*
+        }
+
+        impl $(<$lt>)? $part $(<$lt>)? {
+            pub fn kind(&self) -> $kind {
+                match self {
+                    $($part::$camel(_) => $kind::$camel,)*
+                }
+            }
+        }
+
+        impl $kind {
+            /// The part's name, as in kernel entry points.
+            pub fn name(self) -> &'static str {
+                match self {
+                    $($kind::$camel => stringify!($snake),)*
+                }
+            }
+        }
+    };
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum PhaseKind {
-    Isotropic,
-    HenyeyGreenstein,
+/// The axis enums and the dispatch from built parts to a scene type, from the variant registry.
+macro_rules! factory {
+    (axes {
+        medium $media:tt boundary $boundaries:tt phase $phases:tt environment $environments:tt
+    }
+     variants [$([($M:ident, $m:ident, $mt:ty) ($B:ident, $b:ident, $bt:ty)
+        ($P:ident, $p:ident, $pt:ty) ($E:ident, $e:ident, $et:ty)])*]) => {
+        axis!(
+            /// The medium: extinction and albedo.
+            MediumPart<'a>, MediumKind, $media
+        );
+        axis!(
+            /// The boundary of the medium's box.
+            BoundaryPart, BoundaryKind, $boundaries
+        );
+        axis!(
+            /// The phase function.
+            PhasePart, PhaseKind, $phases
+        );
+        axis!(
+            /// The light: the environment.
+            EnvironmentPart<'a>, EnvironmentKind, $environments
+        );
+
+        /// Hands the scene made of `shared` and `parts` to `visitor`, monomorphised for its variant.
+        fn dispatch<V: SceneVisitor>(shared: Shared, parts: Parts<'_>, visitor: V) -> V::Output {
+            match (parts.medium, parts.boundary, parts.phase, parts.environment) {
+                $((
+                    MediumPart::$M(medium),
+                    BoundaryPart::$B(boundary),
+                    PhasePart::$P(phase),
+                    EnvironmentPart::$E(environment),
+                ) => visitor.visit(&VolumeScene {
+                    camera: shared.camera,
+                    bounds: shared.bounds,
+                    settings: shared.settings,
+                    medium,
+                    boundary,
+                    phase,
+                    environment,
+                }),)*
+            }
+        }
+    };
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum EnvironmentKind {
-    /// The same radiance from every direction: no lookup.
-    Constant,
-    /// A latitude-longitude map, bilinearly interpolated.
-    LatLong,
-}
+volpt_core::variants!('a => factory {});
 
-/// The monomorphised variant a scene renders with.
+/// The monomorphised variant a scene renders with: one kind per axis.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Variant {
     pub medium: MediumKind,
@@ -64,65 +138,57 @@ pub struct Variant {
 
 impl Variant {
     pub fn of(desc: &SceneDescription) -> Self {
-        let medium = match (&desc.medium.density, &desc.medium.albedo) {
-            (DensityDesc::Constant(_), AlbedoDesc::Constant(_)) => MediumKind::Homogeneous,
-            (DensityDesc::Grid(_), AlbedoDesc::Constant(_)) => MediumKind::GridDensity,
-            // A constant extinction under an albedo grid is rare; it becomes a one-voxel density grid.
-            (_, AlbedoDesc::Grid(_)) => MediumKind::GridDensityAlbedo,
-        };
-        let boundary = match desc.boundary.bsdf {
-            BsdfDesc::Null => BoundaryKind::IndexMatched,
-            BsdfDesc::Dielectric { .. } => BoundaryKind::SmoothDielectric,
-            BsdfDesc::RoughDielectric { .. } => BoundaryKind::RoughDielectric,
-        };
-        let phase = match desc.medium.phase {
-            PhaseDesc::Isotropic => PhaseKind::Isotropic,
-            PhaseDesc::HenyeyGreenstein { .. } => PhaseKind::HenyeyGreenstein,
-        };
-        let environment = match desc.environment {
-            EnvironmentDesc::Constant(_) => EnvironmentKind::Constant,
-            EnvironmentDesc::LatLong(_) => EnvironmentKind::LatLong,
-        };
-        Self {
-            medium,
-            boundary,
-            phase,
-            environment,
-        }
+        Parts::of(desc).variant()
     }
 }
 
 impl fmt::Display for Variant {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let medium = match self.medium {
-            MediumKind::Homogeneous => "homogeneous",
-            MediumKind::GridDensity => "grid-density",
-            MediumKind::GridDensityAlbedo => "grid-density-albedo",
-        };
-        let boundary = match self.boundary {
-            BoundaryKind::IndexMatched => "index-matched",
-            BoundaryKind::SmoothDielectric => "smooth-dielectric",
-            BoundaryKind::RoughDielectric => "rough-dielectric",
-        };
-        let phase = match self.phase {
-            PhaseKind::Isotropic => "isotropic",
-            PhaseKind::HenyeyGreenstein => "hg",
-        };
-        write!(f, "{medium}/{boundary}/{phase}")?;
-        // Only the lat-long map is named, so that the names of constant-environment variants (and
-        // the GPU kernels derived from them) stay what they were before environment maps existed.
-        match self.environment {
-            EnvironmentKind::Constant => Ok(()),
-            EnvironmentKind::LatLong => f.write_str("/envmap"),
+        write!(
+            f,
+            "{}/{}/{}/{}",
+            self.medium.name(),
+            self.boundary.name(),
+            self.phase.name(),
+            self.environment.name()
+        )
+    }
+}
+
+/// The four variant parts of a scene, built from its description.
+pub struct Parts<'a> {
+    pub medium: MediumPart<'a>,
+    pub boundary: BoundaryPart,
+    pub phase: PhasePart,
+    pub environment: EnvironmentPart<'a>,
+}
+
+impl<'a> Parts<'a> {
+    /// Reads each axis of the description once; the parts borrow their grids from `desc`.
+    pub fn of(desc: &'a SceneDescription) -> Self {
+        Self {
+            medium: medium(desc),
+            boundary: boundary(&desc.boundary.bsdf),
+            phase: phase(&desc.medium.phase),
+            environment: environment(&desc.environment),
+        }
+    }
+
+    pub fn variant(&self) -> Variant {
+        Variant {
+            medium: self.medium.kind(),
+            boundary: self.boundary.kind(),
+            phase: self.phase.kind(),
+            environment: self.environment.kind(),
         }
     }
 }
 
-/// A computation over a render-ready scene of any variant.
-pub trait SceneVisitor {
-    type Output;
-    /// `ToParams` lets a GPU backend ship the very same scene to its kernels.
-    fn visit<S: Scene + Sync + ToParams>(self, scene: &S) -> Self::Output;
+/// The parts every variant shares.
+struct Shared {
+    camera: PerspectiveCamera,
+    bounds: Aabb,
+    settings: PathSettings,
 }
 
 /// Builds the scene that `desc` describes, with `settings` for the integrator, and hands it to
@@ -132,14 +198,85 @@ pub fn with_scene<V: SceneVisitor>(
     settings: PathSettings,
     visitor: V,
 ) -> V::Output {
-    match &desc.environment {
+    let shared = Shared {
+        camera: camera(&desc.camera, &desc.film),
+        bounds: aabb(&desc.boundary.bounds),
+        settings,
+    };
+    dispatch(shared, Parts::of(desc), visitor)
+}
+
+fn medium(desc: &SceneDescription) -> MediumPart<'_> {
+    let medium = &desc.medium;
+    match (&medium.density, &medium.albedo) {
+        (DensityDesc::Constant(density), AlbedoDesc::Constant(albedo)) => {
+            MediumPart::Homogeneous(HomogeneousMedium {
+                sigma_t: medium.scale * density,
+                albedo: Spectrum::from_array(*albedo),
+            })
+        }
+        (DensityDesc::Grid(density), AlbedoDesc::Constant(albedo)) => {
+            MediumPart::GridDensity(GridMedium {
+                density: grid::<1>(density),
+                scale: medium.scale,
+                majorant: medium.scale * density.max_value(),
+                albedo: ConstantAlbedo(Spectrum::from_array(*albedo)),
+            })
+        }
+        (density, AlbedoDesc::Grid(albedo)) => {
+            let density = match density {
+                DensityDesc::Grid(density) => grid::<1>(density),
+                // A constant extinction under an albedo grid is rare: it becomes a one-voxel grid
+                // over the medium's box.
+                DensityDesc::Constant(sigma) => {
+                    let bounds = aabb(&desc.boundary.bounds);
+                    let mapping = GridMapping::cell_centred(bounds, [1, 1, 1]);
+                    Grid::new(std::slice::from_ref(sigma), [1, 1, 1], mapping)
+                }
+            };
+            let max_density = density.data.iter().copied().fold(0.0, f32::max);
+            MediumPart::GridDensityAlbedo(GridMedium {
+                density,
+                scale: medium.scale,
+                majorant: medium.scale * max_density,
+                albedo: GridAlbedo(grid::<3>(albedo)),
+            })
+        }
+    }
+}
+
+fn boundary(bsdf: &BsdfDesc) -> BoundaryPart {
+    match *bsdf {
+        BsdfDesc::Null => BoundaryPart::IndexMatched(NullBoundary),
+        BsdfDesc::Dielectric { int_ior, ext_ior } => {
+            BoundaryPart::SmoothDielectric(SmoothDielectric {
+                eta: int_ior / ext_ior,
+            })
+        }
+        BsdfDesc::RoughDielectric {
+            alpha,
+            int_ior,
+            ext_ior,
+        } => BoundaryPart::RoughDielectric(RoughDielectric {
+            eta: int_ior / ext_ior,
+            distribution: Ggx { alpha },
+        }),
+    }
+}
+
+fn phase(phase: &PhaseDesc) -> PhasePart {
+    match *phase {
+        PhaseDesc::Isotropic => PhasePart::Isotropic(Isotropic),
+        PhaseDesc::HenyeyGreenstein { g } => PhasePart::HenyeyGreenstein(HenyeyGreenstein { g }),
+    }
+}
+
+fn environment(environment: &EnvironmentDesc) -> EnvironmentPart<'_> {
+    match environment {
         EnvironmentDesc::Constant(rgb) => {
-            let constant = ConstantEnvironment(Spectrum::from_array(*rgb));
-            with_medium(desc, Parts::new(desc, settings, constant), visitor)
+            EnvironmentPart::Constant(ConstantEnvironment(Spectrum::from_array(*rgb)))
         }
-        EnvironmentDesc::LatLong(map) => {
-            with_medium(desc, Parts::new(desc, settings, lat_long(map)), visitor)
-        }
+        EnvironmentDesc::LatLong(map) => EnvironmentPart::LatLong(lat_long(map)),
     }
 }
 
@@ -162,150 +299,6 @@ fn lat_long(map: &LatLongDesc) -> LatLongEnvironment<'_> {
     )
 }
 
-fn with_medium<E, V>(desc: &SceneDescription, parts: Parts<E>, visitor: V) -> V::Output
-where
-    E: volpt_core::Environment + Sync + ToParams,
-    V: SceneVisitor,
-{
-    let medium = &desc.medium;
-    let one_voxel;
-    let density_grid = match &medium.density {
-        DensityDesc::Grid(grid) => grid,
-        DensityDesc::Constant(sigma) => {
-            one_voxel = GridDesc {
-                resolution: [1, 1, 1],
-                channels: 1,
-                bounds: desc.boundary.bounds,
-                convention: GridConvention::Cell,
-                data: vec![*sigma],
-            };
-            &one_voxel
-        }
-    };
-    match Variant::of(desc).medium {
-        MediumKind::Homogeneous => {
-            let (DensityDesc::Constant(density), AlbedoDesc::Constant(albedo)) =
-                (&medium.density, &medium.albedo)
-            else {
-                unreachable!("Variant::of classified this medium as homogeneous")
-            };
-            let m = HomogeneousMedium {
-                sigma_t: medium.scale * density,
-                albedo: Spectrum::from_array(*albedo),
-            };
-            with_boundary(desc, parts, m, visitor)
-        }
-        MediumKind::GridDensity => {
-            let AlbedoDesc::Constant(albedo) = &medium.albedo else {
-                unreachable!("Variant::of classified this albedo as constant")
-            };
-            let m = grid_medium(
-                density_grid,
-                medium.scale,
-                ConstantAlbedo(Spectrum::from_array(*albedo)),
-            );
-            with_boundary(desc, parts, m, visitor)
-        }
-        MediumKind::GridDensityAlbedo => {
-            let AlbedoDesc::Grid(albedo) = &medium.albedo else {
-                unreachable!("Variant::of classified this albedo as a grid")
-            };
-            let m = grid_medium(density_grid, medium.scale, GridAlbedo(grid::<3>(albedo)));
-            with_boundary(desc, parts, m, visitor)
-        }
-    }
-}
-
-/// The parts every variant shares, and the environment, chosen first.
-struct Parts<E> {
-    camera: PerspectiveCamera,
-    bounds: Aabb,
-    settings: PathSettings,
-    environment: E,
-}
-
-impl<E> Parts<E> {
-    fn new(desc: &SceneDescription, settings: PathSettings, environment: E) -> Self {
-        Self {
-            camera: camera(&desc.camera, &desc.film),
-            bounds: aabb(&desc.boundary.bounds),
-            settings,
-            environment,
-        }
-    }
-}
-
-fn with_boundary<E, M, V>(
-    desc: &SceneDescription,
-    parts: Parts<E>,
-    medium: M,
-    visitor: V,
-) -> V::Output
-where
-    E: volpt_core::Environment + Sync + ToParams,
-    M: volpt_core::Medium + Sync + ToParams,
-    V: SceneVisitor,
-{
-    match desc.boundary.bsdf {
-        BsdfDesc::Null => with_phase(desc, parts, medium, NullBoundary, visitor),
-        BsdfDesc::Dielectric { int_ior, ext_ior } => {
-            let b = SmoothDielectric {
-                eta: int_ior / ext_ior,
-            };
-            with_phase(desc, parts, medium, b, visitor)
-        }
-        BsdfDesc::RoughDielectric {
-            alpha,
-            int_ior,
-            ext_ior,
-        } => {
-            let b = RoughDielectric {
-                eta: int_ior / ext_ior,
-                distribution: Ggx { alpha },
-            };
-            with_phase(desc, parts, medium, b, visitor)
-        }
-    }
-}
-
-fn with_phase<E, M, B, V>(
-    desc: &SceneDescription,
-    parts: Parts<E>,
-    medium: M,
-    boundary: B,
-    visitor: V,
-) -> V::Output
-where
-    E: volpt_core::Environment + Sync + ToParams,
-    M: volpt_core::Medium + Sync + ToParams,
-    B: volpt_core::Bsdf + Sync + ToParams,
-    V: SceneVisitor,
-{
-    match desc.medium.phase {
-        PhaseDesc::Isotropic => visitor.visit(&assemble(parts, medium, boundary, Isotropic)),
-        PhaseDesc::HenyeyGreenstein { g } => {
-            visitor.visit(&assemble(parts, medium, boundary, HenyeyGreenstein { g }))
-        }
-    }
-}
-
-fn assemble<E, M, B, P>(
-    parts: Parts<E>,
-    medium: M,
-    boundary: B,
-    phase: P,
-) -> VolumeScene<M, B, P, E> {
-    VolumeScene {
-        camera: parts.camera,
-        bounds: parts.bounds,
-        medium,
-        boundary,
-        phase,
-        environment: parts.environment,
-        settings: parts.settings,
-    }
-}
-
 fn aabb(b: &Bounds) -> Aabb {
     Aabb::new(Vec3::from_array(b.min), Vec3::from_array(b.max))
 }
@@ -317,15 +310,6 @@ fn grid<const C: usize>(g: &GridDesc) -> Grid<'_, C> {
         GridConvention::Cell => GridMapping::cell_centred(bounds, g.resolution),
     };
     Grid::new(&g.data, g.resolution, mapping)
-}
-
-fn grid_medium<A>(density: &GridDesc, scale: f32, albedo: A) -> GridMedium<'_, A> {
-    GridMedium {
-        density: grid::<1>(density),
-        scale,
-        majorant: scale * density.max_value(),
-        albedo,
-    }
 }
 
 /// Mitsuba's perspective camera: the field of view spans `fov_axis`, the other axis follows from the

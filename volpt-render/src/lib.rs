@@ -2,12 +2,13 @@
 //!
 //! - [`factory`]: which monomorphised scene variant a description needs, and building it.
 //! - [`cpu`]: the CPU backend, rayon over the shared path step.
-//! - [`image`]: the film's result and its EXR/PNG files.
+//!
+//! What a render produces (the film, the image and its files, the statistics) is `volpt-film`'s,
+//! shared with the GPU backend; it is re-exported here for convenience.
 
 pub mod cpu;
 pub mod factory;
-pub mod image;
 
-pub use cpu::{render, RenderError, RenderOptions, RenderStats};
-pub use factory::{path_settings, with_scene, SceneVisitor, Variant};
-pub use image::{Image, ImageError};
+pub use cpu::{render, RenderError};
+pub use factory::{path_settings, with_scene, RenderScene, SceneVisitor, Variant};
+pub use volpt_film::{image, Film, Image, ImageError, RenderOptions, RenderStats};

@@ -1,30 +1,30 @@
-//! Scheduling strategies: who traces which path, and how results reach the film.
+//! The strategies' kernel bodies: who traces which path, and how results reach the film.
 //!
 //! Both trace the same paths as the CPU: path `(pixel, sample)` is `PathState::from_camera` with the
 //! launch's seed, run by the shared `path::step`. They differ only in scheduling (the thesis' first
 //! two strategies, after Novák, Havran & Dachsbacher 2010):
 //!
-//! - [`naive`] (naiveSK): one thread per pixel traces that pixel's samples in order and sums them in
+//! - [`naive_sk`] (naiveSK): one thread per pixel traces that pixel's samples in order and sums them in
 //!   `f64`, exactly as the CPU does, so the image is bit-identical to the CPU's. A warp waits for its
 //!   longest path, and there are only `width * height` threads.
-//! - [`regeneration`] (regenerationSK): a persistent grid sized to fill the GPU; a thread advances its
+//! - [`regeneration_sk`] (regenerationSK): a persistent grid sized to fill the GPU; a thread advances its
 //!   path one step at a time, and as soon as the path ends it records it and takes the next path index
 //!   from a global counter (one atomic per warp and refill), so lanes do not idle behind long paths.
 //!   Radiance reaches the film through `f64` atomic additions, whose order varies: the image agrees
 //!   with the CPU's up to the rounding of the sums.
 
-use volpt_core::launch::LaunchParams;
-use volpt_core::path::{step, trace, PathCounters, PathState};
+use volpt_core::path::{sample_pixel, step, PathCounters, PathState};
 use volpt_core::Scene;
 
-use crate::device::{
+use crate::launch::{path_of, pixel_xy, LaunchParams};
+use crate::nvptx::{
     atomic_add_u64, ballot, global_thread_index, lane_id, lanemask_lt, red_add_f64, red_add_u64,
     shfl_idx_u64, warp_sum_u64,
 };
 
 /// Adds the warp's counters to the launch's totals (warp-collective: every lane calls it).
 #[inline(always)]
-unsafe fn add_counters(c: &PathCounters, lp: &LaunchParams) {
+unsafe fn add_counters<P>(c: &PathCounters, lp: &LaunchParams<P>) {
     let totals = lp.counters as *mut u64;
     let values = [c.paths, c.segments, c.tracking_steps, c.truncated];
     let lane0 = lane_id() == 0;
@@ -37,29 +37,29 @@ unsafe fn add_counters(c: &PathCounters, lp: &LaunchParams) {
     }
 }
 
-/// naiveSK: thread `i` renders pixel `i`, adding this launch's samples to its `f64` sum in order
-/// (the CPU's order, so the sums are the CPU's bit for bit).
+/// naiveSK: thread `i` renders pixel `i`, adding this launch's samples to its `f64` sum with the
+/// CPU's own per-pixel loop, so the sums are the CPU's bit for bit.
 ///
 /// # Safety
 /// `lp.film` must hold `3 * width * height` `f64`s and `lp.counters` `launch::COUNTERS` `u64`s.
 #[inline(always)]
-pub unsafe fn naive<S: Scene>(scene: &S, lp: &LaunchParams) {
+pub unsafe fn naive_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     let width = scene.camera().width;
     let pixels = width * scene.camera().height;
     let i = global_thread_index();
     let mut counters = PathCounters::default();
     if i < pixels {
-        let (px, py) = (i % width, i / width);
         // SAFETY: pixel `i` is inside the film, and no other thread touches it.
         let sum = unsafe { &mut *(lp.film as *mut [f64; 3]).add(i as usize) };
-        for sample in lp.first_sample..lp.first_sample + lp.samples {
-            let mut path = PathState::from_camera(scene, px, py, sample, lp.seed);
-            trace(scene, &mut path);
-            counters.record(&path);
-            for (s, r) in sum.iter_mut().zip(path.radiance.to_array()) {
-                *s += r as f64;
-            }
-        }
+        let samples = lp.first_sample..lp.first_sample + lp.samples;
+        sample_pixel(
+            scene,
+            pixel_xy(i, width),
+            samples,
+            lp.seed,
+            sum,
+            &mut counters,
+        );
     }
     // SAFETY: forwarded.
     unsafe { add_counters(&counters, lp) };
@@ -70,9 +70,9 @@ pub unsafe fn naive<S: Scene>(scene: &S, lp: &LaunchParams) {
 /// at any time are spread over the image and the film's atomics rarely collide.
 ///
 /// # Safety
-/// As [`naive`]; and `lp.next_path` must be one zeroed `u64`, and the block size a multiple of 32.
+/// As [`naive_sk`]; and `lp.next_path` must be one zeroed `u64`, and the block size a multiple of 32.
 #[inline(always)]
-pub unsafe fn regeneration<S: Scene>(scene: &S, lp: &LaunchParams) {
+pub unsafe fn regeneration_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     let width = scene.camera().width;
     let pixels = (width * scene.camera().height) as u64;
     let film = lp.film as *mut f64;
@@ -100,15 +100,10 @@ pub unsafe fn regeneration<S: Scene>(scene: &S, lp: &LaunchParams) {
             if need {
                 let index = base + (wanting & below).count_ones() as u64;
                 if index < lp.total_paths {
-                    pixel = (index % pixels) as u32;
-                    let sample = lp.first_sample + (index / pixels) as u32;
-                    path = PathState::from_camera(
-                        scene,
-                        pixel % width,
-                        pixel / width,
-                        sample,
-                        lp.seed,
-                    );
+                    let sample;
+                    (pixel, sample) = path_of(index, pixels, lp.first_sample);
+                    let (px, py) = pixel_xy(pixel, width);
+                    path = PathState::from_camera(scene, px, py, sample, lp.seed);
                     active = true;
                 } else {
                     exhausted = true;

@@ -1,0 +1,296 @@
+//! The typed device ABI: how a scene travels from the host to a GPU kernel.
+//!
+//! Every scene part is a [`Component`]: it names its own `#[repr(C)]` parameter type, writes itself
+//! into it on the host ([`Component::to_params`]) and is rebuilt from it on the device
+//! ([`Component::from_params`]). A whole scene's parameters, [`SceneParams`], are composed from its
+//! parts' parameters, so a kernel receives exactly the fields its variant reads, and every scalar is
+//! the very `f32` the host computed: a kernel's scene is bit for bit the CPU's scene.
+//!
+//! Layout is checked at compile time: parameter types are [`bytemuck::Pod`] (no padding, no
+//! pointers), and each part's size is a multiple of 8 bytes, so that a composition of parts has no
+//! padding either ([`SceneParams::LAYOUT`]). Device memory travels as `u64` addresses; only
+//! `from_params` turns them back into references.
+//!
+//! [`Component::NAME`] is the part's name in kernel entry points (`homogeneous`, `rough_dielectric`):
+//! the host derives the entry point of a scene type from its parts' names ([`SceneAbi::names`]),
+//! and the kernels export the same names from the variant registry ([`crate::variant`]).
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::camera::PerspectiveCamera;
+use crate::grid::{Grid, GridMapping};
+use crate::path::PathSettings;
+use crate::scene::{Scene, VolumeScene};
+use crate::{Aabb, Vec2, Vec3};
+
+/// Copies grid or map values to device memory and returns their device address; the caller keeps
+/// that memory alive for as long as the parameters are used.
+pub type Upload<'u> = dyn FnMut(&[f32]) -> u64 + 'u;
+
+/// A scene part that can travel to a GPU kernel.
+pub trait Component {
+    /// The part's name in kernel entry points: lower case, words joined by `_`.
+    const NAME: &'static str;
+    /// What the kernel receives. Its size must be a multiple of 8 bytes.
+    type Params: Pod;
+
+    fn to_params(&self, upload: &mut Upload<'_>) -> Self::Params;
+
+    /// The device side: rebuilds the part from its parameters.
+    ///
+    /// # Safety
+    /// Every address in `p` must point to the values [`Component::to_params`] uploaded for it,
+    /// valid and unchanged for as long as the part (and any lifetime in its type) lives.
+    unsafe fn from_params(p: &Self::Params) -> Self;
+}
+
+/// The parameters of a part that reads nothing (index-matched boundary, isotropic phase).
+pub type NoParams = ();
+
+/// The camera, as [`PerspectiveCamera`] holds it.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct CameraParams {
+    pub origin: [f32; 3],
+    pub axis_x: [f32; 3],
+    pub axis_y: [f32; 3],
+    pub axis_z: [f32; 3],
+    pub tan_half_fov: [f32; 2],
+    pub width: u32,
+    pub height: u32,
+}
+
+impl From<&PerspectiveCamera> for CameraParams {
+    fn from(c: &PerspectiveCamera) -> Self {
+        Self {
+            origin: c.origin.to_array(),
+            axis_x: c.axis_x.to_array(),
+            axis_y: c.axis_y.to_array(),
+            axis_z: c.axis_z.to_array(),
+            tan_half_fov: c.tan_half_fov.to_array(),
+            width: c.width,
+            height: c.height,
+        }
+    }
+}
+
+impl From<&CameraParams> for PerspectiveCamera {
+    #[inline]
+    fn from(c: &CameraParams) -> Self {
+        Self {
+            origin: Vec3::from_array(c.origin),
+            axis_x: Vec3::from_array(c.axis_x),
+            axis_y: Vec3::from_array(c.axis_y),
+            axis_z: Vec3::from_array(c.axis_z),
+            tan_half_fov: Vec2::from_array(c.tan_half_fov),
+            width: c.width,
+            height: c.height,
+        }
+    }
+}
+
+/// The integrator's limits, with the padding that keeps the size a multiple of 8 spelled out.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SettingsParams {
+    pub max_depth: u32,
+    pub rr_depth: u32,
+    pub max_segments: u32,
+    pub padding: u32,
+}
+
+impl From<&PathSettings> for SettingsParams {
+    fn from(s: &PathSettings) -> Self {
+        Self {
+            max_depth: s.max_depth,
+            rr_depth: s.rr_depth,
+            max_segments: s.max_segments,
+            padding: 0,
+        }
+    }
+}
+
+impl From<&SettingsParams> for PathSettings {
+    #[inline]
+    fn from(s: &SettingsParams) -> Self {
+        Self {
+            max_depth: s.max_depth,
+            rr_depth: s.rr_depth,
+            max_segments: s.max_segments,
+        }
+    }
+}
+
+/// A dense grid in device memory: `len` `f32` values at address `data`, laid out as [`Grid`] says,
+/// and its world-to-index mapping as the host computed it.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GridParams {
+    pub data: u64,
+    /// Number of `f32` values at `data` (`res_x * res_y * res_z * channels`).
+    pub len: u64,
+    pub res: [u32; 3],
+    pub channels: u32,
+    pub bounds_min: [f32; 3],
+    pub bounds_max: [f32; 3],
+    pub scale: [f32; 3],
+    pub offset: [f32; 3],
+}
+
+impl GridParams {
+    /// The parameters of `grid`, whose values `upload` copies to the device.
+    pub fn new<const C: usize>(grid: &Grid<'_, C>, upload: &mut Upload<'_>) -> Self {
+        Self {
+            data: upload(grid.data),
+            len: grid.data.len() as u64,
+            res: grid.res,
+            channels: C as u32,
+            bounds_min: grid.mapping.bounds.min.to_array(),
+            bounds_max: grid.mapping.bounds.max.to_array(),
+            scale: grid.mapping.scale().to_array(),
+            offset: grid.mapping.offset().to_array(),
+        }
+    }
+
+    /// The grid these parameters describe.
+    ///
+    /// # Safety
+    /// `data` must point to `len` initialised `f32` values that stay valid and unchanged for `'a`,
+    /// and `len` must equal `res_x * res_y * res_z * C`.
+    #[inline]
+    pub unsafe fn grid<'a, const C: usize>(&self) -> Grid<'a, C> {
+        let bounds = Aabb::new(
+            Vec3::from_array(self.bounds_min),
+            Vec3::from_array(self.bounds_max),
+        );
+        Grid {
+            // SAFETY: the caller guarantees the address range.
+            data: unsafe {
+                core::slice::from_raw_parts(self.data as *const f32, self.len as usize)
+            },
+            res: self.res,
+            mapping: GridMapping::from_parts(
+                bounds,
+                Vec3::from_array(self.scale),
+                Vec3::from_array(self.offset),
+            ),
+        }
+    }
+}
+
+/// Everything a kernel needs to rebuild a `VolumeScene<M, B, P, E>`: the parts every scene has,
+/// then each variant part's own parameters.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SceneParams<M, B, P, E> {
+    pub camera: CameraParams,
+    pub bounds_min: [f32; 3],
+    pub bounds_max: [f32; 3],
+    pub settings: SettingsParams,
+    pub medium: M,
+    pub boundary: B,
+    pub phase: P,
+    pub environment: E,
+}
+
+impl<M: Pod, B: Pod, P: Pod, E: Pod> SceneParams<M, B, P, E> {
+    /// Evaluated for every composition the host builds: the fixed part is a multiple of 8 bytes
+    /// and so is every variant part, so `repr(C)` inserts no padding and the struct is plain bytes.
+    pub const LAYOUT: () = {
+        let fixed =
+            core::mem::size_of::<CameraParams>() + 24 + core::mem::size_of::<SettingsParams>();
+        let parts = [
+            core::mem::size_of::<M>(),
+            core::mem::size_of::<B>(),
+            core::mem::size_of::<P>(),
+            core::mem::size_of::<E>(),
+        ];
+        assert!(fixed.is_multiple_of(8));
+        let mut sum = fixed;
+        let mut i = 0;
+        while i < parts.len() {
+            assert!(
+                parts[i].is_multiple_of(8),
+                "a part's parameters must be a multiple of 8 bytes"
+            );
+            sum += parts[i];
+            i += 1;
+        }
+        assert!(
+            core::mem::size_of::<Self>() == sum,
+            "SceneParams has padding"
+        );
+        assert!(core::mem::align_of::<Self>() <= 8);
+    };
+}
+
+// SAFETY: `repr(C)` of `Pod` fields; `LAYOUT`, which `SceneAbi::to_params` evaluates for every
+// composition it builds, proves that no padding byte lies between or after them.
+unsafe impl<M: Pod, B: Pod, P: Pod, E: Pod> Zeroable for SceneParams<M, B, P, E> {}
+// SAFETY: as above.
+unsafe impl<M: Pod, B: Pod, P: Pod, E: Pod> Pod for SceneParams<M, B, P, E> {}
+
+/// A whole scene that can travel to a GPU kernel.
+pub trait SceneAbi: Scene + Sized {
+    type Params: Pod;
+    /// The part names of the scene's variant, in registry order (medium, boundary, phase,
+    /// environment): the kernel entry point of this scene type under strategy `s` is
+    /// `s__medium__boundary__phase__environment`.
+    fn names() -> [&'static str; 4];
+    fn to_params(&self, upload: &mut Upload<'_>) -> Self::Params;
+
+    /// The device side of [`SceneAbi::to_params`].
+    ///
+    /// # Safety
+    /// As [`Component::from_params`], for every part.
+    unsafe fn from_params(p: &Self::Params) -> Self;
+}
+
+impl<M, B, P, E> SceneAbi for VolumeScene<M, B, P, E>
+where
+    Self: Scene,
+    M: Component,
+    B: Component,
+    P: Component,
+    E: Component,
+{
+    type Params = SceneParams<M::Params, B::Params, P::Params, E::Params>;
+
+    fn names() -> [&'static str; 4] {
+        [M::NAME, B::NAME, P::NAME, E::NAME]
+    }
+
+    fn to_params(&self, upload: &mut Upload<'_>) -> Self::Params {
+        #[allow(clippy::let_unit_value)]
+        let () = Self::Params::LAYOUT;
+        SceneParams {
+            camera: CameraParams::from(&self.camera),
+            bounds_min: self.bounds.min.to_array(),
+            bounds_max: self.bounds.max.to_array(),
+            settings: SettingsParams::from(&self.settings),
+            medium: self.medium.to_params(upload),
+            boundary: self.boundary.to_params(upload),
+            phase: self.phase.to_params(upload),
+            environment: self.environment.to_params(upload),
+        }
+    }
+
+    #[inline]
+    unsafe fn from_params(p: &Self::Params) -> Self {
+        // SAFETY: forwarded to the caller.
+        unsafe {
+            Self {
+                camera: PerspectiveCamera::from(&p.camera),
+                bounds: Aabb::new(
+                    Vec3::from_array(p.bounds_min),
+                    Vec3::from_array(p.bounds_max),
+                ),
+                medium: M::from_params(&p.medium),
+                boundary: B::from_params(&p.boundary),
+                phase: P::from_params(&p.phase),
+                environment: E::from_params(&p.environment),
+                settings: PathSettings::from(&p.settings),
+            }
+        }
+    }
+}

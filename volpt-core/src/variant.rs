@@ -1,0 +1,121 @@
+//! The variant registry: every value of every variant axis, and the type that implements it.
+//!
+//! A scene is a `VolumeScene<M, B, P, E>`; each of its four parts is chosen from one axis below.
+//! This list is the only place the axes are enumerated: the render factory's dispatch, the GPU
+//! kernels' instantiation and the kernels' entry names are all generated from it (pbrt-v4's
+//! `ForEachType` idea, with `macro_rules!`). Adding an axis value is one line here, beside the
+//! part's own file.
+//!
+//! [`variants!`](crate::variants) calls a macro of the caller with the axes and with the cartesian
+//! product of their values:
+//!
+//! ```text
+//! volpt_core::variants!('a => my_macro { extra tokens });
+//! // expands to
+//! my_macro! { extra tokens
+//!     axes {
+//!         medium [(Homogeneous, homogeneous, HomogeneousMedium) ...]
+//!         boundary [...] phase [...] environment [...]
+//!     }
+//!     variants [
+//!         [(Homogeneous, homogeneous, HomogeneousMedium) (IndexMatched, index_matched, NullBoundary)
+//!          (Isotropic, isotropic, Isotropic) (Constant, constant, ConstantEnvironment)]
+//!         ...
+//!     ]
+//! }
+//! ```
+//!
+//! Each value is `(CamelCase name, snake_case name, type)`. The snake-case name is the part's
+//! [`Component::NAME`](crate::abi::Component::NAME) (a test checks it) and so appears in kernel
+//! entry points; types that borrow grids take the caller's lifetime `'a` (`'_` inside function
+//! bodies, `'static` for type-level questions).
+
+/// Calls `$callback!` with the registry's axes and every combination of their values; see the
+/// [module documentation](crate::variant).
+#[macro_export]
+macro_rules! variants {
+    ($lt:lifetime => $callback:path { $($args:tt)* }) => {
+        $crate::variants! { @mul
+            { ($callback) { $($args)* } axes {
+                medium [
+                    (Homogeneous, homogeneous, $crate::HomogeneousMedium)
+                    (GridDensity, grid_density, $crate::GridMedium<$lt, $crate::ConstantAlbedo>)
+                    (GridDensityAlbedo, grid_density_albedo,
+                        $crate::GridMedium<$lt, $crate::GridAlbedo<$lt>>)
+                ]
+                boundary [
+                    (IndexMatched, index_matched, $crate::NullBoundary)
+                    (SmoothDielectric, smooth_dielectric, $crate::SmoothDielectric)
+                    (RoughDielectric, rough_dielectric, $crate::RoughDielectric)
+                ]
+                phase [
+                    (Isotropic, isotropic, $crate::Isotropic)
+                    (HenyeyGreenstein, henyey_greenstein, $crate::HenyeyGreenstein)
+                ]
+                environment [
+                    (Constant, constant, $crate::ConstantEnvironment)
+                    (LatLong, lat_long, $crate::LatLongEnvironment<$lt>)
+                ]
+            } }
+            [] [[]]
+        }
+    };
+
+    // The product is built one axis at a time: every partial combination in the accumulator is
+    // extended by every value of the next axis. Partial combinations are nested groups
+    // `[[[[] m] b] p]`, because `macro_rules!` cannot splice a repeated group into another
+    // repetition; they are flattened at the end.
+    (@mul { $cb:tt $args:tt axes { $($axis:ident $values:tt)* } } $out:tt $acc:tt) => {
+        $crate::variants! { @step { $cb $args axes { $($axis $values)* } } [] $acc [$($values)*] }
+    };
+    (@step $ctx:tt [$($out:tt)*] [$a:tt $($acc:tt)*] [[$($v:tt)*] $($rest:tt)*]) => {
+        $crate::variants! { @step $ctx [$($out)* $([$a $v])*] [$($acc)*] [[$($v)*] $($rest)*] }
+    };
+    (@step $ctx:tt $out:tt [] [$done:tt $next:tt $($rest:tt)*]) => {
+        $crate::variants! { @step $ctx [] $out [$next $($rest)*] }
+    };
+    (@step { ($cb:path) { $($args:tt)* } axes $axes:tt } [$([[[[[] $m:tt] $b:tt] $p:tt] $e:tt])*] [] [$last:tt]) => {
+        $cb! { $($args)* axes $axes variants [$([$m $b $p $e])*] }
+    };
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::abi::Component;
+
+    /// `(registry name, Component::NAME)` of every part of every variant.
+    macro_rules! registry_facts {
+        (axes $axes:tt variants [$([$(($camel:ident, $snake:ident, $ty:ty))*])*]) => {
+            fn facts() -> [[(&'static str, &'static str); 4]; 36] {
+                [$([$((stringify!($snake), <$ty as Component>::NAME)),*]),*]
+            }
+        };
+    }
+
+    variants!('static => registry_facts {});
+
+    #[test]
+    fn registry_names_are_the_components_names() {
+        for parts in facts() {
+            for (registry, component) in parts {
+                assert_eq!(registry, component);
+            }
+        }
+    }
+
+    #[test]
+    fn every_combination_appears_once() {
+        let variants = facts().map(|parts| parts.map(|(name, _)| name));
+        for (i, a) in variants.iter().enumerate() {
+            for b in &variants[i + 1..] {
+                assert_ne!(a, b);
+            }
+        }
+        assert!(variants.contains(&[
+            "grid_density_albedo",
+            "rough_dielectric",
+            "henyey_greenstein",
+            "lat_long"
+        ]));
+    }
+}

@@ -1,0 +1,124 @@
+//! What one kernel launch receives, and which paths it traces.
+//!
+//! The scheduling arithmetic lives here as plain functions so that the host, the kernels and the CPU
+//! tests share it: a path is `(pixel, sample)`; a launch traces samples
+//! `first_sample .. first_sample + samples` of every pixel; path index `k` of a launch is sample
+//! `first_sample + k / pixels` of pixel `k % pixels` ([`path_of`]), so that the paths in flight at any
+//! time are spread over the image and the film's atomics rarely collide.
+
+use bytemuck::{Pod, Zeroable};
+
+pub use volpt_core::abi::SceneAbi;
+pub use volpt_core::VolumeScene as Scene;
+
+use crate::Strategy;
+
+/// Threads per block. A multiple of the warp size, as the warp-collective code requires.
+pub const BLOCK_SIZE: u32 = 128;
+
+/// Number of `u64` counters a launch reduces: paths, segments, tracking steps, truncated paths.
+pub const COUNTERS: usize = 4;
+
+/// Paths one regenerationSK launch aims at: enough to hide the tail of the last paths, few enough
+/// that progress is reported a few times a second.
+const PATHS_PER_REGENERATION_LAUNCH: u64 = 1 << 22;
+
+/// One launch: the scene's parameters `P` (a [`SceneAbi::Params`]), the sampling, and the device
+/// buffers the kernel writes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LaunchParams<P> {
+    pub scene: P,
+    /// This launch traces samples `first_sample .. first_sample + samples` of every pixel.
+    pub first_sample: u32,
+    pub samples: u32,
+    pub seed: u32,
+    pub padding: u32,
+    /// `width * height * 3` `f64` sums of the samples' radiance, zeroed before the first launch;
+    /// each launch adds its samples.
+    pub film: u64,
+    /// [`COUNTERS`] `u64` totals (paths, segments, tracking steps, truncated), zeroed before the
+    /// render.
+    pub counters: u64,
+    /// One `u64`, zeroed before the launch: the next path index a persistent thread takes.
+    pub next_path: u64,
+    /// Paths to trace in this launch: `width * height * samples`.
+    pub total_paths: u64,
+}
+
+impl<P: Pod> LaunchParams<P> {
+    /// The scene parameters are a multiple of 8 bytes (see `volpt_core::abi`), so the 48 bytes that
+    /// follow them need no padding.
+    pub const LAYOUT: () = assert!(
+        core::mem::size_of::<P>().is_multiple_of(8)
+            && core::mem::size_of::<Self>() == core::mem::size_of::<P>() + 48
+    );
+
+    /// The launch's bytes, as the host copies them to the device.
+    pub fn as_bytes(&self) -> &[u8] {
+        #[allow(clippy::let_unit_value)]
+        let () = Self::LAYOUT;
+        bytemuck::bytes_of(self)
+    }
+}
+
+// SAFETY: `repr(C)` of `Pod` fields; `LAYOUT` (evaluated by `as_bytes`, the only way the host ships
+// the struct) proves that there is no padding.
+unsafe impl<P: Pod> Zeroable for LaunchParams<P> {}
+// SAFETY: as above.
+unsafe impl<P: Pod> Pod for LaunchParams<P> {}
+
+/// The pixel and sample of path index `index` of a launch over `pixels` pixels from `first_sample`.
+#[inline(always)]
+pub fn path_of(index: u64, pixels: u64, first_sample: u32) -> (u32, u32) {
+    (
+        (index % pixels) as u32,
+        first_sample + (index / pixels) as u32,
+    )
+}
+
+/// The film position of pixel `pixel` of an image `width` pixels wide.
+#[inline(always)]
+pub fn pixel_xy(pixel: u32, width: u32) -> (u32, u32) {
+    (pixel % width, pixel / width)
+}
+
+impl Strategy {
+    /// Samples per pixel that one launch traces, out of the `remaining` samples of a render over
+    /// `pixels` pixels.
+    pub fn samples_per_launch(self, pixels: u64, remaining: u32) -> u32 {
+        match self {
+            // One thread per pixel: several samples per launch would only lengthen the warp's
+            // longest path, so each launch is one sample, and progress is reported per sample.
+            Strategy::NaiveSk => remaining.min(1),
+            Strategy::RegenerationSk => {
+                let fit = (PATHS_PER_REGENERATION_LAUNCH / pixels.max(1)).max(1);
+                remaining.min(u32::try_from(fit).unwrap_or(u32::MAX))
+            }
+        }
+    }
+
+    /// The launches of a render of `spp` samples over `pixels` pixels, as
+    /// `(first_sample, samples)`, in order.
+    pub fn launches(self, pixels: u64, spp: u32) -> impl Iterator<Item = (u32, u32)> {
+        let mut first = 0;
+        core::iter::from_fn(move || {
+            let samples = self.samples_per_launch(pixels, spp - first);
+            (samples > 0).then(|| {
+                let launch = (first, samples);
+                first += samples;
+                launch
+            })
+        })
+    }
+
+    /// Blocks of [`BLOCK_SIZE`] threads one launch needs; `resident_blocks` is how many the GPU
+    /// keeps resident at once for the kernel.
+    pub fn blocks(self, pixels: u64, resident_blocks: u32) -> u32 {
+        match self {
+            Strategy::NaiveSk => pixels.div_ceil(BLOCK_SIZE as u64) as u32,
+            // Persistent threads: exactly as many blocks as the GPU keeps resident.
+            Strategy::RegenerationSk => resident_blocks.max(1),
+        }
+    }
+}

@@ -1,0 +1,30 @@
+//! The GPU side of volpt that host and kernels share, `no_std`.
+//!
+//! - [`launch`]: the launch parameters a kernel receives ([`LaunchParams`]), composed from the
+//!   scene's typed device ABI ([`volpt_core::abi`]), and the scheduling arithmetic of every
+//!   strategy as plain functions (tested on the CPU, used by host and kernels alike).
+//! - [`Strategy`]: the scheduling strategies, generated from one list with their entry names.
+//! - [`export_kernels!`]: exports the kernels of every strategy for one scene type. The workspace's
+//!   kernels crate invokes it for every variant of the registry; a library user invokes it for a
+//!   scene of their own parts (see `docs/extending.md`).
+//! - on nvptx64 only: [`strategy`] (the strategies' kernel bodies) and the PTX intrinsics they use.
+#![no_std]
+#![cfg_attr(
+    target_arch = "nvptx64",
+    feature(abi_ptx, stdarch_nvptx, asm_experimental_arch)
+)]
+
+// The `clap` derive of `Strategy` (a host-only feature) expands to paths through `std`.
+#[cfg(feature = "clap")]
+extern crate std;
+
+pub mod launch;
+mod strategies;
+
+#[cfg(target_arch = "nvptx64")]
+pub mod nvptx;
+#[cfg(target_arch = "nvptx64")]
+pub mod strategy;
+
+pub use launch::LaunchParams;
+pub use strategies::Strategy;

@@ -1,0 +1,94 @@
+//! The scheduling strategies (Novák, Havran & Dachsbacher 2010; the thesis's naiveSK and
+//! regenerationSK), listed once: [`strategies!`](crate::strategies) generates the host's
+//! [`Strategy`] enum and [`export_kernels!`](crate::export_kernels) one kernel per strategy.
+//!
+//! Each entry is `(CamelCase variant, kernel function in `strategy`, command-line name)`; the
+//! function's name is also the prefix of the kernels' entry points.
+
+/// Calls `$callback!` with `$args` and the strategy list.
+#[macro_export]
+macro_rules! strategies {
+    ($callback:path { $($args:tt)* }) => {
+        $callback! { $($args)* strategies [
+            (NaiveSk, naive_sk, "naive-sk")
+            (RegenerationSk, regeneration_sk, "regeneration-sk")
+        ] }
+    };
+}
+
+/// The kernels of every strategy for one scene type `VolumeScene<M, B, P, E>`, exported as
+/// `<strategy>__<m>__<b>__<p>__<e>`: the names must be the parts' `Component::NAME`s, which is how
+/// the host finds the entry point of a scene type.
+///
+/// ```text
+/// volpt_device::export_kernels!(my_fog: MyFog, index_matched: NullBoundary,
+///                               isotropic: Isotropic, constant: ConstantEnvironment);
+/// ```
+#[macro_export]
+macro_rules! export_kernels {
+    ($m:ident: $mt:ty, $b:ident: $bt:ty, $p:ident: $pt:ty, $e:ident: $et:ty $(,)?) => {
+        $crate::strategies! { $crate::export_kernels { @each ($m: $mt, $b: $bt, $p: $pt, $e: $et) } }
+    };
+    (@each ($m:ident: $mt:ty, $b:ident: $bt:ty, $p:ident: $pt:ty, $e:ident: $et:ty)
+     strategies [$(($camel:ident, $s:ident, $cli:literal))*]) => {$(
+        const _: () = {
+            /// # Safety
+            /// `params` must be the device address of an initialised `LaunchParams` for this
+            /// scene type, whose buffers, grids and maps stay allocated until the kernel ends.
+            #[export_name = concat!(stringify!($s), "__", stringify!($m), "__", stringify!($b),
+                "__", stringify!($p), "__", stringify!($e))]
+            pub unsafe extern "ptx-kernel" fn kernel(
+                params: *const $crate::LaunchParams<
+                    <$crate::launch::Scene<$mt, $bt, $pt, $et> as $crate::launch::SceneAbi>::Params,
+                >,
+            ) {
+                // SAFETY: the caller's contract.
+                let lp = unsafe { *params };
+                // SAFETY: the grid and map addresses in `lp` are device allocations the host keeps
+                // alive.
+                let scene = unsafe {
+                    <$crate::launch::Scene<$mt, $bt, $pt, $et> as $crate::launch::SceneAbi>::from_params(&lp.scene)
+                };
+                // SAFETY: `lp`'s buffers are sized for this launch.
+                unsafe { $crate::strategy::$s(&scene, &lp) }
+            }
+        };
+    )*};
+}
+
+macro_rules! define_strategy {
+    (strategies [$(($camel:ident, $s:ident, $cli:literal))*]) => {
+        /// A GPU scheduling strategy: who traces which path, and how results reach the film.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+        pub enum Strategy {
+            $(#[cfg_attr(feature = "clap", value(name = $cli))] $camel,)*
+        }
+
+        impl Strategy {
+            pub const ALL: &'static [Strategy] = &[$(Strategy::$camel),*];
+
+            /// The name users type: `--strategy naive-sk`.
+            pub fn name(self) -> &'static str {
+                match self {
+                    $(Strategy::$camel => $cli,)*
+                }
+            }
+
+            /// The prefix of this strategy's kernel entry points.
+            pub fn entry_prefix(self) -> &'static str {
+                match self {
+                    $(Strategy::$camel => stringify!($s),)*
+                }
+            }
+        }
+    };
+}
+
+strategies!(define_strategy {});
+
+impl core::fmt::Display for Strategy {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.name())
+    }
+}

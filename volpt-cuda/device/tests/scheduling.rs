@@ -1,0 +1,91 @@
+//! The scheduling arithmetic every strategy's host loop and kernel share: across a render's launches,
+//! every `(pixel, sample)` is traced exactly once, for odd image sizes and renders of several launches.
+
+use volpt_device::launch::{path_of, pixel_xy, BLOCK_SIZE};
+use volpt_device::Strategy;
+
+/// How often each `(pixel, sample)` of a `pixels` x `spp` render is traced, as the kernels of
+/// `strategy` map their work onto paths.
+fn coverage(strategy: Strategy, pixels: u64, spp: u32) -> Vec<u32> {
+    let mut seen = vec![0u32; pixels as usize * spp as usize];
+    let mut launches = 0;
+    for (first, samples) in strategy.launches(pixels, spp) {
+        launches += 1;
+        match strategy {
+            // Thread `i` of the launch renders pixel `i`, all of the launch's samples.
+            Strategy::NaiveSk => {
+                let threads = strategy.blocks(pixels, 0) as u64 * BLOCK_SIZE as u64;
+                assert!(threads >= pixels);
+                for thread in 0..threads.min(pixels) {
+                    for sample in first..first + samples {
+                        seen[(sample as u64 * pixels + thread) as usize] += 1;
+                    }
+                }
+            }
+            // Persistent threads take path indices 0 .. total_paths from the global counter.
+            Strategy::RegenerationSk => {
+                for index in 0..pixels * samples as u64 {
+                    let (pixel, sample) = path_of(index, pixels, first);
+                    assert!((pixel as u64) < pixels && sample < spp);
+                    seen[(sample as u64 * pixels + pixel as u64) as usize] += 1;
+                }
+            }
+        }
+    }
+    assert!(launches >= 1);
+    seen
+}
+
+#[test]
+fn every_path_is_traced_once_across_launches() {
+    for &strategy in Strategy::ALL {
+        for pixels in [1, 7, 97 * 61, 1 << 20, (1 << 22) + 3] {
+            for spp in [1, 3, 5] {
+                let seen = coverage(strategy, pixels, spp);
+                assert!(
+                    seen.iter().all(|&n| n == 1),
+                    "{strategy}: {pixels} pixels x {spp} spp: some path traced {:?} times",
+                    seen.iter().find(|&&n| n != 1)
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn regeneration_splits_large_renders_into_several_launches() {
+    let launches: Vec<_> = Strategy::RegenerationSk.launches(160_000, 100).collect();
+    assert_eq!(launches[0], (0, 26));
+    assert_eq!(launches.len(), 4);
+    assert_eq!(launches.last(), Some(&(78, 22)));
+    // One path per launch at least, even for films larger than a launch's budget.
+    assert_eq!(Strategy::RegenerationSk.samples_per_launch(1 << 30, 100), 1);
+    assert_eq!(Strategy::RegenerationSk.samples_per_launch(1, 7), 7);
+    assert_eq!(Strategy::NaiveSk.launches(5, 3).count(), 3);
+    assert_eq!(Strategy::NaiveSk.launches(5, 0).count(), 0);
+}
+
+#[test]
+fn launch_grids_fit_the_strategy() {
+    assert_eq!(Strategy::NaiveSk.blocks(129, 1000), 2);
+    assert_eq!(Strategy::NaiveSk.blocks(128, 1000), 1);
+    assert_eq!(Strategy::RegenerationSk.blocks(1 << 20, 264), 264);
+    assert_eq!(Strategy::RegenerationSk.blocks(1 << 20, 0), 1);
+}
+
+#[test]
+fn pixels_are_row_major() {
+    assert_eq!(pixel_xy(0, 7), (0, 0));
+    assert_eq!(pixel_xy(6, 7), (6, 0));
+    assert_eq!(pixel_xy(7, 7), (0, 1));
+    assert_eq!(pixel_xy(7 * 5 + 3, 7), (3, 5));
+}
+
+#[test]
+fn strategy_names_are_the_kernels_prefixes() {
+    assert_eq!(Strategy::NaiveSk.name(), "naive-sk");
+    assert_eq!(Strategy::RegenerationSk.entry_prefix(), "regeneration_sk");
+    for s in Strategy::ALL {
+        assert_eq!(s.name().replace('-', "_"), s.entry_prefix());
+    }
+}
