@@ -68,6 +68,42 @@ for entry in "${SCENES[@]}"; do
     done
 done
 
+# A library user's own medium (examples/smooth-ball) through its own kernels crate: the GPU's
+# naive-sk image equals the CPU's bit for bit, regeneration-sk up to the order of its sums.
+SB="bin/smooth-ball --spp 8"
+if $SB "$OUT/smooth-ball-cpu.exr" >"$OUT/smooth-ball-cpu.log" 2>&1; then
+    for s in "${STRATEGIES[@]}"; do
+        if $SB "$OUT/smooth-ball-$s.exr" --cuda --strategy "$s" --ptx smooth_ball_kernels.ptx \
+            >"$OUT/smooth-ball-$s.log" 2>&1; then
+            if [ "$s" = naive-sk ]; then tol=--identical; else tol="--max-relative 1e-6"; fi
+            # shellcheck disable=SC2086
+            check "smooth-ball-cpu-vs-$s" "$VOLPT" compare "$OUT/smooth-ball-cpu.exr" "$OUT/smooth-ball-$s.exr" $tol
+        else
+            log "FAIL smooth-ball $s: $(tail -n 2 "$OUT/smooth-ball-$s.log" | tr '\n' ' ')"; failures=$((failures + 1))
+        fi
+    done
+else
+    log "FAIL smooth-ball cpu render"; failures=$((failures + 1))
+fi
+
+# What specialisation saves (docs/effects.md): each scene specialised and with --general, GPU and CPU.
+if [ -n "${EFFECTS:-}" ]; then
+    for entry in "${SCENES[@]}"; do
+        IFS=: read -r name file params <<<"$entry"
+        for variant in specialised general; do
+            flag=""; [ "$variant" = general ] && flag=--general
+            # shellcheck disable=SC2086
+            "$VOLPT" bench "$file" $params $flag --backend cuda --trials 3 --json \
+                >"$OUT/effects-$name-$variant-gpu.json" 2>/dev/null || { log "FAIL effects $name $variant gpu"; failures=$((failures + 1)); }
+            # shellcheck disable=SC2086
+            "$VOLPT" bench "$file" $params $flag --resolution 100x100 --spp 8 --trials 2 --json \
+                >"$OUT/effects-$name-$variant-cpu.json" 2>/dev/null || { log "FAIL effects $name $variant cpu"; failures=$((failures + 1)); }
+            log "effects $name $variant: gpu $(grep -E '"(variant|time_median_s)"' "$OUT/effects-$name-$variant-gpu.json" | tr -d ' \n') cpu $(grep -E '"time_median_s"' "$OUT/effects-$name-$variant-cpu.json" | tr -d ' \n')"
+        done
+    done
+    (cd "$OUT" && tar czf effects.tar.gz ./effects-*.json && rm -f ./effects-*.json)
+fi
+
 for s in "${STRATEGIES[@]}"; do
     check "memcheck-$s" compute-sanitizer --tool memcheck --error-exitcode 1 \
         "$VOLPT" render scenes/cgg-logo/scene.xml -Dresolution=64 --spp 2 --backend cuda --strategy "$s" \

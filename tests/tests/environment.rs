@@ -51,7 +51,7 @@ fn wavy_map() -> LatLongDesc {
 }
 
 #[test]
-fn variant_names_the_envmap_only_for_lat_long() {
+fn variant_names_the_environment() {
     let mut desc = cube_scene(
         4,
         4,
@@ -65,14 +65,14 @@ fn variant_names_the_envmap_only_for_lat_long() {
     );
     assert_eq!(
         Variant::of(&desc).to_string(),
-        "homogeneous/rough-dielectric/hg"
+        "homogeneous/rough_dielectric/henyey_greenstein/constant"
     );
     desc.environment = EnvironmentDesc::LatLong(wavy_map());
     let variant = Variant::of(&desc);
     assert_eq!(variant.environment, EnvironmentKind::LatLong);
     assert_eq!(
         variant.to_string(),
-        "homogeneous/rough-dielectric/hg/envmap"
+        "homogeneous/rough_dielectric/henyey_greenstein/lat_long"
     );
 }
 

@@ -8,7 +8,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use volpt_core::PathSettings;
 use volpt_cuda::{CudaRenderer, Strategy};
 use volpt_render::{
-    render, with_scene, Image, RenderOptions, RenderScene, RenderStats, SceneVisitor,
+    render, with_scene_as, Effects, Image, RenderOptions, RenderScene, RenderStats, SceneVisitor,
 };
 use volpt_scene::SceneDescription;
 
@@ -25,6 +25,8 @@ pub struct RenderJob<'a> {
     pub desc: &'a SceneDescription,
     pub settings: PathSettings,
     pub options: RenderOptions,
+    /// Specialised to the scene's effects, or the general variant (`--general`).
+    pub effects: Effects,
     pub show_progress: bool,
 }
 
@@ -81,7 +83,7 @@ impl Backend {
             options: job.options,
             progress: progress_bar(job.show_progress),
         };
-        with_scene(job.desc, job.settings, visitor)
+        with_scene_as(job.desc, job.settings, job.effects, visitor)
     }
 }
 

@@ -3,17 +3,27 @@
 use std::fmt::Write;
 use std::path::Path;
 
-use volpt_render::Variant;
+use volpt_render::factory::{Effects, Parts};
 use volpt_scene::{
     AlbedoDesc, BsdfDesc, DensityDesc, EnvironmentDesc, GridDesc, PhaseDesc, SceneDescription,
 };
 
-pub fn describe(path: &Path, desc: &SceneDescription) -> String {
+pub fn describe(path: &Path, desc: &SceneDescription, effects: Effects) -> String {
     let mut s = String::new();
     let b = &desc.boundary.bounds;
     let m = &desc.medium;
     let _ = writeln!(s, "scene      {}", path.display());
-    let _ = writeln!(s, "variant    {}", Variant::of(desc));
+    let parts = Parts::of(desc, effects);
+    let _ = writeln!(s, "variant    {}", parts.variant());
+    if effects == Effects::General {
+        let _ = writeln!(
+            s,
+            "           (--general: every axis at its most general part)"
+        );
+    }
+    for rule in &parts.simplifications {
+        let _ = writeln!(s, "           specialised: {rule}");
+    }
     let _ = writeln!(
         s,
         "film       {}x{}, {} spp",

@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand};
 use tracing_subscriber::EnvFilter;
+use volpt_render::factory::{Effects, Parts};
 use volpt_render::image::preview_path;
 use volpt_render::{path_settings, Image, RenderOptions, RenderStats, Variant};
 use volpt_scene::{Config, SceneAssembler, SceneDescription};
@@ -86,9 +87,21 @@ struct SceneArgs {
     /// Depth from which Russian roulette starts, Mitsuba's rr_depth; -1 disables it.
     #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(i64).range(-1..=u32::MAX as i64))]
     rr_depth: Option<i64>,
+    /// Render with the most general variant (grid density and albedo, Henyey-Greenstein, lat-long
+    /// map) instead of the one specialised to the scene's effects: what specialisation saves.
+    #[arg(long)]
+    general: bool,
 }
 
 impl SceneArgs {
+    fn effects(&self) -> Effects {
+        if self.general {
+            Effects::General
+        } else {
+            Effects::Specialised
+        }
+    }
+
     /// The command line's part of the scene, for the assembler.
     fn config(&self) -> Config {
         Config {
@@ -176,7 +189,7 @@ fn main() -> Result<()> {
         Command::Bench(args) => bench_command(args),
         Command::Info(args) => {
             let desc = load(&args)?;
-            print!("{}", info::describe(&args.scene, &desc));
+            print!("{}", info::describe(&args.scene, &desc, args.effects()));
             Ok(())
         }
         Command::Scene(SceneCommand::Export { scene, out, name }) => {
@@ -235,10 +248,11 @@ fn render_command(args: RenderArgs) -> Result<()> {
         desc: &desc,
         settings: path_settings(&desc),
         options: options(&desc, &args.sampling)?,
+        effects: args.scene.effects(),
         show_progress: true,
     };
     let backend = Backend::open(args.sampling.backend, args.sampling.strategy)?;
-    let variant = Variant::of(&desc);
+    let variant = Parts::of(&desc, job.effects).variant();
     tracing::info!(
         scene = %args.scene.scene.display(),
         %variant,
@@ -293,6 +307,7 @@ fn bench_command(args: BenchArgs) -> Result<()> {
         desc: &desc,
         settings: path_settings(&desc),
         options: options(&desc, &args.sampling)?,
+        effects: args.scene.effects(),
         show_progress: false,
     };
     let backend = Backend::open(args.sampling.backend, args.sampling.strategy)?;
@@ -320,7 +335,7 @@ fn bench_command(args: BenchArgs) -> Result<()> {
         backend: format!("{:?}", args.sampling.backend).to_lowercase(),
         strategy: backend.strategy().map(|s| s.name().to_owned()),
         device: backend.device_name(),
-        variant: Variant::of(&desc).to_string(),
+        variant: Parts::of(&desc, job.effects).variant().to_string(),
         width: image.width,
         height: image.height,
         spp: job.options.spp,

@@ -75,7 +75,7 @@ fn info_names_the_variant() {
     assert!(out.status.success(), "{}", stderr(&out));
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
-        stdout.contains("homogeneous/rough-dielectric/hg"),
+        stdout.contains("homogeneous/rough_dielectric/henyey_greenstein/constant"),
         "{stdout}"
     );
 }

@@ -137,8 +137,9 @@ pub struct Variant {
 }
 
 impl Variant {
+    /// The variant the factory picks for `desc` (specialised).
     pub fn of(desc: &SceneDescription) -> Self {
-        Parts::of(desc).variant()
+        Parts::of(desc, Effects::Specialised).variant()
     }
 }
 
@@ -155,22 +156,100 @@ impl fmt::Display for Variant {
     }
 }
 
+/// How the factory chooses parts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Effects {
+    /// Simulate only the effects the scene calls for: a value that makes an effect trivial selects
+    /// the simpler part ([`Simplification`]).
+    #[default]
+    Specialised,
+    /// The most general part of every axis that represents the scene exactly: grid density and
+    /// albedo, Henyey-Greenstein, a lat-long map. The boundary stays as described: no other boundary
+    /// equals an index-matched or a smooth one exactly. For measuring what specialisation saves.
+    General,
+}
+
+/// A rule that made the factory pick a simpler part than the description names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Simplification {
+    /// A density grid with one value everywhere, covering the medium's box, is a constant
+    /// extinction: homogeneous with a constant albedo, a one-voxel density grid beside an albedo grid.
+    ConstantDensityGrid,
+    /// An albedo grid with one value everywhere, covering the medium's box, is a constant albedo.
+    ConstantAlbedoGrid,
+    /// Henyey-Greenstein with g = 0 is isotropic.
+    ZeroAsymmetry,
+    /// A smooth dielectric with relative IOR exactly 1 neither reflects nor bends: index-matched.
+    /// Only where depth is not counted (unlimited max_depth, no roulette), because a dielectric
+    /// crossing counts as an interaction and an index-matched one does not.
+    UnitIorRatio,
+}
+
+impl fmt::Display for Simplification {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Simplification::ConstantDensityGrid => {
+                "the density grid has one value over the whole box: constant extinction"
+            }
+            Simplification::ConstantAlbedoGrid => {
+                "the albedo grid has one value over the whole box: constant albedo"
+            }
+            Simplification::ZeroAsymmetry => "Henyey-Greenstein with g = 0: isotropic phase",
+            Simplification::UnitIorRatio => {
+                "dielectric with IOR ratio 1, depth not limited: index-matched boundary"
+            }
+        })
+    }
+}
+
 /// The four variant parts of a scene, built from its description.
 pub struct Parts<'a> {
     pub medium: MediumPart<'a>,
     pub boundary: BoundaryPart,
     pub phase: PhasePart,
     pub environment: EnvironmentPart<'a>,
+    /// The rules that made a part simpler than the description names, in axis order.
+    pub simplifications: Vec<Simplification>,
 }
 
 impl<'a> Parts<'a> {
     /// Reads each axis of the description once; the parts borrow their grids from `desc`.
-    pub fn of(desc: &'a SceneDescription) -> Self {
+    pub fn of(desc: &'a SceneDescription, effects: Effects) -> Self {
+        let mut simplifications = Vec::new();
+        let mut fired = |rule| simplifications.push(rule);
+        let (medium, boundary, phase, environment) = match effects {
+            Effects::Specialised => (
+                medium(desc, &mut fired),
+                boundary(desc, &mut fired),
+                phase(&desc.medium.phase, &mut fired),
+                environment(&desc.environment),
+            ),
+            Effects::General => (
+                MediumPart::GridDensityAlbedo(general_medium(desc)),
+                boundary(desc, &mut |_| ()),
+                PhasePart::HenyeyGreenstein(match desc.medium.phase {
+                    PhaseDesc::Isotropic => HenyeyGreenstein { g: 0.0 },
+                    PhaseDesc::HenyeyGreenstein { g } => HenyeyGreenstein { g },
+                }),
+                EnvironmentPart::LatLong(match &desc.environment {
+                    EnvironmentDesc::Constant(rgb) => LatLongEnvironment::new(
+                        rgb,
+                        1,
+                        1,
+                        LatLongRows::CellCentred,
+                        [Vec3::X, Vec3::Y, Vec3::Z],
+                        1.0,
+                    ),
+                    EnvironmentDesc::LatLong(map) => lat_long(map),
+                }),
+            ),
+        };
         Self {
-            medium: medium(desc),
-            boundary: boundary(&desc.boundary.bsdf),
-            phase: phase(&desc.medium.phase),
-            environment: environment(&desc.environment),
+            medium,
+            boundary,
+            phase,
+            environment,
+            simplifications,
         }
     }
 
@@ -191,11 +270,21 @@ struct Shared {
     settings: PathSettings,
 }
 
-/// Builds the scene that `desc` describes, with `settings` for the integrator, and hands it to
-/// `visitor`. The scene borrows its grids from `desc`.
+/// Builds the scene that `desc` describes, with `settings` for the integrator, specialised to its
+/// effects, and hands it to `visitor`. The scene borrows its grids from `desc`.
 pub fn with_scene<V: SceneVisitor>(
     desc: &SceneDescription,
     settings: PathSettings,
+    visitor: V,
+) -> V::Output {
+    with_scene_as(desc, settings, Effects::Specialised, visitor)
+}
+
+/// [`with_scene`], choosing parts as `effects` says.
+pub fn with_scene_as<V: SceneVisitor>(
+    desc: &SceneDescription,
+    settings: PathSettings,
+    effects: Effects,
     visitor: V,
 ) -> V::Output {
     let shared = Shared {
@@ -203,51 +292,126 @@ pub fn with_scene<V: SceneVisitor>(
         bounds: aabb(&desc.boundary.bounds),
         settings,
     };
-    dispatch(shared, Parts::of(desc), visitor)
+    dispatch(shared, Parts::of(desc, effects), visitor)
 }
 
-fn medium(desc: &SceneDescription) -> MediumPart<'_> {
+/// The one value of `grid` per channel, if it has a single value everywhere and covers `bounds`
+/// (outside its own box a grid is zero, so a smaller grid is not constant over the medium).
+fn uniform<'g>(grid: &'g GridDesc, bounds: &Bounds) -> Option<&'g [f32]> {
+    let covers =
+        (0..3).all(|i| grid.bounds.min[i] <= bounds.min[i] && grid.bounds.max[i] >= bounds.max[i]);
+    let channels = grid.channels as usize;
+    let first = grid.data.get(..channels)?;
+    let same = grid.data.chunks_exact(channels).all(|v| v == first);
+    (covers && same).then_some(first)
+}
+
+fn medium<'a>(desc: &'a SceneDescription, fired: &mut dyn FnMut(Simplification)) -> MediumPart<'a> {
     let medium = &desc.medium;
-    match (&medium.density, &medium.albedo) {
-        (DensityDesc::Constant(density), AlbedoDesc::Constant(albedo)) => {
+    let bounds = &desc.boundary.bounds;
+    let density = match &medium.density {
+        DensityDesc::Grid(grid) => match uniform(grid, bounds) {
+            Some(value) => {
+                fired(Simplification::ConstantDensityGrid);
+                Density::Constant(&value[0])
+            }
+            None => Density::Grid(grid),
+        },
+        DensityDesc::Constant(sigma) => Density::Constant(sigma),
+    };
+    let albedo = match &medium.albedo {
+        AlbedoDesc::Grid(grid) => match uniform(grid, bounds) {
+            Some(value) => {
+                fired(Simplification::ConstantAlbedoGrid);
+                Albedo::Constant([value[0], value[1], value[2]])
+            }
+            None => Albedo::Grid(grid),
+        },
+        AlbedoDesc::Constant(rgb) => Albedo::Constant(*rgb),
+    };
+    match (density, albedo) {
+        (Density::Constant(density), Albedo::Constant(albedo)) => {
             MediumPart::Homogeneous(HomogeneousMedium {
                 sigma_t: medium.scale * density,
-                albedo: Spectrum::from_array(*albedo),
+                albedo: Spectrum::from_array(albedo),
             })
         }
-        (DensityDesc::Grid(density), AlbedoDesc::Constant(albedo)) => {
-            MediumPart::GridDensity(GridMedium {
-                density: grid::<1>(density),
-                scale: medium.scale,
-                majorant: medium.scale * density.max_value(),
-                albedo: ConstantAlbedo(Spectrum::from_array(*albedo)),
-            })
-        }
-        (density, AlbedoDesc::Grid(albedo)) => {
-            let density = match density {
-                DensityDesc::Grid(density) => grid::<1>(density),
-                // A constant extinction under an albedo grid is rare: it becomes a one-voxel grid
-                // over the medium's box.
-                DensityDesc::Constant(sigma) => {
-                    let bounds = aabb(&desc.boundary.bounds);
-                    let mapping = GridMapping::cell_centred(bounds, [1, 1, 1]);
-                    Grid::new(std::slice::from_ref(sigma), [1, 1, 1], mapping)
-                }
-            };
-            let max_density = density.data.iter().copied().fold(0.0, f32::max);
-            MediumPart::GridDensityAlbedo(GridMedium {
-                density,
-                scale: medium.scale,
-                majorant: medium.scale * max_density,
-                albedo: GridAlbedo(grid::<3>(albedo)),
-            })
+        (Density::Grid(density), Albedo::Constant(albedo)) => MediumPart::GridDensity(GridMedium {
+            density: grid::<1>(density),
+            scale: medium.scale,
+            majorant: medium.scale * density.max_value(),
+            albedo: ConstantAlbedo(Spectrum::from_array(albedo)),
+        }),
+        (density, Albedo::Grid(albedo)) => {
+            MediumPart::GridDensityAlbedo(grid_medium(desc, density, GridAlbedo(grid::<3>(albedo))))
         }
     }
 }
 
-fn boundary(bsdf: &BsdfDesc) -> BoundaryPart {
-    match *bsdf {
+/// The medium as grids of density and albedo, whatever the description holds: constants become
+/// one-voxel grids over the medium's box, whose trilinear lookup is that constant everywhere.
+fn general_medium(desc: &SceneDescription) -> GridMedium<'_, GridAlbedo<'_>> {
+    let medium = &desc.medium;
+    let density = match &medium.density {
+        DensityDesc::Grid(grid) => Density::Grid(grid),
+        DensityDesc::Constant(sigma) => Density::Constant(sigma),
+    };
+    let albedo = match &medium.albedo {
+        AlbedoDesc::Grid(albedo) => grid::<3>(albedo),
+        AlbedoDesc::Constant(rgb) => one_voxel(desc, rgb),
+    };
+    grid_medium(desc, density, GridAlbedo(albedo))
+}
+
+/// A medium's density as the description has it, before it becomes a part.
+enum Density<'a> {
+    Constant(&'a f32),
+    Grid(&'a GridDesc),
+}
+
+enum Albedo<'a> {
+    Constant([f32; 3]),
+    Grid(&'a GridDesc),
+}
+
+/// A grid medium with `albedo`; a constant density becomes a one-voxel grid over the medium's box.
+fn grid_medium<'a>(
+    desc: &'a SceneDescription,
+    density: Density<'a>,
+    albedo: GridAlbedo<'a>,
+) -> GridMedium<'a, GridAlbedo<'a>> {
+    let density = match density {
+        Density::Grid(density) => grid::<1>(density),
+        Density::Constant(sigma) => one_voxel(desc, std::slice::from_ref(sigma)),
+    };
+    let max_density = density.data.iter().copied().fold(0.0, f32::max);
+    GridMedium {
+        density,
+        scale: desc.medium.scale,
+        majorant: desc.medium.scale * max_density,
+        albedo,
+    }
+}
+
+/// A one-voxel grid of `value` (its channels) over the medium's box.
+fn one_voxel<'a, const C: usize>(desc: &SceneDescription, value: &'a [f32]) -> Grid<'a, C> {
+    let bounds = aabb(&desc.boundary.bounds);
+    Grid::new(
+        value,
+        [1, 1, 1],
+        GridMapping::cell_centred(bounds, [1, 1, 1]),
+    )
+}
+
+fn boundary(desc: &SceneDescription, fired: &mut dyn FnMut(Simplification)) -> BoundaryPart {
+    let depth_not_counted =
+        desc.integrator.max_depth.is_none() && desc.integrator.rr_depth.is_none();
+    match desc.boundary.bsdf {
         BsdfDesc::Null => BoundaryPart::IndexMatched(NullBoundary),
+        BsdfDesc::Dielectric { int_ior, ext_ior } if int_ior == ext_ior && depth_not_counted => {
+            fired(Simplification::UnitIorRatio);
+            BoundaryPart::IndexMatched(NullBoundary)
+        }
         BsdfDesc::Dielectric { int_ior, ext_ior } => {
             BoundaryPart::SmoothDielectric(SmoothDielectric {
                 eta: int_ior / ext_ior,
@@ -264,9 +428,13 @@ fn boundary(bsdf: &BsdfDesc) -> BoundaryPart {
     }
 }
 
-fn phase(phase: &PhaseDesc) -> PhasePart {
+fn phase(phase: &PhaseDesc, fired: &mut dyn FnMut(Simplification)) -> PhasePart {
     match *phase {
         PhaseDesc::Isotropic => PhasePart::Isotropic(Isotropic),
+        PhaseDesc::HenyeyGreenstein { g: 0.0 } => {
+            fired(Simplification::ZeroAsymmetry);
+            PhasePart::Isotropic(Isotropic)
+        }
         PhaseDesc::HenyeyGreenstein { g } => PhasePart::HenyeyGreenstein(HenyeyGreenstein { g }),
     }
 }

@@ -10,5 +10,7 @@ pub mod cpu;
 pub mod factory;
 
 pub use cpu::{render, RenderError};
-pub use factory::{path_settings, with_scene, RenderScene, SceneVisitor, Variant};
+pub use factory::{
+    path_settings, with_scene, with_scene_as, Effects, RenderScene, SceneVisitor, Variant,
+};
 pub use volpt_film::{image, Film, Image, ImageError, RenderOptions, RenderStats};

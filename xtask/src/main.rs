@@ -1,7 +1,9 @@
 //! Project automation: `cargo xtask <task>`.
 //!
-//! - `ptx`: compiles the GPU kernels (`volpt-cuda/kernels`) with rustc's NVPTX backend and writes
-//!   `volpt-cuda/ptx/volpt_kernels.ptx`, which `volpt-cuda` embeds at its next build.
+//! - `ptx [PACKAGE]`: compiles a kernels crate with rustc's NVPTX backend. By default the workspace's
+//!   (`volpt-kernels`), written to `volpt-cuda/ptx/volpt_kernels.ptx`, which `volpt-cuda` embeds at
+//!   its next build; any other kernels crate of the workspace (a library user's, see
+//!   `docs/extending.md`) to `<its directory>/ptx/<crate>.ptx`.
 //! - `device-bundle`: the PTX, a release `volpt` with it embedded, the scenes, the third-party data
 //!   and the device script, in `bundle/` (git-ignored), ready to carry to the GPU machine.
 
@@ -13,10 +15,13 @@ use anyhow::{bail, Context, Result};
 fn main() -> Result<()> {
     let task = std::env::args().nth(1);
     match task.as_deref() {
-        Some("ptx") => ptx().map(|_| ()),
+        Some("ptx") => {
+            let package = std::env::args().nth(2);
+            ptx(package.as_deref().unwrap_or(KERNELS)).map(|_| ())
+        }
         Some("device-bundle") => device_bundle(),
         _ => {
-            eprintln!("usage: cargo xtask <ptx|device-bundle>");
+            eprintln!("usage: cargo xtask <ptx [PACKAGE]|device-bundle>");
             std::process::exit(2)
         }
     }
@@ -50,12 +55,18 @@ fn ensure_rust_src() -> Result<()> {
     run(Command::new("rustup").args(["component", "add", "rust-src"]))
 }
 
-/// Builds the kernels and returns the path of the PTX.
+/// The workspace's kernels crate, whose PTX `volpt-cuda` embeds.
+const KERNELS: &str = "volpt-kernels";
+
+/// The library-user example's kernels crate (`examples/smooth-ball`), carried to the device too.
+const EXAMPLE_KERNELS: &str = "volpt-example-smooth-ball-kernels";
+
+/// Builds the kernels crate `package` and returns the path of its PTX.
 ///
 /// Stable rustc with `RUSTC_BOOTSTRAP=1` (the `abi_ptx` feature); no linker is needed, because with
 /// fat LTO `--emit=asm` writes the whole linked module as PTX. A separate target directory keeps
 /// host builds from rebuilding `core`.
-fn ptx() -> Result<PathBuf> {
+fn ptx(package: &str) -> Result<PathBuf> {
     ensure_rust_src()?;
     let root = root();
     let target_dir = root.join("target-ptx");
@@ -73,22 +84,51 @@ fn ptx() -> Result<PathBuf> {
             "--target",
             "nvptx64-nvidia-cuda",
         ])
-        .args(["--profile", "nvptx", "-p", "volpt-kernels", "--target-dir"])
+        .args(["--profile", "nvptx", "-p", package, "--target-dir"])
         .arg(&target_dir))?;
-    let built = target_dir.join("nvptx64-nvidia-cuda/nvptx/deps/volpt_kernels.s");
+    let crate_name = package.replace('-', "_");
+    let built = target_dir.join(format!("nvptx64-nvidia-cuda/nvptx/deps/{crate_name}.s"));
     let ptx =
         std::fs::read_to_string(&built).with_context(|| format!("reading {}", built.display()))?;
     let entries = ptx.lines().filter(|l| l.contains(".entry")).count();
     if entries == 0 {
         bail!("{} has no kernel entry points", built.display());
     }
-    let out = root.join("volpt-cuda/ptx/volpt_kernels.ptx");
+    let out = if package == KERNELS {
+        root.join("volpt-cuda/ptx/volpt_kernels.ptx")
+    } else {
+        package_dir(&root, package)?.join(format!("ptx/{crate_name}.ptx"))
+    };
+    if let Some(dir) = out.parent() {
+        std::fs::create_dir_all(dir)?;
+    }
     // Rewrite only on change, so that an unchanged PTX does not rebuild volpt-cuda.
     if std::fs::read_to_string(&out).ok().as_deref() != Some(ptx.as_str()) {
         std::fs::write(&out, &ptx).with_context(|| format!("writing {}", out.display()))?;
     }
     eprintln!("xtask: {} kernels -> {}", entries, out.display());
     Ok(out)
+}
+
+/// The directory of workspace member `package`, from `cargo metadata`.
+fn package_dir(root: &Path, package: &str) -> Result<PathBuf> {
+    let output = Command::new(env!("CARGO"))
+        .current_dir(root)
+        .args(["metadata", "--format-version", "1", "--no-deps"])
+        .output()
+        .context("running cargo metadata")?;
+    let metadata: serde_json::Value = serde_json::from_slice(&output.stdout)?;
+    let manifest = metadata["packages"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .find(|p| p["name"] == package)
+        .and_then(|p| p["manifest_path"].as_str())
+        .with_context(|| format!("{package} is not a package of this workspace"))?;
+    Ok(Path::new(manifest)
+        .parent()
+        .expect("a manifest lives in a directory")
+        .to_owned())
 }
 
 fn copy_dir(from: &Path, to: &Path, skip: &dyn Fn(&Path) -> bool) -> Result<()> {
@@ -111,12 +151,21 @@ fn copy_dir(from: &Path, to: &Path, skip: &dyn Fn(&Path) -> bool) -> Result<()> 
 /// `bundle/`: everything the GPU machine (which has no Rust) needs for `bundle/run.sh`.
 fn device_bundle() -> Result<()> {
     let root = root();
-    let ptx = ptx()?;
+    let example_ptx = ptx(EXAMPLE_KERNELS)?;
+    let ptx = ptx(KERNELS)?;
     run(Command::new(env!("CARGO")).current_dir(&root).args([
         "build",
         "--release",
         "-p",
         "volpt-cli",
+    ]))?;
+    run(Command::new(env!("CARGO")).current_dir(&root).args([
+        "build",
+        "--release",
+        "-p",
+        "volpt-example-smooth-ball",
+        "--example",
+        "render",
     ]))?;
     let bundle = root.join("bundle");
     if bundle.exists() {
@@ -126,9 +175,14 @@ fn device_bundle() -> Result<()> {
     let target =
         std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), PathBuf::from);
     std::fs::copy(target.join("release/volpt"), bundle.join("bin/volpt"))?;
-    // Debug info is most of the binary; the device carries at most 64 MiB.
-    run(Command::new("strip").arg(bundle.join("bin/volpt")))?;
+    std::fs::copy(
+        target.join("release/examples/render"),
+        bundle.join("bin/smooth-ball"),
+    )?;
+    // Debug info is most of the binaries; the device carries at most 64 MiB.
+    run(Command::new("strip").args([bundle.join("bin/volpt"), bundle.join("bin/smooth-ball")]))?;
     std::fs::copy(&ptx, bundle.join("volpt_kernels.ptx"))?;
+    std::fs::copy(&example_ptx, bundle.join("smooth_ball_kernels.ptx"))?;
     // Generated grids are large and are regenerated on the device by `volpt scene generate`.
     copy_dir(&root.join("scenes"), &bundle.join("scenes"), &|p| {
         p.extension().is_some_and(|e| e == "vol")
