@@ -3,7 +3,8 @@
 //! Every message names the file it is about and, for XML, the line; value errors also name the
 //! field and say what was expected and what was found, so that a user can fix the scene without
 //! reading volpt's source. Each variant's message is complete on its own (it includes any
-//! underlying cause), so callers can print it with `{}` alone.
+//! underlying cause), so callers can print it with `{}` alone; the cause is also its `source()`,
+//! for callers that walk the chain.
 
 use std::fmt;
 use std::path::PathBuf;
@@ -16,6 +17,7 @@ pub enum SceneError {
     #[error("{}: {error}", path.display())]
     Io {
         path: PathBuf,
+        #[source]
         error: std::io::Error,
     },
 
@@ -89,6 +91,7 @@ pub enum SceneError {
         path: PathBuf,
         line: usize,
         element: String,
+        #[source]
         error: Box<SceneError>,
     },
 }

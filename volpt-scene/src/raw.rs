@@ -26,8 +26,9 @@ use crate::error::{GridProblem, SceneError};
 /// corrupt or hostile, and is rejected before anything is allocated.
 pub const MAX_VALUES: u64 = 1 << 32;
 
-/// How one value is stored.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// How one value is stored (in TOML scenes: `u8`, `i8`, ... `f64`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum ScalarType {
     I8,
     U8,
@@ -141,9 +142,11 @@ impl ScalarType {
     }
 }
 
-/// Byte order of multi-byte values.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Byte order of multi-byte values (in TOML scenes: `little`, the default, or `big`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum ByteOrder {
+    #[default]
     Little,
     Big,
 }

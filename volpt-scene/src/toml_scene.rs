@@ -47,14 +47,15 @@ pub struct SceneFile {
 pub struct VolumeSpec {
     pub file: String,
     /// `raw`, `metaimage`, `vtk` or `vol`; by default from the extension (`.raw` needs it said).
-    pub format: Option<String>,
+    pub format: Option<VolumeFormat>,
     /// Raw files: voxels per axis.
     pub resolution: Option<[u32; 3]>,
     /// Raw files: `u8`, `i8`, `u16`, `i16`, `u32`, `i32`, `u64`, `i64`, `f32`, `f64`.
     #[serde(rename = "type")]
-    pub scalar: Option<String>,
+    pub scalar: Option<ScalarType>,
     /// Raw files: `little` (default) or `big`.
-    pub byte_order: Option<String>,
+    #[serde(default)]
+    pub byte_order: ByteOrder,
     /// Raw files: bytes to skip before the data.
     #[serde(default)]
     pub header_bytes: u64,
@@ -68,6 +69,39 @@ pub struct VolumeSpec {
     /// Extinction per unit density.
     #[serde(default = "one")]
     pub scale: f32,
+}
+
+/// The grid file's format (`volume.format`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum VolumeFormat {
+    Raw,
+    MetaImage,
+    Vtk,
+    Vol,
+}
+
+/// The boundary's surface (`boundary.bsdf`), named as Mitsuba's plugins.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BsdfKind {
+    Null,
+    Dielectric,
+    /// The thesis's boundary, the default.
+    #[default]
+    RoughDielectric,
+}
+
+/// The image axis the field of view spans (`camera.fov_axis`), as Mitsuba names it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FovAxisName {
+    #[default]
+    X,
+    Y,
+    Smaller,
+    Larger,
+    Diagonal,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -106,8 +140,8 @@ pub struct PhaseSpec {
 #[serde(deny_unknown_fields)]
 pub struct BoundarySpec {
     /// `null` (index-matched), `dielectric` or `roughdielectric` (GGX).
-    #[serde(default = "rough_dielectric")]
-    pub bsdf: String,
+    #[serde(default)]
+    pub bsdf: BsdfKind,
     #[serde(default = "thesis_alpha")]
     pub alpha: f32,
     /// A number or a Mitsuba IOR name (`water`, `air`, ...).
@@ -122,7 +156,7 @@ pub struct BoundarySpec {
 impl Default for BoundarySpec {
     fn default() -> Self {
         Self {
-            bsdf: rough_dielectric(),
+            bsdf: BsdfKind::default(),
             alpha: thesis_alpha(),
             int_ior: thesis_int_ior(),
             ext_ior: thesis_ext_ior(),
@@ -151,8 +185,8 @@ pub struct CameraSpec {
     #[serde(default = "thesis_fov")]
     pub fov: f32,
     /// `x` (default), `y`, `smaller`, `larger` or `diagonal`, as in Mitsuba.
-    #[serde(default = "x_axis")]
-    pub fov_axis: String,
+    #[serde(default)]
+    pub fov_axis: FovAxisName,
 }
 
 impl Default for CameraSpec {
@@ -162,7 +196,7 @@ impl Default for CameraSpec {
             target: [0.0; 3],
             up: y_up(),
             fov: thesis_fov(),
-            fov_axis: x_axis(),
+            fov_axis: FovAxisName::default(),
         }
     }
 }
@@ -236,9 +270,6 @@ impl Default for EnvironmentSpec {
 fn one() -> f32 {
     1.0
 }
-fn rough_dielectric() -> String {
-    "roughdielectric".into()
-}
 fn thesis_alpha() -> f32 {
     0.1
 }
@@ -256,9 +287,6 @@ fn y_up() -> [f32; 3] {
 }
 fn thesis_fov() -> f32 {
     0.7
-}
-fn x_axis() -> String {
-    "x".into()
 }
 fn thesis_resolution() -> u32 {
     400
@@ -283,14 +311,37 @@ fn parse_with_text(path: &Path) -> Result<(SceneFile, String), SceneError> {
         path: path.to_owned(),
         error,
     })?;
-    let file = toml::from_str(&text).map_err(|e| SceneError::Toml {
-        path: path.to_owned(),
-        line: e
-            .span()
-            .map_or(1, |span| text[..span.start].matches('\n').count() + 1),
-        message: e.message().to_owned(),
+    let file = toml::from_str(&text).map_err(|e| {
+        let start = e.span().map(|span| span.start);
+        SceneError::Toml {
+            path: path.to_owned(),
+            line: start.map_or(1, |start| text[..start].matches('\n').count() + 1),
+            // serde names the wrong value (an unknown variant, a wrong type) but not its key.
+            message: match start.and_then(|start| field_at(&text, start)) {
+                Some(field) => format!("{field}: {}", e.message()),
+                None => e.message().to_owned(),
+            },
+        }
     })?;
     Ok((file, text))
+}
+
+/// The `table.key` whose value stands at byte `offset` of a TOML text: the key on that line, in
+/// the last `[table]` above it.
+fn field_at(text: &str, offset: usize) -> Option<String> {
+    let line_start = text[..offset].rfind('\n').map_or(0, |i| i + 1);
+    let line = &text[line_start..];
+    let (key, _) = line.split_once('=')?;
+    let key = key.trim();
+    let table = text[..line_start]
+        .lines()
+        .rev()
+        .map(str::trim)
+        .find_map(|l| l.strip_prefix('[')?.strip_suffix(']'));
+    Some(match table {
+        Some(table) => format!("{}.{key}", table.trim()),
+        None => key.to_owned(),
+    })
 }
 
 /// The file being loaded, for error messages: value errors point at the line of their key.
@@ -359,7 +410,7 @@ pub fn load_volume_only(
             format: None,
             resolution: None,
             scalar: None,
-            byte_order: None,
+            byte_order: ByteOrder::Little,
             header_bytes: 0,
             bounds: None,
             array: None,
@@ -429,13 +480,13 @@ fn assemble(
             named_ior(name).ok_or_else(|| cx.invalid(field, "a number or a Mitsuba IOR name", name))
         }
     };
-    let bsdf = match b.bsdf.as_str() {
-        "null" => BsdfDesc::Null,
-        "dielectric" => BsdfDesc::Dielectric {
+    let bsdf = match b.bsdf {
+        BsdfKind::Null => BsdfDesc::Null,
+        BsdfKind::Dielectric => BsdfDesc::Dielectric {
             int_ior: ior(&b.int_ior, "boundary.int_ior")?,
             ext_ior: ior(&b.ext_ior, "boundary.ext_ior")?,
         },
-        "roughdielectric" => {
+        BsdfKind::RoughDielectric => {
             if !(b.alpha.is_finite() && b.alpha > 0.0) {
                 return Err(cx.invalid("boundary.alpha", "a positive roughness", b.alpha));
             }
@@ -445,13 +496,6 @@ fn assemble(
                 ext_ior: ior(&b.ext_ior, "boundary.ext_ior")?,
             }
         }
-        other => {
-            return Err(cx.invalid(
-                "boundary.bsdf",
-                "null, dielectric or roughdielectric",
-                other,
-            ))
-        }
     };
     let bounds = match b.bounds {
         Some(box_) => checked_box(cx, "boundary.bounds", box_)?,
@@ -459,19 +503,12 @@ fn assemble(
     };
 
     let c = &file.camera;
-    let fov_axis = match c.fov_axis.as_str() {
-        "x" => FovAxis::X,
-        "y" => FovAxis::Y,
-        "smaller" => FovAxis::Smaller,
-        "larger" => FovAxis::Larger,
-        "diagonal" => FovAxis::Diagonal,
-        other => {
-            return Err(cx.invalid(
-                "camera.fov_axis",
-                "x, y, smaller, larger or diagonal",
-                other,
-            ))
-        }
+    let fov_axis = match c.fov_axis {
+        FovAxisName::X => FovAxis::X,
+        FovAxisName::Y => FovAxis::Y,
+        FovAxisName::Smaller => FovAxis::Smaller,
+        FovAxisName::Larger => FovAxis::Larger,
+        FovAxisName::Diagonal => FovAxis::Diagonal,
     };
     if !(c.fov > 0.0 && c.fov < 180.0) {
         return Err(cx.invalid("camera.fov", "degrees in (0, 180)", c.fov));
@@ -581,11 +618,11 @@ fn read_volume(cx: &Cx<'_>, file: &Path, v: &VolumeSpec) -> Result<GridDesc, Sce
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
-    let format = match (&v.format, extension.as_deref()) {
-        (Some(f), _) => f.as_str(),
-        (None, Some("mha" | "mhd")) => "metaimage",
-        (None, Some("vtk" | "vti")) => "vtk",
-        (None, Some("vol")) => "vol",
+    let format = match (v.format, extension.as_deref()) {
+        (Some(f), _) => f,
+        (None, Some("mha" | "mhd")) => VolumeFormat::MetaImage,
+        (None, Some("vtk" | "vti")) => VolumeFormat::Vtk,
+        (None, Some("vol")) => VolumeFormat::Vol,
         (None, _) => {
             return Err(cx.invalid(
                 "volume.format",
@@ -599,41 +636,27 @@ fn read_volume(cx: &Cx<'_>, file: &Path, v: &VolumeSpec) -> Result<GridDesc, Sce
         .map(|b| checked_box(cx, "volume.bounds", b))
         .transpose()?;
     let mut grid = match format {
-        "raw" => {
+        VolumeFormat::Raw => {
             let resolution = v
                 .resolution
                 .ok_or_else(|| cx.missing("resolution = [x, y, z]"))?;
-            let scalar = match v.scalar.as_deref() {
-                Some(name) => ScalarType::ALL
-                    .into_iter()
-                    .find(|s| s.name() == name)
-                    .ok_or_else(|| {
-                        cx.invalid(
-                            "volume.type",
-                            "u8, i8, u16, i16, u32, i32, u64, i64, f32 or f64",
-                            name,
-                        )
-                    })?,
+            let scalar = match v.scalar {
+                Some(scalar) => scalar,
                 None => return Err(cx.missing("type (e.g. \"u8\")")),
-            };
-            let byte_order = match v.byte_order.as_deref() {
-                None | Some("little") => ByteOrder::Little,
-                Some("big") => ByteOrder::Big,
-                Some(other) => return Err(cx.invalid("volume.byte_order", "little or big", other)),
             };
             let bounds = bounds.ok_or_else(|| cx.missing("bounds = [[min], [max]]"))?;
             let layout = RawLayout {
                 resolution,
                 channels: 1,
                 scalar,
-                byte_order,
+                byte_order: v.byte_order,
                 header_bytes: v.header_bytes,
             };
             return read_raw(file, &layout, bounds);
         }
-        "metaimage" => read_metaimage(file)?,
-        "vtk" => read_vtk(file, v.array.as_deref())?,
-        "vol" => {
+        VolumeFormat::MetaImage => read_metaimage(file)?,
+        VolumeFormat::Vtk => read_vtk(file, v.array.as_deref())?,
+        VolumeFormat::Vol => {
             let vol = read_vol(file)?;
             vol.check_density(file)?;
             GridDesc {
@@ -645,7 +668,6 @@ fn read_volume(cx: &Cx<'_>, file: &Path, v: &VolumeSpec) -> Result<GridDesc, Sce
                 data: vol.data,
             }
         }
-        other => return Err(cx.invalid("volume.format", "raw, metaimage, vtk or vol", other)),
     };
     if grid.channels != 1 {
         return Err(cx.invalid(
