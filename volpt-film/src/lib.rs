@@ -4,13 +4,16 @@
 //! - [`image`]: the image ([`Image`]) and its files (OpenEXR, PNG preview).
 //! - [`RenderStats`]: time and path counters, with the throughputs reported from them.
 //! - [`RenderOptions`]: how many samples, with which seed.
+//! - [`checkpoint`]: a render's sums saved to a file, to resume it bit for bit.
 
+pub mod checkpoint;
 pub mod image;
 
 use std::time::Duration;
 
 use volpt_core::PathCounters;
 
+pub use checkpoint::{Checkpoint, CheckpointError};
 pub use image::{preview_path, Image, ImageError};
 
 /// How many samples per pixel to trace, with which seed: the same seed gives the same paths on

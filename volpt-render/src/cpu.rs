@@ -5,6 +5,7 @@
 //! a pixel's samples are traced and summed by the core's `sample_pixel`, the very loop the GPU's
 //! naive strategy runs, so that the two agree bit for bit.
 
+use std::ops::Range;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
@@ -36,28 +37,47 @@ pub fn render<S: Scene + Sync>(
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> Result<(Image, RenderStats), RenderError> {
     let (width, height) = (scene.camera().width, scene.camera().height);
-    if width == 0 || height == 0 || options.spp == 0 {
+    let mut film = Film::new(width, height);
+    let stats = render_samples(scene, &mut film, 0..options.spp, options, progress)?;
+    Ok((film.image(options.spp), stats))
+}
+
+/// Adds samples `samples` of every pixel to `film` (which holds the samples before them, for a
+/// resumed render), calling `progress(done, total)` with counts of this call's samples.
+pub fn render_samples<S: Scene + Sync>(
+    scene: &S,
+    film: &mut Film,
+    samples: Range<u32>,
+    options: &RenderOptions,
+    progress: &(dyn Fn(u64, u64) + Sync),
+) -> Result<RenderStats, RenderError> {
+    let (width, height) = (scene.camera().width, scene.camera().height);
+    if width == 0 || height == 0 || samples.is_empty() {
         return Err(RenderError::Empty {
             width,
             height,
-            spp: options.spp,
+            spp: samples.len() as u32,
         });
     }
+    assert_eq!(
+        (film.width, film.height),
+        (width, height),
+        "the film must be the camera's"
+    );
     let threads = options.threads.unwrap_or(0);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .map_err(|source| RenderError::ThreadPool { threads, source })?;
 
-    let mut film = Film::new(width, height);
-    let total = width as u64 * height as u64 * options.spp as u64;
+    let total = width as u64 * height as u64 * samples.len() as u64;
     let done = AtomicU64::new(0);
     let start = Instant::now();
     let counters = pool.install(|| {
         let mut counters = PathCounters::default();
-        let mut first = 0;
-        while first < options.spp {
-            let samples = first..(first + SAMPLES_PER_PASS).min(options.spp);
+        let mut first = samples.start;
+        while first < samples.end {
+            let pass_samples = first..(first + SAMPLES_PER_PASS).min(samples.end);
             let pass = film
                 .sums
                 .par_chunks_mut(width as usize)
@@ -66,20 +86,21 @@ pub fn render<S: Scene + Sync>(
                     let mut row_counters = PathCounters::default();
                     for (x, sum) in row.iter_mut().enumerate() {
                         let pixel = (x as u32, y as u32);
-                        let seed = options.seed;
-                        sample_pixel(scene, pixel, samples.clone(), seed, sum, &mut row_counters);
+                        let (range, seed) = (pass_samples.clone(), options.seed);
+                        sample_pixel(scene, pixel, range, seed, sum, &mut row_counters);
                     }
-                    let n = done.fetch_add(width as u64 * samples.len() as u64, Ordering::Relaxed);
-                    progress(n + width as u64 * samples.len() as u64, total);
+                    let n = width as u64 * pass_samples.len() as u64;
+                    progress(done.fetch_add(n, Ordering::Relaxed) + n, total);
                     row_counters
                 })
                 .reduce(PathCounters::default, PathCounters::merge);
             counters = counters.merge(pass);
-            first = samples.end;
+            first = pass_samples.end;
         }
         counters
     });
-    let elapsed = start.elapsed();
-
-    Ok((film.image(options.spp), RenderStats { elapsed, counters }))
+    Ok(RenderStats {
+        elapsed: start.elapsed(),
+        counters,
+    })
 }

@@ -9,8 +9,8 @@
 pub mod cpu;
 pub mod factory;
 
-pub use cpu::{render, RenderError};
+pub use cpu::{render, render_samples, RenderError};
 pub use factory::{
     path_settings, with_scene, with_scene_as, Effects, RenderScene, SceneVisitor, Variant,
 };
-pub use volpt_film::{image, Film, Image, ImageError, RenderOptions, RenderStats};
+pub use volpt_film::{image, Checkpoint, Film, Image, ImageError, RenderOptions, RenderStats};

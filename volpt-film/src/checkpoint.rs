@@ -1,0 +1,191 @@
+//! Checkpoints of a render in progress: the film's per-pixel sums and how many samples they hold.
+//!
+//! With the counter-based RNG, sample `s` of pixel `p` is the same path whoever traces it and
+//! whenever, and the sums are added in sample order: a render resumed from a checkpoint gives the
+//! uninterrupted render's image bit for bit.
+//!
+//! File layout (little-endian): the magic `VOLPTCK1`, the scene's fingerprint (`u64`), width,
+//! height, seed and samples (`u32` each), `3 * width * height` `f64` sums, and an FNV-1a checksum
+//! (`u64`) of everything before it. The size is checked against the header before anything is
+//! allocated, and the checksum before the sums are used.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use thiserror::Error;
+
+use crate::Film;
+
+const MAGIC: &[u8; 8] = b"VOLPTCK1";
+const HEADER: usize = 8 + 8 + 4 * 4;
+
+/// A render's state: which scene (by fingerprint), which seed, and the sums of samples
+/// `0 .. samples` of every pixel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Checkpoint {
+    pub fingerprint: u64,
+    pub seed: u32,
+    pub samples: u32,
+    pub film: Film,
+}
+
+#[derive(Debug, Error)]
+pub enum CheckpointError {
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{}: not a volpt checkpoint, or a damaged one: {problem}", path.display())]
+    Corrupt { path: PathBuf, problem: String },
+    #[error(
+        "{}: the checkpoint is of another render: its {field} is {found}, this render's is \
+         {expected}",
+        path.display()
+    )]
+    Mismatch {
+        path: PathBuf,
+        field: &'static str,
+        expected: String,
+        found: String,
+    },
+}
+
+/// FNV-1a, 64 bit: a checksum against damaged files, and the scene fingerprint's hash.
+#[derive(Clone, Copy, Debug)]
+pub struct Fnv(u64);
+
+impl Default for Fnv {
+    fn default() -> Self {
+        Self(0xcbf2_9ce4_8422_2325)
+    }
+}
+
+impl Fnv {
+    pub fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0 ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
+
+    pub fn finish(self) -> u64 {
+        self.0
+    }
+}
+
+impl Checkpoint {
+    /// Writes the checkpoint to `path` atomically: to a temporary file beside it, then renamed, so
+    /// that an interruption while writing leaves the previous checkpoint intact.
+    pub fn write(&self, path: &Path) -> Result<(), CheckpointError> {
+        let io = |source| CheckpointError::Io {
+            path: path.to_owned(),
+            source,
+        };
+        let mut bytes = Vec::with_capacity(HEADER + self.film.sums.len() * 24 + 8);
+        bytes.extend_from_slice(MAGIC);
+        bytes.extend_from_slice(&self.fingerprint.to_le_bytes());
+        for v in [self.film.width, self.film.height, self.seed, self.samples] {
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+        for sum in &self.film.sums {
+            for c in sum {
+                bytes.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        let mut fnv = Fnv::default();
+        fnv.write(&bytes);
+        bytes.extend_from_slice(&fnv.finish().to_le_bytes());
+        let mut name = path.file_name().unwrap_or_default().to_owned();
+        name.push(".partial");
+        let partial = path.with_file_name(name);
+        let mut file = std::fs::File::create(&partial).map_err(io)?;
+        file.write_all(&bytes).map_err(io)?;
+        file.sync_all().map_err(io)?;
+        std::fs::rename(&partial, path).map_err(io)
+    }
+
+    /// Reads the checkpoint at `path` and checks that it belongs to a render of `fingerprint` and
+    /// `seed` on a `width` x `height` film.
+    pub fn read(
+        path: &Path,
+        fingerprint: u64,
+        (width, height): (u32, u32),
+        seed: u32,
+    ) -> Result<Self, CheckpointError> {
+        let corrupt = |problem: String| CheckpointError::Corrupt {
+            path: path.to_owned(),
+            problem,
+        };
+        let mismatch = |field, expected: String, found: String| CheckpointError::Mismatch {
+            path: path.to_owned(),
+            field,
+            expected,
+            found,
+        };
+        let io = |source| CheckpointError::Io {
+            path: path.to_owned(),
+            source,
+        };
+        let meta = std::fs::metadata(path).map_err(io)?;
+        if !meta.is_file() {
+            return Err(corrupt("not a regular file".into()));
+        }
+        // Only a checkpoint of this film's size can be this render's: anything else is refused
+        // before it is read, whatever its header claims.
+        let expected_len = (HEADER + width as usize * height as usize * 24 + 8) as u64;
+        if meta.len() != expected_len {
+            return Err(corrupt(format!(
+                "{} bytes, a {width}x{height} film's checkpoint has {expected_len}",
+                meta.len()
+            )));
+        }
+        let bytes = std::fs::read(path).map_err(io)?;
+        let (payload, checksum) = bytes.split_at(bytes.len() - 8);
+        let mut fnv = Fnv::default();
+        fnv.write(payload);
+        if fnv.finish().to_le_bytes() != checksum {
+            return Err(corrupt("the checksum does not match its contents".into()));
+        }
+        if &payload[..8] != MAGIC {
+            return Err(corrupt("it does not start with VOLPTCK1".into()));
+        }
+        let u64_at = |i: usize| u64::from_le_bytes(payload[i..i + 8].try_into().expect("8 bytes"));
+        let u32_at = |i: usize| u32::from_le_bytes(payload[i..i + 4].try_into().expect("4 bytes"));
+        let found_fingerprint = u64_at(8);
+        if found_fingerprint != fingerprint {
+            return Err(mismatch(
+                "scene (fingerprint of the scene and its settings)",
+                format!("{fingerprint:016x}"),
+                format!("{found_fingerprint:016x}"),
+            ));
+        }
+        let (w, h) = (u32_at(16), u32_at(20));
+        if (w, h) != (width, height) {
+            return Err(mismatch(
+                "film",
+                format!("{width}x{height}"),
+                format!("{w}x{h}"),
+            ));
+        }
+        let found_seed = u32_at(24);
+        if found_seed != seed {
+            return Err(mismatch("seed", seed.to_string(), found_seed.to_string()));
+        }
+        let samples = u32_at(28);
+        let sums = payload[HEADER..]
+            .chunks_exact(24)
+            .map(|p| [0, 8, 16].map(|i| f64::from_le_bytes(p[i..i + 8].try_into().expect("8"))))
+            .collect();
+        Ok(Self {
+            fingerprint,
+            seed,
+            samples,
+            film: Film {
+                width,
+                height,
+                sums,
+            },
+        })
+    }
+}
