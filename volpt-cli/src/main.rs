@@ -274,13 +274,25 @@ fn summary(image: &Image, spp: u32, stats: &RenderStats, variant: Variant) -> St
         stats.tracking_steps_per_second() * 1e-6,
         c.segments as f64 / c.paths.max(1) as f64,
     );
-    if c.truncated > 0 {
-        s += &format!(
-            "\nwarning: {} paths reached the segment bound and were dropped (biased dark)",
-            c.truncated
-        );
+    if let Some(warning) = truncation_warning(c) {
+        s += "\n";
+        s += &warning;
     }
     s
+}
+
+/// What the safety bounds of the path settings cost the image, if they cut any path.
+fn truncation_warning(c: &volpt_core::PathCounters) -> Option<String> {
+    (c.truncated > 0).then(|| {
+        format!(
+            "warning: {} of {} paths reached a safety bound and were dropped (the image is biased \
+             dark): {} the free-flight bound, {} the tracking-step bound",
+            c.truncated,
+            c.paths,
+            c.truncated - c.truncated_tracking,
+            c.truncated_tracking
+        )
+    })
 }
 
 fn bench_command(args: BenchArgs) -> Result<()> {
@@ -331,6 +343,7 @@ fn bench_command(args: BenchArgs) -> Result<()> {
         segments: counters.segments,
         tracking_steps: counters.tracking_steps,
         truncated_paths: counters.truncated,
+        truncated_tracking_paths: counters.truncated_tracking,
         paths_per_s: counters.paths as f64 / time.mean,
         segments_per_s: counters.segments as f64 / time.mean,
         tracking_steps_per_s: counters.tracking_steps as f64 / time.mean,

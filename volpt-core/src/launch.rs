@@ -158,6 +158,9 @@ pub struct SettingsParams {
     pub max_depth: u32,
     pub rr_depth: u32,
     pub max_segments: u32,
+    pub max_tracking_steps: u32,
+    /// Explicit, so that no byte of the struct is uninitialised padding when it is copied.
+    pub padding: u32,
 }
 
 impl From<&PathSettings> for SettingsParams {
@@ -166,6 +169,8 @@ impl From<&PathSettings> for SettingsParams {
             max_depth: s.max_depth,
             rr_depth: s.rr_depth,
             max_segments: s.max_segments,
+            max_tracking_steps: s.max_tracking_steps,
+            padding: 0,
         }
     }
 }
@@ -177,6 +182,7 @@ impl SettingsParams {
             max_depth: self.max_depth,
             rr_depth: self.rr_depth,
             max_segments: self.max_segments,
+            max_tracking_steps: self.max_tracking_steps,
         }
     }
 }
@@ -231,7 +237,8 @@ pub struct LaunchParams {
     /// `width * height * 3` `f64` sums of the samples' radiance, zeroed before the first launch;
     /// each launch adds its samples.
     pub film: u64,
-    /// [`COUNTERS`] `u64` totals (paths, segments, tracking steps, truncated), zeroed before the launch.
+    /// [`COUNTERS`] `u64` totals (paths, segments, tracking steps, truncated, truncated by tracking),
+    /// zeroed before the launch.
     pub counters: u64,
     /// One `u64`, zeroed before the launch: the next path index a persistent thread takes.
     pub next_path: u64,
@@ -244,11 +251,12 @@ const _: () = assert!(core::mem::size_of::<CameraParams>() == 64);
 const _: () = assert!(core::mem::size_of::<GridParams>() == 16 + 4 * 4 + 4 * 12);
 const _: () = assert!(core::mem::size_of::<MediumParams>() == 24 + 2 * 80);
 const _: () = assert!(core::mem::size_of::<EnvironmentParams>() == 16 + 36 + 20 + 16);
-const _: () = assert!(core::mem::size_of::<SceneParams>() == 64 + 24 + 184 + 88 + 8 + 4 + 12);
-const _: () = assert!(core::mem::size_of::<LaunchParams>() == 384 + 16 + 4 * 8);
+const _: () = assert!(core::mem::size_of::<SceneParams>() == 64 + 24 + 184 + 88 + 8 + 4 + 20);
+const _: () = assert!(core::mem::size_of::<LaunchParams>() == 392 + 16 + 4 * 8);
 
-/// Number of `u64` counters a launch reduces: paths, segments, tracking steps, truncated paths.
-pub const COUNTERS: usize = 4;
+/// Number of `u64` counters a launch reduces: paths, segments, tracking steps, truncated paths, and
+/// of those the paths cut by the tracking-step bound.
+pub const COUNTERS: usize = 5;
 
 /// Rebuilds a scene component from launch parameters.
 pub trait FromParams<'a>: Sized {

@@ -184,6 +184,7 @@ impl CudaRenderer {
             segments: totals[1],
             tracking_steps: totals[2],
             truncated: totals[3],
+            truncated_tracking: totals[4],
         };
         Ok((
             Image {
