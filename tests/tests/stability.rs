@@ -602,6 +602,42 @@ fn world_coordinates_of_1e5() {
     assert!(check_position_resolution(&dense, "moved".as_ref()).is_err());
 }
 
+fn stability_scene(params: &[(&str, &str)]) -> Result<SceneDescription, SceneError> {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/stability/cube.xml");
+    let config = Config {
+        params: params
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect(),
+        ..Config::default()
+    };
+    SceneAssembler::new(config).assemble(volpt_scene::builder_for(&path)?.as_ref())
+}
+
+/// The scene file of the suite (`scenes/stability/cube.xml`, for the GPU script) loads at the
+/// origin and at 1e5 (where the loader once took a unit box for a flat one), and refuses 1e8.
+#[test]
+fn the_stability_scene_file_loads_where_the_suite_renders() {
+    let at_origin = stability_scene(&[]).expect("at the origin");
+    assert_eq!(at_origin.boundary.bounds, unit_bounds());
+    let far = stability_scene(&[
+        ("offset", "1e5"),
+        ("origin", "100002, 1.5, 2.5"),
+        ("target", "1e5, 0, 0"),
+        ("sigma_t", "4"),
+    ])
+    .expect("at 1e5");
+    assert_eq!(far.boundary.bounds.min[0], 1e5 - 0.5);
+    let message = stability_scene(&[("sigma_t", "1e8")])
+        .expect_err("too dense")
+        .to_string();
+    assert!(
+        message.contains("cube.xml") && message.contains("extinction"),
+        "{message}"
+    );
+}
+
 /// A builder that hands the assembler a ready description.
 struct Given(SceneDescription);
 

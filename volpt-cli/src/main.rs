@@ -3,7 +3,9 @@
 mod backend;
 mod bench;
 mod compare;
+mod converge;
 mod info;
+mod plot;
 
 use std::path::{Path, PathBuf};
 
@@ -40,6 +42,8 @@ enum Command {
     Scene(SceneCommand),
     /// Compare two OpenEXR images pixel by pixel (e.g. a CPU and a GPU render of one seed).
     Compare(compare::CompareArgs),
+    /// Error against time for each setting: progressive renders, CSV, SVG plots, a table.
+    Converge(converge::ConvergeArgs),
 }
 
 #[derive(Subcommand)]
@@ -193,6 +197,7 @@ fn main() -> Result<()> {
             Ok(())
         }
         Command::Compare(args) => compare::run(&args),
+        Command::Converge(args) => converge::run(&args),
     }
 }
 
