@@ -416,7 +416,7 @@ fn rays_through_edges_corners_faces_and_from_the_boundary() {
         ),
     ];
     for (case, origin, dir, inside, chord) in cases {
-        let along = |albedo| AlongRay {
+        let along = || AlongRay {
             ray: Ray::new(origin, dir),
             inside,
             paths: 20_000,
@@ -428,14 +428,14 @@ fn rays_through_edges_corners_faces_and_from_the_boundary() {
             BsdfDesc::Null,
             1.0,
         );
-        let (mean, se) = with_scene(&absorber, settings(&absorber), along(0.0));
+        let (mean, se) = with_scene(&absorber, settings(&absorber), along());
         let expected = (-2.0 * chord as f64).exp();
         assert!(
             (mean - expected).abs() <= 5.0 * se + 1e-6,
             "{case}: {mean} +- {se}, expected {expected}"
         );
         let furnace = with_albedo(absorber.clone(), 1.0);
-        let (mean, _) = with_scene(&furnace, settings(&furnace), along(1.0));
+        let (mean, _) = with_scene(&furnace, settings(&furnace), along());
         assert_eq!(mean, 1.0, "{case}: furnace");
         let rough_furnace = SceneDescription {
             boundary: BoundaryDesc {
@@ -444,7 +444,7 @@ fn rays_through_edges_corners_faces_and_from_the_boundary() {
             },
             ..furnace
         };
-        let (mean, se) = with_scene(&rough_furnace, settings(&rough_furnace), along(1.0));
+        let (mean, se) = with_scene(&rough_furnace, settings(&rough_furnace), along());
         // Radiance inside a medium of relative index eta is eta^2 that outside.
         let light = if inside {
             (1.05f64 / 1.01).powi(2)
