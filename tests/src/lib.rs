@@ -126,3 +126,83 @@ pub fn camera_ray_transmittance<S: Scene>(
     };
     (ray, transmittance)
 }
+
+/// Per pixel, the mean over the renderer's own camera rays (same seed, so the same jittered rays)
+/// of `L * exp(-tau)` along each ray, and the variance of the renderer's estimate of it: each path
+/// either escapes unscattered with `L` (probability `T`) or is absorbed, so its variance is
+/// `L^2 T (1 - T)`. tau is integrated by midpoint quadrature of the medium's own `sigma_t`.
+struct ExpectedTransmittance {
+    spp: u32,
+    seed: u32,
+    radiance: f32,
+}
+
+impl SceneVisitor for ExpectedTransmittance {
+    type Output = (Vec<f64>, Vec<f64>);
+
+    fn visit<S: volpt_render::RenderScene>(self, scene: &S) -> Self::Output {
+        let camera = scene.camera();
+        let (mut mean, mut var) = (Vec::new(), Vec::new());
+        for y in 0..camera.height {
+            for x in 0..camera.width {
+                let (mut m, mut v) = (0.0f64, 0.0f64);
+                for s in 0..self.spp {
+                    let (_, t) = camera_ray_transmittance(scene, (x, y), s, self.seed, 4000);
+                    m += t;
+                    v += t * (1.0 - t);
+                }
+                let l = self.radiance as f64;
+                let n = self.spp as f64;
+                mean.push(l * m / n);
+                var.push(l * l * v / (n * n));
+            }
+        }
+        (mean, var)
+    }
+}
+
+/// `image`, rendered from `desc` with `spp` samples and `seed`, is a pure absorber lit by `radiance`:
+/// every pixel within 5 standard deviations of its expectation (5 sigma: a false alarm among 1024
+/// pixels has probability below 1e-3), and the whole image within 4 standard errors, which a 1%
+/// bias in transmittance would exceed by far.
+pub fn assert_matches_transmittance(
+    desc: &SceneDescription,
+    image: &Image,
+    radiance: f32,
+    spp: u32,
+    seed: u32,
+) {
+    let (mean, var) = with_scene(
+        desc,
+        volpt_render::path_settings(desc),
+        ExpectedTransmittance {
+            spp,
+            seed,
+            radiance,
+        },
+    );
+    let (mut sum_diff, mut sum_var) = (0.0, 0.0);
+    for (i, px) in image.pixels.iter().enumerate() {
+        let sd = var[i].sqrt();
+        for c in px {
+            let diff = *c as f64 - mean[i];
+            // 1 / spp covers the binomial's discreteness where the normal approximation is poor.
+            let bound = 5.0 * sd + 1e-5 + if sd > 0.0 { 1.0 / spp as f64 } else { 0.0 };
+            assert!(
+                diff.abs() <= bound,
+                "pixel {i}: {c} vs expected {} (sd {sd})",
+                mean[i]
+            );
+        }
+        sum_diff += px[0] as f64 - mean[i];
+        sum_var += var[i];
+    }
+    // An image of rays that all miss or all cross an opaque medium has no variance: the per-pixel
+    // bounds above then already ask for the exact values.
+    if sum_var > 0.0 {
+        let z = sum_diff / sum_var.sqrt();
+        assert!(z.abs() < 4.0, "image-wide z = {z}");
+    }
+    let bias = sum_diff / mean.iter().sum::<f64>();
+    assert!(bias.abs() < 0.01, "image-wide relative bias {bias}");
+}

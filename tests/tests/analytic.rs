@@ -6,78 +6,9 @@ use volpt_core::path::{trace, PathState};
 use volpt_core::PathSettings;
 use volpt_render::{with_scene, Image, SceneVisitor};
 use volpt_scene::description::*;
-use volpt_tests::{camera_ray_transmittance, cube_scene, homogeneous, render_cpu, render_with};
+use volpt_tests::{assert_matches_transmittance, cube_scene, homogeneous, render_cpu, render_with};
 
 const SPP: u32 = 256;
-
-/// Per pixel, the mean over the renderer's own camera rays (same seed, so the same jittered rays)
-/// of `L * exp(-tau)` along each ray, and the variance of the renderer's estimate of it: each path
-/// either escapes unscattered with `L` (probability `T`) or is absorbed, so its variance is
-/// `L^2 T (1 - T)`. tau is integrated by midpoint quadrature of the medium's own `sigma_t`.
-struct ExpectedTransmittance {
-    spp: u32,
-    seed: u32,
-    radiance: f32,
-}
-
-impl SceneVisitor for ExpectedTransmittance {
-    type Output = (Vec<f64>, Vec<f64>);
-
-    fn visit<S: volpt_render::RenderScene>(self, scene: &S) -> Self::Output {
-        let camera = scene.camera();
-        let (mut mean, mut var) = (Vec::new(), Vec::new());
-        for y in 0..camera.height {
-            for x in 0..camera.width {
-                let (mut m, mut v) = (0.0f64, 0.0f64);
-                for s in 0..self.spp {
-                    let (_, t) = camera_ray_transmittance(scene, (x, y), s, self.seed, 4000);
-                    m += t;
-                    v += t * (1.0 - t);
-                }
-                let l = self.radiance as f64;
-                let n = self.spp as f64;
-                mean.push(l * m / n);
-                var.push(l * l * v / (n * n));
-            }
-        }
-        (mean, var)
-    }
-}
-
-/// Every pixel within 5 standard deviations of its expectation (5 sigma: a false alarm among 1024
-/// pixels has probability below 1e-3), and the whole image within 4 standard errors, which a 1%
-/// bias in transmittance would exceed by far.
-fn assert_matches_transmittance(desc: &SceneDescription, image: &Image, radiance: f32, seed: u32) {
-    let (mean, var) = with_scene(
-        desc,
-        volpt_render::path_settings(desc),
-        ExpectedTransmittance {
-            spp: SPP,
-            seed,
-            radiance,
-        },
-    );
-    let (mut sum_diff, mut sum_var) = (0.0, 0.0);
-    for (i, px) in image.pixels.iter().enumerate() {
-        let sd = var[i].sqrt();
-        for c in px {
-            let diff = *c as f64 - mean[i];
-            // 1 / spp covers the binomial's discreteness where the normal approximation is poor.
-            let bound = 5.0 * sd + 1e-5 + if sd > 0.0 { 1.0 / SPP as f64 } else { 0.0 };
-            assert!(
-                diff.abs() <= bound,
-                "pixel {i}: {c} vs expected {} (sd {sd})",
-                mean[i]
-            );
-        }
-        sum_diff += px[0] as f64 - mean[i];
-        sum_var += var[i];
-    }
-    let z = sum_diff / sum_var.sqrt();
-    assert!(z.abs() < 4.0, "image-wide z = {z}");
-    let bias = sum_diff / mean.iter().sum::<f64>();
-    assert!(bias.abs() < 0.01, "image-wide relative bias {bias}");
-}
 
 #[test]
 fn homogeneous_absorber_transmits_beer_lambert() {
@@ -89,7 +20,7 @@ fn homogeneous_absorber_transmits_beer_lambert() {
         0.75,
     );
     let (image, _) = render_cpu(&desc, SPP, 7);
-    assert_matches_transmittance(&desc, &image, 0.75, 7);
+    assert_matches_transmittance(&desc, &image, 0.75, SPP, 7);
 }
 
 fn wavy_density_grid(convention: GridConvention) -> GridDesc {
@@ -129,7 +60,7 @@ fn grid_absorber_transmits_beer_lambert_for_both_grid_conventions() {
             volpt_render::factory::MediumKind::GridDensity
         );
         let (image, _) = render_cpu(&desc, SPP, seed);
-        assert_matches_transmittance(&desc, &image, 1.0, seed);
+        assert_matches_transmittance(&desc, &image, 1.0, SPP, seed);
     }
 }
 
@@ -146,7 +77,7 @@ fn max_depth_one_shows_only_unscattered_light() {
     );
     desc.integrator.max_depth = Some(1);
     let (image, _) = render_cpu(&desc, SPP, 11);
-    assert_matches_transmittance(&desc, &image, 1.0, 11);
+    assert_matches_transmittance(&desc, &image, 1.0, SPP, 11);
 }
 
 fn assert_furnace(image: &Image, radiance: f32, tolerance: f32) {

@@ -21,7 +21,10 @@ pub struct BenchReport {
     pub paths: u64,
     pub segments: u64,
     pub tracking_steps: u64,
+    /// Paths cut by a safety bound (free flights or tracking steps per path).
     pub truncated_paths: u64,
+    /// Of those, the paths cut by the tracking-step bound.
+    pub truncated_tracking_paths: u64,
     /// Throughputs over the mean time.
     pub paths_per_s: f64,
     pub segments_per_s: f64,

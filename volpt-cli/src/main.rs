@@ -3,7 +3,9 @@
 mod backend;
 mod bench;
 mod compare;
+mod converge;
 mod info;
+mod plot;
 
 use std::path::{Path, PathBuf};
 
@@ -42,6 +44,8 @@ enum Command {
     Scene(SceneCommand),
     /// Compare two OpenEXR images pixel by pixel (e.g. a CPU and a GPU render of one seed).
     Compare(compare::CompareArgs),
+    /// Error against time for each setting: progressive renders, CSV, SVG plots, a table.
+    Converge(converge::ConvergeArgs),
 }
 
 #[derive(Subcommand)]
@@ -207,6 +211,7 @@ fn main() -> Result<()> {
             Ok(())
         }
         Command::Compare(args) => compare::run(&args),
+        Command::Converge(args) => converge::run(&args),
     }
 }
 
@@ -289,13 +294,25 @@ fn summary(image: &Image, spp: u32, stats: &RenderStats, variant: Variant) -> St
         stats.tracking_steps_per_second() * 1e-6,
         c.segments as f64 / c.paths.max(1) as f64,
     );
-    if c.truncated > 0 {
-        s += &format!(
-            "\nwarning: {} paths reached the segment bound and were dropped (biased dark)",
-            c.truncated
-        );
+    if let Some(warning) = truncation_warning(c) {
+        s += "\n";
+        s += &warning;
     }
     s
+}
+
+/// What the safety bounds of the path settings cost the image, if they cut any path.
+fn truncation_warning(c: &volpt_core::PathCounters) -> Option<String> {
+    (c.truncated > 0).then(|| {
+        format!(
+            "warning: {} of {} paths reached a safety bound and were dropped (the image is biased \
+             dark): {} the free-flight bound, {} the tracking-step bound",
+            c.truncated,
+            c.paths,
+            c.truncated - c.truncated_tracking,
+            c.truncated_tracking
+        )
+    })
 }
 
 fn bench_command(args: BenchArgs) -> Result<()> {
@@ -347,6 +364,7 @@ fn bench_command(args: BenchArgs) -> Result<()> {
         segments: counters.segments,
         tracking_steps: counters.tracking_steps,
         truncated_paths: counters.truncated,
+        truncated_tracking_paths: counters.truncated_tracking,
         paths_per_s: counters.paths as f64 / time.mean,
         segments_per_s: counters.segments as f64 / time.mean,
         tracking_steps_per_s: counters.tracking_steps as f64 / time.mean,

@@ -89,14 +89,14 @@ impl From<&CameraParams> for PerspectiveCamera {
     }
 }
 
-/// The integrator's limits, with the padding that keeps the size a multiple of 8 spelled out.
+/// The integrator's limits.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct SettingsParams {
     pub max_depth: u32,
     pub rr_depth: u32,
     pub max_segments: u32,
-    pub padding: u32,
+    pub max_tracking_steps: u32,
 }
 
 impl From<&PathSettings> for SettingsParams {
@@ -105,7 +105,7 @@ impl From<&PathSettings> for SettingsParams {
             max_depth: s.max_depth,
             rr_depth: s.rr_depth,
             max_segments: s.max_segments,
-            padding: 0,
+            max_tracking_steps: s.max_tracking_steps,
         }
     }
 }
@@ -117,6 +117,7 @@ impl From<&SettingsParams> for PathSettings {
             max_depth: s.max_depth,
             rr_depth: s.rr_depth,
             max_segments: s.max_segments,
+            max_tracking_steps: s.max_tracking_steps,
         }
     }
 }

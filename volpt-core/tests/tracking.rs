@@ -12,7 +12,7 @@ mod common;
 
 use common::*;
 use volpt_core::math::ln;
-use volpt_core::tracking::delta_tracking;
+use volpt_core::tracking::{delta_tracking, FreeFlight};
 use volpt_core::{HomogeneousMedium, Medium, Ray, Rng, Spectrum, Vec3};
 
 const N: u32 = 100_000;
@@ -110,12 +110,13 @@ fn fly<M: Medium>(medium: &M, t_max: f32, seed: u32) -> Flights {
     for i in 0..N {
         let mut rng = Rng::new(seed, 7, i);
         let mut steps = 0;
-        match delta_tracking(medium, &ray(), t_max, &mut rng, &mut steps) {
-            Some(t) => {
+        match delta_tracking(medium, &ray(), t_max, &mut rng, &mut steps, u32::MAX) {
+            FreeFlight::Collision(t) => {
                 assert!(t >= 0.0 && t < t_max, "t = {t}");
                 flights.distances.push(t as f64);
             }
-            None => flights.escaped += 1,
+            FreeFlight::Escaped => flights.escaped += 1,
+            FreeFlight::OutOfSteps => unreachable!("no step budget"),
         }
         flights.steps.push(steps as f64);
     }
@@ -271,8 +272,8 @@ fn vacuum_returns_immediately() {
         albedo: Spectrum::ONE,
     };
     assert_eq!(
-        delta_tracking(&vacuum, &ray(), f32::INFINITY, &mut rng, &mut steps),
-        None
+        delta_tracking(&vacuum, &ray(), f32::INFINITY, &mut rng, &mut steps, 0),
+        FreeFlight::Escaped
     );
     assert_eq!(
         delta_tracking(
@@ -280,9 +281,10 @@ fn vacuum_returns_immediately() {
             &ray(),
             10.0,
             &mut rng,
-            &mut steps
+            &mut steps,
+            0
         ),
-        None
+        FreeFlight::Escaped
     );
     // No tentative collision, and no random number consumed.
     assert_eq!(steps, 0);
@@ -294,7 +296,40 @@ fn vacuum_returns_immediately() {
     };
     for i in 0..1000 {
         let mut rng = Rng::new(1, 2, i);
-        let hit = delta_tracking(&medium, &ray(), 0.0, &mut rng, &mut steps);
-        assert!(hit.is_none() || hit == Some(0.0));
+        let hit = delta_tracking(&medium, &ray(), 0.0, &mut rng, &mut steps, u32::MAX);
+        assert!(hit == FreeFlight::Escaped || hit == FreeFlight::Collision(0.0));
+    }
+}
+
+/// A majorant that delta tracking can never get past: infinite (`t` stays 0, every tentative
+/// collision is rejected), NaN, or finite but enormous over a long flight. Each must stop at the
+/// budget, having counted exactly the budget's steps, never more.
+#[test]
+fn step_budget_bounds_hopeless_majorants() {
+    for majorant in [f32::INFINITY, f32::NAN, 1e30] {
+        let medium = Layered { majorant };
+        let mut rng = Rng::new(4, 5, 6);
+        let mut steps = 0;
+        let flight = delta_tracking(&medium, &ray(), 10.0, &mut rng, &mut steps, 1000);
+        assert_eq!(flight, FreeFlight::OutOfSteps, "majorant {majorant}");
+        assert_eq!(steps, 1000, "majorant {majorant}");
+        // A budget already spent stops the next flight before its first step.
+        let flight = delta_tracking(&medium, &ray(), 10.0, &mut rng, &mut steps, 1000);
+        assert_eq!(flight, FreeFlight::OutOfSteps);
+        assert_eq!(steps, 1000);
+    }
+}
+
+/// Under the budget the budget changes nothing: the same random numbers give the same flights.
+#[test]
+fn step_budget_does_not_change_flights_under_it() {
+    let medium = Layered { majorant: 8.0 };
+    for i in 0..10_000 {
+        let (mut a, mut b) = (Rng::new(3, 1, i), Rng::new(3, 1, i));
+        let (mut sa, mut sb) = (0, 0);
+        let unbounded = delta_tracking(&medium, &ray(), 3.0, &mut a, &mut sa, u32::MAX);
+        let bounded = delta_tracking(&medium, &ray(), 3.0, &mut b, &mut sb, 1000);
+        assert_eq!(unbounded, bounded);
+        assert_eq!(sa, sb);
     }
 }

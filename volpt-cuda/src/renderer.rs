@@ -183,6 +183,7 @@ impl CudaRenderer {
             segments: totals[1],
             tracking_steps: totals[2],
             truncated: totals[3],
+            truncated_tracking: totals[4],
         };
         Ok((film.image(options.spp), RenderStats { elapsed, counters }))
     }

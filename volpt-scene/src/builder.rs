@@ -147,7 +147,8 @@ impl SceneAssembler {
         Self { config }
     }
 
-    /// The builder's scene with the config's overrides applied.
+    /// The builder's scene with the config's overrides applied, refused if `f32` positions cannot
+    /// resolve its free flights ([`crate::numerics`]).
     pub fn assemble(&self, builder: &dyn SceneBuilder) -> Result<SceneDescription, SceneError> {
         let c = &self.config;
         let mut desc = builder.build(&c.params)?;
@@ -165,6 +166,7 @@ impl SceneAssembler {
         if let Some(rr_depth) = c.rr_depth {
             desc.integrator.rr_depth = rr_depth;
         }
+        crate::numerics::check_position_resolution(&desc, Path::new(&builder.source()))?;
         Ok(desc)
     }
 }

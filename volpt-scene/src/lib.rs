@@ -14,6 +14,7 @@
 //! - [`vtk`]: VTK image data (legacy `STRUCTURED_POINTS` `.vtk`, XML `.vti`), read and written.
 //! - [`transfer`]: transfer functions from density to RGB albedo, and their text files.
 //! - [`normalise`]: rescaling a grid's values onto `[0, target]` (raw counts to densities).
+//! - [`numerics`]: whether `f32` positions resolve a scene's free flights (checked on assembly).
 
 pub mod builder;
 pub mod description;
@@ -22,6 +23,7 @@ pub mod generate;
 pub mod metaimage;
 pub mod mitsuba;
 pub mod normalise;
+pub mod numerics;
 mod output;
 pub mod raw;
 pub mod toml_scene;

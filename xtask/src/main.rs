@@ -4,8 +4,9 @@
 //!   (`volpt-kernels`), written to `volpt-cuda/ptx/volpt_kernels.ptx`, which `volpt-cuda` embeds at
 //!   its next build; any other kernels crate of the workspace (a library user's, see
 //!   `docs/extending.md`) to `<its directory>/ptx/<crate>.ptx`.
-//! - `device-bundle`: the PTX, a release `volpt` with it embedded, the scenes, the third-party data
-//!   and the device script, in `bundle/` (git-ignored), ready to carry to the GPU machine.
+//! - `device-bundle`: the PTX, a release `volpt` with it embedded, the library-user example and its
+//!   PTX, the scenes, the third-party data and the device scripts (`bench/device/*.sh`), in
+//!   `bundle/` (git-ignored), ready to carry to the GPU machine.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -196,7 +197,14 @@ fn device_bundle() -> Result<()> {
             shared.display()
         );
     }
-    std::fs::copy(root.join("bench/device/run.sh"), bundle.join("run.sh"))?;
+    // Every device script: run.sh (checks and benchmark), stability.sh, accuracy.sh, ab.sh.
+    for entry in std::fs::read_dir(root.join("bench/device"))? {
+        let path = entry?.path();
+        if path.extension().is_some_and(|e| e == "sh") {
+            let name = path.file_name().expect("directory entries have names");
+            std::fs::copy(&path, bundle.join(name))?;
+        }
+    }
     eprintln!("xtask: bundle ready in {}", bundle.display());
     Ok(())
 }

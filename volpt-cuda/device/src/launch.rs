@@ -16,8 +16,9 @@ use crate::Strategy;
 /// Threads per block. A multiple of the warp size, as the warp-collective code requires.
 pub const BLOCK_SIZE: u32 = 128;
 
-/// Number of `u64` counters a launch reduces: paths, segments, tracking steps, truncated paths.
-pub const COUNTERS: usize = 4;
+/// Number of `u64` counters a launch reduces: paths, segments, tracking steps, truncated paths, and
+/// of those the paths cut by the tracking-step bound.
+pub const COUNTERS: usize = 5;
 
 /// Paths one regenerationSK launch aims at: enough to hide the tail of the last paths, few enough
 /// that progress is reported a few times a second.
@@ -37,8 +38,8 @@ pub struct LaunchParams<P> {
     /// `width * height * 3` `f64` sums of the samples' radiance, zeroed before the first launch;
     /// each launch adds its samples.
     pub film: u64,
-    /// [`COUNTERS`] `u64` totals (paths, segments, tracking steps, truncated), zeroed before the
-    /// render.
+    /// [`COUNTERS`] `u64` totals (paths, segments, tracking steps, truncated, truncated by
+    /// tracking), zeroed before the render.
     pub counters: u64,
     /// One `u64`, zeroed before the launch: the next path index a persistent thread takes.
     pub next_path: u64,

@@ -26,7 +26,13 @@ use crate::nvptx::{
 #[inline(always)]
 unsafe fn add_counters<P>(c: &PathCounters, lp: &LaunchParams<P>) {
     let totals = lp.counters as *mut u64;
-    let values = [c.paths, c.segments, c.tracking_steps, c.truncated];
+    let values = [
+        c.paths,
+        c.segments,
+        c.tracking_steps,
+        c.truncated,
+        c.truncated_tracking,
+    ];
     let lane0 = lane_id() == 0;
     for (k, v) in values.into_iter().enumerate() {
         let sum = warp_sum_u64(v);

@@ -18,14 +18,10 @@ pub(crate) fn box_from_corners(points: &[[f64; 3]]) -> Option<Bounds> {
             max[a] = max[a].max(p[a]);
         }
     }
+    // Relative to the box's size, not to its distance from the origin: a unit box at 1e5 is a box.
     let extent = (0..3).map(|a| max[a] - min[a]).fold(0.0, f64::max);
-    let magnitude = min
-        .iter()
-        .chain(&max)
-        .map(|v| v.abs())
-        .fold(extent, f64::max);
-    let tol = TOLERANCE * magnitude;
-    if (0..3).any(|a| max[a] - min[a] <= tol) {
+    let tol = TOLERANCE * extent;
+    if extent == 0.0 || (0..3).any(|a| max[a] - min[a] <= tol) {
         return None;
     }
     let mut corners_seen = 0u8;

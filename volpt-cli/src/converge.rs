@@ -1,0 +1,607 @@
+//! `volpt converge`: what accuracy costs in time.
+//!
+//! Each configuration (one value of every `--setting`) renders progressively: round `r` adds two
+//! independent batches of `2^r` samples per pixel, one to each half of the samples. After every
+//! round the estimate (the mean of both halves) is compared with a reference:
+//!
+//! - MSE and RMSE over all pixel channels, and relative MSE `(x - ref)^2 / (ref^2 + 0.01)`;
+//! - variance of the estimate: the halves are independent, so `((a - b) / 2)^2` estimates it per
+//!   pixel channel without bias;
+//! - bias: `sqrt(max(MSE - variance - reference variance, 0))`, what more samples will not remove
+//!   (a depth limit's); a rendered reference is two independent halves too, so its own noise is
+//!   estimated the same way and not taken for bias (a given reference counts as exact);
+//! - efficiency `1 / (MSE x time)`, with time the render time of the samples so far.
+//!
+//! The reference is a given OpenEXR, the analytic value of a white furnace, or a render at
+//! `--reference-spp` with the scene's own settings (roulette from depth 5 at the latest, which
+//! changes the noise, not the mean), cached in the output directory.
+//!
+//! Settings are knobs the renderer really has ([`Choice`]); a new knob (GPU math, strategy) adds a
+//! variant there and nothing else.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::time::Duration;
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use volpt_core::PathSettings;
+use volpt_render::{path_settings, Effects, Image, RenderOptions};
+use volpt_scene::description::{AlbedoDesc, BsdfDesc, EnvironmentDesc};
+use volpt_scene::SceneDescription;
+
+use crate::backend::{Backend, RenderJob};
+use crate::plot::{log_log_svg, Series};
+use crate::{load, options, SamplingArgs, SceneArgs};
+
+#[derive(Args)]
+pub struct ConvergeArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    #[command(flatten)]
+    sampling: SamplingArgs,
+    /// A knob and the values to compare, e.g. `rr_depth=1,5,-1`, `roulette=on,off`,
+    /// `max_depth=2,4,8,-1`. Several give every combination. Without any, the scene's own settings.
+    #[arg(long = "setting", value_name = "NAME=A,B,...", value_parser = parse_setting)]
+    settings: Vec<Vec<Choice>>,
+    /// Reference image (OpenEXR); default: the analytic value of a white furnace, or a render at
+    /// --reference-spp cached in the output directory.
+    #[arg(long)]
+    reference: Option<PathBuf>,
+    /// Samples per pixel of a rendered reference.
+    #[arg(long, default_value_t = 4096)]
+    reference_spp: u32,
+    /// Render time budget per configuration, in seconds (the round running at the budget finishes).
+    #[arg(long, default_value_t = 10.0)]
+    time: f64,
+    /// Stop a configuration at this many samples per pixel even within its time budget.
+    #[arg(long, default_value_t = 1 << 16)]
+    max_spp: u32,
+    /// RMSE for the time-to-error column (default: the largest final RMSE, so every
+    /// configuration reaches it).
+    #[arg(long)]
+    target_rmse: Option<f64>,
+    /// Output directory: converge.csv, rmse.svg, rel-mse.svg, table.md, the cached reference.
+    #[arg(short, long, default_value = "converge")]
+    out: PathBuf,
+}
+
+/// One value of one knob.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Choice {
+    /// Russian roulette from the scene's `rr_depth` (5 if it has none), or never.
+    Roulette(bool),
+    /// Roulette from this depth; `None` never.
+    RrDepth(Option<u32>),
+    /// Longest path; `None` unlimited.
+    MaxDepth(Option<u32>),
+}
+
+impl Choice {
+    fn apply(self, settings: &mut PathSettings, scene: &PathSettings) {
+        let depth = |d: Option<u32>| d.unwrap_or(PathSettings::UNLIMITED);
+        match self {
+            Choice::Roulette(true) if scene.rr_depth == PathSettings::UNLIMITED => {
+                settings.rr_depth = PathSettings::default().rr_depth
+            }
+            Choice::Roulette(true) => settings.rr_depth = scene.rr_depth,
+            Choice::Roulette(false) => settings.rr_depth = PathSettings::UNLIMITED,
+            Choice::RrDepth(d) => settings.rr_depth = depth(d),
+            Choice::MaxDepth(d) => settings.max_depth = depth(d),
+        }
+    }
+
+    fn label(self) -> String {
+        let depth = |d: Option<u32>| d.map_or("-1".to_owned(), |d| d.to_string());
+        match self {
+            Choice::Roulette(on) => format!("roulette={}", if on { "on" } else { "off" }),
+            Choice::RrDepth(d) => format!("rr_depth={}", depth(d)),
+            Choice::MaxDepth(d) => format!("max_depth={}", depth(d)),
+        }
+    }
+}
+
+fn parse_setting(s: &str) -> Result<Vec<Choice>, String> {
+    let (name, values) = s
+        .split_once('=')
+        .ok_or_else(|| format!("expected NAME=A,B,..., found {s:?}"))?;
+    let depth = |v: &str| match v {
+        "-1" => Ok(None),
+        _ => v
+            .parse::<u32>()
+            .map(Some)
+            .map_err(|_| format!("{name}: expected a depth (an integer >= 0, or -1), found {v:?}")),
+    };
+    values
+        .split(',')
+        .map(|v| match name {
+            "roulette" => match v {
+                "on" => Ok(Choice::Roulette(true)),
+                "off" => Ok(Choice::Roulette(false)),
+                _ => Err(format!("roulette: expected on or off, found {v:?}")),
+            },
+            "rr_depth" => depth(v).map(Choice::RrDepth),
+            "max_depth" => depth(v).map(Choice::MaxDepth),
+            _ => Err(format!(
+                "unknown setting {name:?}: expected roulette, rr_depth or max_depth"
+            )),
+        })
+        .collect()
+}
+
+/// One configuration: its name and the integrator settings it renders with.
+struct Configuration {
+    label: String,
+    settings: PathSettings,
+}
+
+/// Every combination of the settings' values (the scene's own settings if there are none).
+fn configurations(desc: &SceneDescription, settings: &[Vec<Choice>]) -> Vec<Configuration> {
+    let scene = path_settings(desc);
+    let mut out = vec![Configuration {
+        label: String::new(),
+        settings: scene,
+    }];
+    for values in settings {
+        out = out
+            .iter()
+            .flat_map(|c| {
+                values.iter().map(move |choice| {
+                    let mut settings = c.settings;
+                    choice.apply(&mut settings, &scene);
+                    let label = if c.label.is_empty() {
+                        choice.label()
+                    } else {
+                        format!("{} {}", c.label, choice.label())
+                    };
+                    Configuration { label, settings }
+                })
+            })
+            .collect();
+    }
+    if out.len() == 1 && out[0].label.is_empty() {
+        out[0].label = "scene settings".to_owned();
+    }
+    out
+}
+
+/// The errors after one round.
+#[derive(Clone, Copy, Debug)]
+struct Row {
+    round: u32,
+    spp: u64,
+    time_s: f64,
+    mse: f64,
+    rel_mse: f64,
+    variance: f64,
+    reference_variance: f64,
+}
+
+impl Row {
+    fn rmse(&self) -> f64 {
+        self.mse.sqrt()
+    }
+    fn bias(&self) -> f64 {
+        (self.mse - self.variance - self.reference_variance)
+            .max(0.0)
+            .sqrt()
+    }
+    fn efficiency(&self) -> f64 {
+        1.0 / (self.mse * self.time_s)
+    }
+}
+
+/// What the estimate is compared with: per pixel channel.
+enum Reference {
+    Constant([f32; 3]),
+    /// An image, and the variance of its pixels as estimates (mean over pixel channels).
+    Image(Image, f64),
+}
+
+impl Reference {
+    fn variance(&self) -> f64 {
+        match self {
+            Reference::Constant(_) => 0.0,
+            Reference::Image(_, variance) => *variance,
+        }
+    }
+
+    /// The mean of two independent renders, and the variance of that mean.
+    fn from_halves(a: &Image, b: &Image) -> Self {
+        let mut mean = a.clone();
+        let mut variance = 0.0;
+        for (m, pb) in mean.pixels.iter_mut().zip(&b.pixels) {
+            for c in 0..3 {
+                variance += (0.5 * (m[c] as f64 - pb[c] as f64)).powi(2);
+                m[c] = 0.5 * (m[c] + pb[c]);
+            }
+        }
+        let count = 3.0 * a.pixels.len() as f64;
+        Reference::Image(mean, variance / count)
+    }
+
+    fn at(&self, pixel: usize, channel: usize) -> f64 {
+        match self {
+            Reference::Constant(rgb) => rgb[channel] as f64,
+            Reference::Image(image, _) => image.pixels[pixel][channel] as f64,
+        }
+    }
+}
+
+/// The sums of both halves of the samples, per pixel channel.
+struct Halves {
+    a: Vec<[f64; 3]>,
+    b: Vec<[f64; 3]>,
+    spp_each: u64,
+}
+
+impl Halves {
+    fn add(sums: &mut [[f64; 3]], image: &Image, spp: u32) {
+        for (s, p) in sums.iter_mut().zip(&image.pixels) {
+            for c in 0..3 {
+                s[c] += p[c] as f64 * spp as f64;
+            }
+        }
+    }
+
+    /// MSE, relative MSE and the variance of the estimate, over all pixel channels.
+    fn errors(&self, reference: &Reference) -> (f64, f64, f64) {
+        let n = self.spp_each as f64;
+        let (mut mse, mut rel, mut var) = (0.0, 0.0, 0.0);
+        for (i, (a, b)) in self.a.iter().zip(&self.b).enumerate() {
+            for c in 0..3 {
+                let (ma, mb) = (a[c] / n, b[c] / n);
+                let estimate = 0.5 * (ma + mb);
+                let r = reference.at(i, c);
+                let e2 = (estimate - r).powi(2);
+                mse += e2;
+                rel += e2 / (r * r + 0.01);
+                var += (0.5 * (ma - mb)).powi(2);
+            }
+        }
+        let count = 3.0 * self.a.len() as f64;
+        (mse / count, rel / count, var / count)
+    }
+}
+
+/// Renders `desc` with `settings`, `spp` samples and `seed`: every render of this command.
+fn render_once(
+    backend: &Backend,
+    desc: &SceneDescription,
+    settings: PathSettings,
+    options: RenderOptions,
+    effects: Effects,
+) -> Result<(Image, Duration)> {
+    let job = RenderJob {
+        desc,
+        settings,
+        options,
+        effects,
+        show_progress: false,
+    };
+    let (image, stats) = backend.render(&job)?;
+    if stats.counters.truncated > 0 {
+        tracing::warn!(
+            truncated = stats.counters.truncated,
+            "paths reached a safety bound and were dropped"
+        );
+    }
+    Ok((image, stats.elapsed))
+}
+
+pub fn run(args: &ConvergeArgs) -> Result<()> {
+    let desc = load(&args.scene)?;
+    let base = options(&desc, &args.sampling)?;
+    let backend = Backend::open(args.sampling.backend, args.sampling.strategy)?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let reference = reference(args, &desc, &backend, base)?;
+    let configurations = configurations(&desc, &args.settings);
+    let pixels = (desc.film.width * desc.film.height) as usize;
+
+    let mut results = Vec::new();
+    for (k, config) in configurations.iter().enumerate() {
+        let bar = ProgressBar::new((args.time * 1000.0) as u64);
+        bar.set_style(
+            ProgressStyle::with_template("{spinner} {prefix} [{elapsed_precise}] {wide_bar} {msg}")
+                .expect("static template"),
+        );
+        bar.set_prefix(format!(
+            "{}/{} {}",
+            k + 1,
+            configurations.len(),
+            config.label
+        ));
+        let mut halves = Halves {
+            a: vec![[0.0; 3]; pixels],
+            b: vec![[0.0; 3]; pixels],
+            spp_each: 0,
+        };
+        let mut time = 0.0;
+        let mut rows = Vec::new();
+        for round in 0.. {
+            let spp = 1u32 << round.min(20);
+            // Distinct seeds for every batch of every round (and not the reference's).
+            let seed = |half: u32| base.seed.wrapping_add(2 * round + half + 1);
+            for (half, sums) in [(0, &mut halves.a), (1, &mut halves.b)] {
+                let options = RenderOptions {
+                    spp,
+                    seed: seed(half),
+                    ..base
+                };
+                let (image, elapsed) = render_once(
+                    &backend,
+                    &desc,
+                    config.settings,
+                    options,
+                    args.scene.effects(),
+                )?;
+                Halves::add(sums, &image, spp);
+                time += elapsed.as_secs_f64();
+            }
+            halves.spp_each += spp as u64;
+            let (mse, rel_mse, variance) = halves.errors(&reference);
+            let row = Row {
+                round,
+                spp: 2 * halves.spp_each,
+                time_s: time,
+                mse,
+                rel_mse,
+                variance,
+                reference_variance: reference.variance(),
+            };
+            bar.set_position((time * 1000.0) as u64);
+            bar.set_message(format!(
+                "{} spp, RMSE {:.3e}, bias {:.3e}",
+                row.spp,
+                row.rmse(),
+                row.bias()
+            ));
+            rows.push(row);
+            if time >= args.time || row.spp >= args.max_spp as u64 {
+                break;
+            }
+        }
+        bar.finish_and_clear();
+        results.push((config.label.clone(), rows));
+    }
+    write_outputs(args, &results)
+}
+
+/// The reference the errors are measured against.
+fn reference(
+    args: &ConvergeArgs,
+    desc: &SceneDescription,
+    backend: &Backend,
+    base: RenderOptions,
+) -> Result<Reference> {
+    let (w, h) = (desc.film.width, desc.film.height);
+    if let Some(path) = &args.reference {
+        let image = Image::read_exr(path)?;
+        if (image.width, image.height) != (w, h) {
+            bail!(
+                "{}: the reference is {}x{} but the render is {w}x{h}",
+                path.display(),
+                image.width,
+                image.height
+            );
+        }
+        return Ok(Reference::Image(image, 0.0));
+    }
+    if let Some(rgb) = white_furnace(desc) {
+        tracing::info!(
+            ?rgb,
+            "white furnace: the reference is the environment's radiance"
+        );
+        return Ok(Reference::Constant(rgb));
+    }
+    let key = reference_key(args, desc);
+    let cached = [0, 1].map(|half| args.out.join(format!("reference-{key:016x}-{half}.exr")));
+    if cached.iter().all(|p| p.exists()) {
+        tracing::info!(path = %cached[0].display(), "using the cached reference");
+        let [a, b] = [&cached[0], &cached[1]].map(|p| Image::read_exr(p));
+        return Ok(Reference::from_halves(&a?, &b?));
+    }
+    tracing::info!(spp = args.reference_spp, "rendering the reference");
+    let mut halves = Vec::new();
+    for (half, path) in cached.iter().enumerate() {
+        let options = RenderOptions {
+            spp: args.reference_spp.div_ceil(2),
+            // Seeds no batch of the runs uses (they count up from the base seed).
+            seed: base.seed.wrapping_sub(1 + half as u32),
+            ..base
+        };
+        let job = RenderJob {
+            desc,
+            settings: reference_settings(desc),
+            options,
+            effects: args.scene.effects(),
+            show_progress: true,
+        };
+        let (image, _) = backend.render(&job)?;
+        image.write_exr(path)?;
+        halves.push(image);
+    }
+    Ok(Reference::from_halves(&halves[0], &halves[1]))
+}
+
+/// The scene's settings with Russian roulette from depth 5 at the latest: roulette is unbiased,
+/// and without it a reference of a high-albedo scene costs many times more.
+fn reference_settings(desc: &SceneDescription) -> PathSettings {
+    let scene = path_settings(desc);
+    PathSettings {
+        rr_depth: scene.rr_depth.min(PathSettings::default().rr_depth),
+        ..scene
+    }
+}
+
+/// A white furnace: albedo 1 everywhere, a lossless boundary, a constant environment and no depth
+/// limit; every path returns exactly the environment's radiance.
+fn white_furnace(desc: &SceneDescription) -> Option<[f32; 3]> {
+    let lossless = matches!(
+        desc.boundary.bsdf,
+        BsdfDesc::Null | BsdfDesc::Dielectric { .. }
+    );
+    match (&desc.medium.albedo, &desc.environment) {
+        (AlbedoDesc::Constant(a), EnvironmentDesc::Constant(rgb))
+            if *a == [1.0; 3] && lossless && desc.integrator.max_depth.is_none() =>
+        {
+            Some(*rgb)
+        }
+        _ => None,
+    }
+}
+
+/// FNV-1a of everything the reference depends on, so that a changed scene renders a new one.
+fn reference_key(args: &ConvergeArgs, desc: &SceneDescription) -> u64 {
+    let key = format!(
+        "{:?} {:?} {:?} {} {}",
+        std::fs::canonicalize(&args.scene.scene).unwrap_or_else(|_| args.scene.scene.clone()),
+        args.scene.config(),
+        reference_settings(desc),
+        args.reference_spp,
+        args.sampling.seed
+    );
+    key.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+        (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
+fn write_outputs(args: &ConvergeArgs, results: &[(String, Vec<Row>)]) -> Result<()> {
+    let write = |name: &str, text: &str| -> Result<PathBuf> {
+        let path = args.out.join(name);
+        std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
+        Ok(path)
+    };
+    let mut csv = String::from(
+        "setting,round,spp,time_s,rmse,rel_mse,variance,reference_variance,bias,efficiency\n",
+    );
+    for (label, rows) in results {
+        for r in rows {
+            let _ = writeln!(
+                csv,
+                "{label},{},{},{:.6},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e}",
+                r.round,
+                r.spp,
+                r.time_s,
+                r.rmse(),
+                r.rel_mse,
+                r.variance,
+                r.reference_variance,
+                r.bias(),
+                r.efficiency()
+            );
+        }
+    }
+    let series = |f: fn(&Row) -> f64| -> Vec<Series> {
+        results
+            .iter()
+            .map(|(label, rows)| Series {
+                name: label.clone(),
+                points: rows.iter().map(|r| (r.time_s, f(r))).collect(),
+            })
+            .collect()
+    };
+    let scene = args.scene.scene.display().to_string();
+    let mut written = vec![
+        write("converge.csv", &csv)?,
+        write(
+            "rmse.svg",
+            &log_log_svg(&scene, "render time (s)", "RMSE", &series(Row::rmse)),
+        )?,
+        write(
+            "rel-mse.svg",
+            &log_log_svg(
+                &scene,
+                "render time (s)",
+                "relative MSE",
+                &series(|r| r.rel_mse),
+            ),
+        )?,
+    ];
+    let table = table(results, args.target_rmse);
+    print!("{table}");
+    written.push(write("table.md", &table)?);
+    for path in written {
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+/// Final errors per configuration, the time each first reached the target RMSE, and its efficiency.
+fn table(results: &[(String, Vec<Row>)], target: Option<f64>) -> String {
+    let finals = results.iter().filter_map(|(_, rows)| rows.last());
+    let target = target.unwrap_or_else(|| finals.map(Row::rmse).fold(0.0, f64::max));
+    let mut s = format!(
+        "| setting | spp | time (s) | RMSE | relative MSE | bias | time to RMSE {target:.2e} (s) | \
+         efficiency 1/(MSE s) |\n|---|---:|---:|---:|---:|---:|---:|---:|\n"
+    );
+    for (label, rows) in results {
+        let Some(last) = rows.last() else { continue };
+        let reached = rows
+            .iter()
+            .find(|r| r.rmse() <= target)
+            .map_or("-".to_owned(), |r| format!("{:.3}", r.time_s));
+        let _ = writeln!(
+            s,
+            "| {label} | {} | {:.3} | {:.3e} | {:.3e} | {:.3e} | {reached} | {:.3e} |",
+            last.spp,
+            last.time_s,
+            last.rmse(),
+            last.rel_mse,
+            last.bias(),
+            last.efficiency()
+        );
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn settings_parse_and_combine() {
+        assert_eq!(
+            parse_setting("rr_depth=1,-1").unwrap(),
+            vec![Choice::RrDepth(Some(1)), Choice::RrDepth(None)]
+        );
+        assert!(parse_setting("roulette=maybe").is_err());
+        assert!(parse_setting("depth=3")
+            .unwrap_err()
+            .contains("unknown setting"));
+        let scene = PathSettings::default();
+        let mut s = scene;
+        Choice::MaxDepth(Some(3)).apply(&mut s, &scene);
+        Choice::Roulette(false).apply(&mut s, &scene);
+        assert_eq!((s.max_depth, s.rr_depth), (3, PathSettings::UNLIMITED));
+    }
+
+    /// Two halves that differ by +-d around an estimate that is off by e: the variance estimate is
+    /// d^2, the MSE e^2 + 0 (the mean is the midpoint), and the bias what is left.
+    #[test]
+    fn errors_split_into_variance_and_bias() {
+        let (r, e, d) = (0.5, 0.1, 0.2);
+        let halves = Halves {
+            a: vec![[r + e + d; 3]; 4],
+            b: vec![[r + e - d; 3]; 4],
+            spp_each: 1,
+        };
+        let (mse, rel, var) = halves.errors(&Reference::Constant([r as f32; 3]));
+        assert!((mse - e * e).abs() < 1e-6, "{mse}");
+        assert!((var - d * d).abs() < 1e-12, "{var}");
+        assert!((rel - e * e / (r * r + 0.01)).abs() < 1e-6, "{rel}");
+        let row = Row {
+            round: 0,
+            spp: 2,
+            time_s: 2.0,
+            mse: 0.06,
+            rel_mse: 0.0,
+            variance: 0.01,
+            reference_variance: 0.01,
+        };
+        assert!((row.bias() - 0.2).abs() < 1e-12);
+        assert!((row.efficiency() - 1.0 / 0.12).abs() < 1e-9);
+    }
+}
