@@ -1,5 +1,8 @@
 //! Shared helpers for the integration tests: small scenes built directly as descriptions, and
-//! rendering them through the same factory and CPU backend the CLI uses.
+//! rendering them through the same factory and CPU backend the CLI uses; [`reference`] holds the
+//! independent `f64` references they are compared with.
+
+pub mod reference;
 
 use volpt_core::path::PathState;
 use volpt_core::{Medium, PathSettings, Ray, Scene};
@@ -125,4 +128,44 @@ pub fn camera_ray_transmittance<S: Scene>(
         }
     };
     (ray, transmittance)
+}
+
+/// Per pixel and channel, the mean of the renderer's samples and the variance of that mean (the
+/// sample variance over `spp`): the standard error every per-pixel window is derived from.
+pub fn pixel_statistics(desc: &SceneDescription, spp: u32, seed: u32) -> Vec<[(f64, f64); 3]> {
+    with_core_scene(desc, PixelStatistics { spp, seed })
+}
+
+struct PixelStatistics {
+    spp: u32,
+    seed: u32,
+}
+
+impl SceneVisitor for PixelStatistics {
+    type Output = Vec<[(f64, f64); 3]>;
+
+    fn visit<S: Scene + Sync + volpt_core::launch::ToParams>(self, scene: &S) -> Self::Output {
+        let camera = scene.camera();
+        let n = self.spp as f64;
+        let mut out = Vec::new();
+        for y in 0..camera.height {
+            for x in 0..camera.width {
+                let (mut sum, mut sum2) = ([0.0f64; 3], [0.0f64; 3]);
+                for s in 0..self.spp {
+                    let mut path = PathState::from_camera(scene, x, y, s, self.seed);
+                    volpt_core::path::trace(scene, &mut path);
+                    for (c, v) in path.radiance.to_array().into_iter().enumerate() {
+                        sum[c] += v as f64;
+                        sum2[c] += v as f64 * v as f64;
+                    }
+                }
+                out.push(std::array::from_fn(|c| {
+                    let mean = sum[c] / n;
+                    let var = (sum2[c] / n - mean * mean).max(0.0) * n / (n - 1.0);
+                    (mean, var / n)
+                }));
+            }
+        }
+        out
+    }
 }
