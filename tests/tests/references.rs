@@ -305,7 +305,10 @@ fn grid_absorber_matches_independent_beer_lambert() {
                 (r + image.pixels[i][0] as f64, e + reference[i].0.x)
             });
         let bias = rendered / expected - 1.0;
-        assert!(bias.abs() < 0.01, "{what}: relative bias {bias} over the medium");
+        assert!(
+            bias.abs() < 0.01,
+            "{what}: relative bias {bias} over the medium"
+        );
         eprintln!("Beer-Lambert {what}: z = {z:.2}, relative bias {bias:.4}");
     }
 }
@@ -348,7 +351,10 @@ fn image_orientation_matches_the_reference_camera() {
             let value = image.pixel(x, y)[0];
             match hits {
                 4 => {
-                    assert!(value < 1e-3, "pixel ({x}, {y}) sees the opaque box: {value}");
+                    assert!(
+                        value < 1e-3,
+                        "pixel ({x}, {y}) sees the opaque box: {value}"
+                    );
                     dark += 1;
                     assert!(x < camera.width / 2 && y < camera.height / 2);
                 }
