@@ -1,7 +1,8 @@
 //! Shared helpers for the integration tests: small scenes built directly as descriptions, and
 //! rendering them through the same factory and CPU backend the CLI uses; [`reference`] holds the
-//! independent `f64` references they are compared with.
+//! independent `f64` references they are compared with, [`compare`] the comparisons.
 
+pub mod compare;
 pub mod reference;
 
 use volpt_core::path::PathState;
