@@ -6,7 +6,7 @@ pub mod compare;
 pub mod reference;
 
 use volpt_core::path::PathState;
-use volpt_core::{Medium, PathSettings, Ray, Scene};
+use volpt_core::{PathSettings, Scene};
 use volpt_render::{render, with_scene, Image, RenderOptions, RenderStats, SceneVisitor};
 use volpt_scene::description::*;
 
@@ -101,34 +101,6 @@ pub fn render_with(
 /// Visits the built scene with a closure-like visitor, for tests that need the core scene itself.
 pub fn with_core_scene<V: SceneVisitor>(desc: &SceneDescription, visitor: V) -> V::Output {
     with_scene(desc, volpt_render::path_settings(desc), visitor)
-}
-
-/// The camera ray of sample `sample` of pixel `(x, y)` (the very ray the renderer traces) and its
-/// transmittance `exp(-tau)` through the medium, with `tau` by the midpoint rule in `steps` steps.
-pub fn camera_ray_transmittance<S: Scene>(
-    scene: &S,
-    (x, y): (u32, u32),
-    sample: u32,
-    seed: u32,
-    steps: u32,
-) -> (Ray, f64) {
-    let ray = PathState::from_camera(scene, x, y, sample, seed).ray;
-    let transmittance = match scene.bounds().entry(&ray) {
-        None => 1.0,
-        Some(hit) => {
-            let inner = Ray::new(hit.point, ray.dir);
-            let exit = scene.bounds().exit(&inner);
-            let dt = exit.t / steps as f32;
-            let tau: f64 = (0..steps)
-                .map(|i| {
-                    let p = inner.at((i as f32 + 0.5) * dt);
-                    scene.medium().sigma_t(p) as f64 * dt as f64
-                })
-                .sum();
-            (-tau).exp()
-        }
-    };
-    (ray, transmittance)
 }
 
 /// Per pixel and channel, the mean of the renderer's samples and the variance of that mean (the

@@ -6,77 +6,43 @@ use volpt_core::path::{trace, PathState};
 use volpt_core::{PathSettings, Scene};
 use volpt_render::{with_scene, Image, SceneVisitor};
 use volpt_scene::description::*;
-use volpt_tests::{camera_ray_transmittance, cube_scene, homogeneous, render_cpu, render_with};
+use volpt_tests::compare::{
+    absorber_expectation, assert_matches, coverage, relative_bias, Coverage,
+};
+use volpt_tests::reference::{RefCamera, RefMedium};
+use volpt_tests::{cube_scene, homogeneous, render_cpu, render_with};
 
-const SPP: u32 = 256;
+/// Enough for a 1% bias over the medium's pixels to be 4 standard errors.
+const BEER_LAMBERT_SPP: u32 = 4096;
 
-/// Per pixel, the mean over the renderer's own camera rays (same seed, so the same jittered rays)
-/// of `L * exp(-tau)` along each ray, and the variance of the renderer's estimate of it: each path
-/// either escapes unscattered with `L` (probability `T`) or is absorbed, so its variance is
-/// `L^2 T (1 - T)`. tau is integrated by midpoint quadrature of the medium's own `sigma_t`.
-struct ExpectedTransmittance {
-    spp: u32,
-    seed: u32,
-    radiance: f32,
-}
-
-impl SceneVisitor for ExpectedTransmittance {
-    type Output = (Vec<f64>, Vec<f64>);
-
-    fn visit<S: Scene + Sync + volpt_core::launch::ToParams>(self, scene: &S) -> Self::Output {
-        let camera = scene.camera();
-        let (mut mean, mut var) = (Vec::new(), Vec::new());
-        for y in 0..camera.height {
-            for x in 0..camera.width {
-                let (mut m, mut v) = (0.0f64, 0.0f64);
-                for s in 0..self.spp {
-                    let (_, t) = camera_ray_transmittance(scene, (x, y), s, self.seed, 4000);
-                    m += t;
-                    v += t * (1.0 - t);
-                }
-                let l = self.radiance as f64;
-                let n = self.spp as f64;
-                mean.push(l * m / n);
-                var.push(l * l * v / (n * n));
-            }
-        }
-        (mean, var)
-    }
-}
-
-/// Every pixel within 5 standard deviations of its expectation (5 sigma: a false alarm among 1024
-/// pixels has probability below 1e-3), and the whole image within 4 standard errors, which a 1%
-/// bias in transmittance would exceed by far.
-fn assert_matches_transmittance(desc: &SceneDescription, image: &Image, radiance: f32, seed: u32) {
-    let (mean, var) = with_scene(
-        desc,
-        volpt_render::path_settings(desc),
-        ExpectedTransmittance {
-            spp: SPP,
-            seed,
-            radiance,
-        },
+/// Every pixel that sees only the medium or only the background within 5 standard errors (plus
+/// the quadrature error) of the independent reference `L * mean(exp(-tau))` over the pixel
+/// (`volpt_tests::compare::absorber_expectation`: own camera, box and grid in f64), each channel's
+/// sum over the medium's pixels within 5 standard errors, and the transmitted light summed over
+/// the medium's pixels (not diluted by background) within 1%.
+fn assert_matches_transmittance(desc: &SceneDescription, image: &Image) {
+    let camera = RefCamera::new(&desc.camera, &desc.film);
+    let cover = coverage(&camera, &RefMedium::new(desc).bounds);
+    let expected = absorber_expectation(desc, BEER_LAMBERT_SPP, 1000);
+    assert_matches("Beer-Lambert", image, &expected, |i| {
+        cover[i] != Coverage::Silhouette
+    });
+    let in_medium = |i: usize| cover[i] == Coverage::Medium;
+    assert!(cover.iter().filter(|&&c| c == Coverage::Medium).count() > 100);
+    assert_matches("Beer-Lambert in the medium", image, &expected, in_medium);
+    // The test must be able to see a 1% bias: 4 of the summed estimate's standard errors.
+    let (mean, variance) = (0..expected.len())
+        .filter(|&i| in_medium(i))
+        .fold((0.0, 0.0), |(m, v), i| {
+            (m + expected[i].mean.x, v + expected[i].variance.x)
+        });
+    let relative_se = variance.sqrt() / mean;
+    assert!(
+        relative_se < 0.0025,
+        "relative standard error {relative_se}"
     );
-    let (mut sum_diff, mut sum_var) = (0.0, 0.0);
-    for (i, px) in image.pixels.iter().enumerate() {
-        let sd = var[i].sqrt();
-        for c in px {
-            let diff = *c as f64 - mean[i];
-            // 1 / spp covers the binomial's discreteness where the normal approximation is poor.
-            let bound = 5.0 * sd + 1e-5 + if sd > 0.0 { 1.0 / SPP as f64 } else { 0.0 };
-            assert!(
-                diff.abs() <= bound,
-                "pixel {i}: {c} vs expected {} (sd {sd})",
-                mean[i]
-            );
-        }
-        sum_diff += px[0] as f64 - mean[i];
-        sum_var += var[i];
-    }
-    let z = sum_diff / sum_var.sqrt();
-    assert!(z.abs() < 4.0, "image-wide z = {z}");
-    let bias = sum_diff / mean.iter().sum::<f64>();
-    assert!(bias.abs() < 0.01, "image-wide relative bias {bias}");
+    let bias = relative_bias(image, &expected, in_medium);
+    assert!(bias.abs() < 0.01, "relative bias {bias} over the medium");
 }
 
 #[test]
@@ -88,8 +54,8 @@ fn homogeneous_absorber_transmits_beer_lambert() {
         BsdfDesc::Null,
         0.75,
     );
-    let (image, _) = render_cpu(&desc, SPP, 7);
-    assert_matches_transmittance(&desc, &image, 0.75, 7);
+    let (image, _) = render_cpu(&desc, BEER_LAMBERT_SPP, 7);
+    assert_matches_transmittance(&desc, &image);
 }
 
 fn wavy_density_grid(convention: GridConvention) -> GridDesc {
@@ -128,8 +94,8 @@ fn grid_absorber_transmits_beer_lambert_for_both_grid_conventions() {
             volpt_render::Variant::of(&desc).medium,
             volpt_render::factory::MediumKind::GridDensity
         );
-        let (image, _) = render_cpu(&desc, SPP, seed);
-        assert_matches_transmittance(&desc, &image, 1.0, seed);
+        let (image, _) = render_cpu(&desc, BEER_LAMBERT_SPP, seed);
+        assert_matches_transmittance(&desc, &image);
     }
 }
 
@@ -145,8 +111,8 @@ fn max_depth_one_shows_only_unscattered_light() {
         1.0,
     );
     desc.integrator.max_depth = Some(1);
-    let (image, _) = render_cpu(&desc, SPP, 11);
-    assert_matches_transmittance(&desc, &image, 1.0, 11);
+    let (image, _) = render_cpu(&desc, BEER_LAMBERT_SPP, 11);
+    assert_matches_transmittance(&desc, &image);
 }
 
 fn assert_furnace(image: &Image, radiance: f32, tolerance: f32) {
