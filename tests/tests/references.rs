@@ -203,7 +203,10 @@ fn grid_absorber_matches_independent_beer_lambert() {
             bias.abs() < 0.01,
             "{what}: relative bias {bias} over the medium"
         );
-        eprintln!("Beer-Lambert {what}: z = {:.2}, relative bias {bias:.4}", z[0]);
+        eprintln!(
+            "Beer-Lambert {what}: z = {:.2}, relative bias {bias:.4}",
+            z[0]
+        );
     }
 }
 
