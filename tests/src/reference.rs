@@ -287,12 +287,6 @@ impl RefMedium {
             None => 1.0,
         }
     }
-
-    /// Henyey & Greenstein 1941, of the cosine between the propagation directions before and after.
-    pub fn phase(&self, cos_theta: f64) -> f64 {
-        let g = self.g;
-        (1.0 - g * g) / (4.0 * PI * (1.0 + g * g - 2.0 * g * cos_theta).powf(1.5))
-    }
 }
 
 /// The environment of the description: constant, or Mitsuba's lat-long `envmap` (bilinear, `u`
