@@ -1,5 +1,9 @@
 //! Shared helpers for the integration tests: small scenes built directly as descriptions, and
-//! rendering them through the same factory and CPU backend the CLI uses.
+//! rendering them through the same factory and CPU backend the CLI uses; [`reference`] holds the
+//! independent `f64` references they are compared with, [`compare`] the comparisons.
+
+pub mod compare;
+pub mod reference;
 
 use volpt_core::path::PathState;
 use volpt_core::{Medium, PathSettings, Ray, Scene};
@@ -99,32 +103,44 @@ pub fn with_core_scene<V: SceneVisitor>(desc: &SceneDescription, visitor: V) -> 
     with_scene(desc, volpt_render::path_settings(desc), visitor)
 }
 
-/// The camera ray of sample `sample` of pixel `(x, y)` (the very ray the renderer traces) and its
-/// transmittance `exp(-tau)` through the medium, with `tau` by the midpoint rule in `steps` steps.
-pub fn camera_ray_transmittance<S: Scene>(
-    scene: &S,
-    (x, y): (u32, u32),
-    sample: u32,
+/// Per pixel and channel, the mean of the renderer's samples and the variance of that mean (the
+/// sample variance over `spp`): the standard error every per-pixel window is derived from.
+pub fn pixel_statistics(desc: &SceneDescription, spp: u32, seed: u32) -> Vec<[(f64, f64); 3]> {
+    with_core_scene(desc, PixelStatistics { spp, seed })
+}
+
+struct PixelStatistics {
+    spp: u32,
     seed: u32,
-    steps: u32,
-) -> (Ray, f64) {
-    let ray = PathState::from_camera(scene, x, y, sample, seed).ray;
-    let transmittance = match scene.bounds().entry(&ray) {
-        None => 1.0,
-        Some(hit) => {
-            let inner = Ray::new(hit.point, ray.dir);
-            let exit = scene.bounds().exit(&inner);
-            let dt = exit.t / steps as f32;
-            let tau: f64 = (0..steps)
-                .map(|i| {
-                    let p = inner.at((i as f32 + 0.5) * dt);
-                    scene.medium().sigma_t(p) as f64 * dt as f64
-                })
-                .sum();
-            (-tau).exp()
+}
+
+impl SceneVisitor for PixelStatistics {
+    type Output = Vec<[(f64, f64); 3]>;
+
+    fn visit<S: volpt_render::RenderScene>(self, scene: &S) -> Self::Output {
+        let camera = scene.camera();
+        let n = self.spp as f64;
+        let mut out = Vec::new();
+        for y in 0..camera.height {
+            for x in 0..camera.width {
+                let (mut sum, mut sum2) = ([0.0f64; 3], [0.0f64; 3]);
+                for s in 0..self.spp {
+                    let mut path = PathState::from_camera(scene, x, y, s, self.seed);
+                    volpt_core::path::trace(scene, &mut path);
+                    for (c, v) in path.radiance.to_array().into_iter().enumerate() {
+                        sum[c] += v as f64;
+                        sum2[c] += v as f64 * v as f64;
+                    }
+                }
+                out.push(std::array::from_fn(|c| {
+                    let mean = sum[c] / n;
+                    let var = (sum2[c] / n - mean * mean).max(0.0) * n / (n - 1.0);
+                    (mean, var / n)
+                }));
+            }
         }
-    };
-    (ray, transmittance)
+        out
+    }
 }
 
 /// Per pixel, the mean over the renderer's own camera rays (same seed, so the same jittered rays)
@@ -205,4 +221,32 @@ pub fn assert_matches_transmittance(
     }
     let bias = sum_diff / mean.iter().sum::<f64>();
     assert!(bias.abs() < 0.01, "image-wide relative bias {bias}");
+}
+
+/// The camera ray of sample `sample` of pixel `(x, y)` (the very ray the renderer traces) and its
+/// transmittance `exp(-tau)` through the medium, with `tau` by the midpoint rule in `steps` steps.
+pub fn camera_ray_transmittance<S: Scene>(
+    scene: &S,
+    (x, y): (u32, u32),
+    sample: u32,
+    seed: u32,
+    steps: u32,
+) -> (Ray, f64) {
+    let ray = PathState::from_camera(scene, x, y, sample, seed).ray;
+    let transmittance = match scene.bounds().entry(&ray) {
+        None => 1.0,
+        Some(hit) => {
+            let inner = Ray::new(hit.point, ray.dir);
+            let exit = scene.bounds().exit(&inner);
+            let dt = exit.t / steps as f32;
+            let tau: f64 = (0..steps)
+                .map(|i| {
+                    let p = inner.at((i as f32 + 0.5) * dt);
+                    scene.medium().sigma_t(p) as f64 * dt as f64
+                })
+                .sum();
+            (-tau).exp()
+        }
+    };
+    (ray, transmittance)
 }

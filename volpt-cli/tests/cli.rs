@@ -51,15 +51,7 @@ fn renders_the_example_to_exr_and_png() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("24x24 at 2 spp"), "{stdout}");
     assert!(stdout.contains("M paths/s"), "{stdout}");
-    let image = exr::prelude::read_first_rgba_layer_from_file(
-        &exr,
-        |res, _| vec![[0.0f32; 3]; res.width() * res.height()],
-        |px: &mut Vec<[f32; 3]>, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-            px[pos.y() * 24 + pos.x()] = [r, g, b];
-        },
-    )
-    .expect("a readable EXR");
-    let pixels = image.layer_data.channel_data.pixels;
+    let pixels = read_rgb(&exr, 24);
     assert_eq!(pixels.len(), 24 * 24);
     // The corner sees the white environment; the centre sees the amber cube, darker in blue.
     assert_eq!(pixels[0], [1.0, 1.0, 1.0]);
@@ -172,27 +164,46 @@ fn zero_threads_and_zero_trials_are_refused() {
     assert_clean_error(&out, &["--trials"]);
 }
 
-/// Without a GPU (as in CI) `--backend cuda` is a clear error naming what is missing; with one it
-/// renders. Either way it never panics.
+fn read_rgb(path: &Path, width: usize) -> Vec<[f32; 3]> {
+    let image = exr::prelude::read_first_rgba_layer_from_file(
+        path,
+        |res, _| vec![[0.0f32; 3]; res.width() * res.height()],
+        move |px: &mut Vec<[f32; 3]>, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            px[pos.y() * width + pos.x()] = [r, g, b];
+        },
+    )
+    .expect("a readable EXR");
+    image.layer_data.channel_data.pixels
+}
+
+/// Without a GPU (as in CI) `--backend cuda` is a clear error naming what is missing and never a
+/// panic; with one, its naive-sk image is bit-identical to the CPU's (same seed, same paths).
 #[test]
 fn cuda_backend_without_a_gpu_is_a_clear_error() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let out_file = dir.path().join("gpu.exr");
     let scene = example();
-    let out = volpt(&[
-        "render",
-        scene.to_str().unwrap(),
-        "--spp",
-        "1",
-        "--resolution",
-        "8x8",
-        "--backend",
-        "cuda",
-        "-o",
-        out_file.to_str().unwrap(),
-    ]);
+    let render = |name: &str, backend: &[&str]| {
+        let file = dir.path().join(name);
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "--spp",
+            "2",
+            "--resolution",
+            "8x8",
+            "-o",
+            file.to_str().unwrap(),
+        ];
+        args.extend(backend);
+        (volpt(&args), file)
+    };
+    let (out, gpu_file) = render("gpu.exr", &["--backend", "cuda", "--strategy", "naive-sk"]);
     if out.status.success() {
-        eprintln!("a GPU is present: --backend cuda rendered, nothing to check here");
+        let (cpu, cpu_file) = render("cpu.exr", &[]);
+        assert!(cpu.status.success(), "{}", stderr(&cpu));
+        let (gpu, cpu) = (read_rgb(&gpu_file, 8), read_rgb(&cpu_file, 8));
+        assert_eq!(gpu.len(), 64);
+        assert_eq!(gpu, cpu, "the GPU's naive-sk image differs from the CPU's");
         return;
     }
     let err = stderr(&out);

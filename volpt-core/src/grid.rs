@@ -111,10 +111,12 @@ impl<'a, const C: usize> Grid<'a, C> {
         let x1 = (x0 + 1).min(self.res[0] - 1);
         let y1 = (y0 + 1).min(self.res[1] - 1);
         let z1 = (z0 + 1).min(self.res[2] - 1);
+        // Rounding can carry `a + (b - a) * t` one ulp above `max(a, b)`; clamped, no lookup ever
+        // exceeds the largest sample, which the majorant of delta tracking relies on.
         let lerp_c = |a: [f32; C], b: [f32; C], t: f32| {
             let mut r = [0.0; C];
             for c in 0..C {
-                r[c] = a[c] + (b[c] - a[c]) * t;
+                r[c] = (a[c] + (b[c] - a[c]) * t).min(a[c].max(b[c]));
             }
             r
         };

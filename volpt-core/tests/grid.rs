@@ -373,3 +373,34 @@ fn resolution_one_along_an_axis_is_constant_along_it() {
         }
     }
 }
+
+/// No lookup exceeds the largest sample (the majorant of delta tracking is `scale * max`): without
+/// a clamp, rounding carries `a + (b - a) * t` one ulp above `max(a, b)` for many pairs.
+#[test]
+fn lookups_never_exceed_the_largest_sample() {
+    let mut rng = TestRng::new(41);
+    for convention in CONVENTIONS {
+        for _ in 0..200 {
+            let res = [2, 2, 2];
+            let data = random_data(&mut rng, res, 1)
+                .iter()
+                .map(|v| v.abs() * 1e-3)
+                .collect::<Vec<f32>>();
+            let largest = data.iter().copied().fold(0.0, f32::max);
+            let grid = Grid::<1>::new(&data, res, mapping(convention, res));
+            let b = bounds();
+            let (lo, hi) = (
+                b.min.to_array().map(f64::from),
+                b.max.to_array().map(f64::from),
+            );
+            for _ in 0..500 {
+                let p = to_vec3(random_point(&mut rng, lo, hi));
+                let v = grid.lookup(p)[0];
+                assert!(
+                    v <= largest,
+                    "{v} above the largest sample {largest} at {p}"
+                );
+            }
+        }
+    }
+}
