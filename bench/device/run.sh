@@ -86,6 +86,27 @@ else
     log "FAIL smooth-ball cpu render"; failures=$((failures + 1))
 fi
 
+# Checkpoints on the GPU: naive-sk resumed from a checkpoint equals its uninterrupted render bit for
+# bit. And a film too large for the card is a clear error (60000^2 pixels of f64 RGB: 86 GB).
+CK="scenes/cgg-logo/scene.xml -Dresolution=64 --seed 3 --backend cuda --strategy naive-sk"
+# shellcheck disable=SC2086
+if "$VOLPT" render $CK --spp 6 -o "$OUT/ck-whole.exr" >"$OUT/ck-whole.log" 2>&1 \
+    && "$VOLPT" render $CK --spp 2 --checkpoint "$OUT/ck.ckpt" -o "$OUT/ck-part.exr" >"$OUT/ck-part.log" 2>&1 \
+    && "$VOLPT" render $CK --spp 6 --resume "$OUT/ck.ckpt" -o "$OUT/ck-resumed.exr" >"$OUT/ck-resumed.log" 2>&1; then
+    check "checkpoint-resume-naive-sk" "$VOLPT" compare "$OUT/ck-whole.exr" "$OUT/ck-resumed.exr" --identical
+else
+    log "FAIL checkpoint renders: $(tail -n 2 "$OUT/ck-resumed.log" | tr '\n' ' ')"; failures=$((failures + 1))
+fi
+rm -f "$OUT/ck.ckpt"
+"$VOLPT" render scenes/example/cube.xml --resolution 60000x60000 --spp 1 --backend cuda -o "$OUT/oom.exr" \
+    >"$OUT/oom.log" 2>&1
+code=$?
+if [ $code -ne 0 ] && [ $code -lt 128 ] && ! grep -q panicked "$OUT/oom.log"; then
+    log "PASS device out of memory is an error: $(grep -m1 -i 'error' "$OUT/oom.log")"
+else
+    log "FAIL device out of memory (exit $code): $(tail -n 3 "$OUT/oom.log" | tr '\n' ' ')"; failures=$((failures + 1))
+fi
+
 # What specialisation saves (docs/effects.md): each scene specialised and with --general, GPU and CPU.
 if [ -n "${EFFECTS:-}" ]; then
     for entry in "${SCENES[@]}"; do

@@ -1,5 +1,6 @@
 //! The backends a render can run on, behind one call.
 
+use std::ops::Range;
 use std::time::Duration;
 
 use anyhow::Result;
@@ -8,7 +9,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use volpt_core::PathSettings;
 use volpt_cuda::{CudaRenderer, Strategy};
 use volpt_render::{
-    render, with_scene_as, Effects, Image, RenderOptions, RenderScene, RenderStats, SceneVisitor,
+    render_samples, with_scene_as, Effects, Film, Image, RenderOptions, RenderScene, RenderStats,
+    SceneVisitor,
 };
 use volpt_scene::SceneDescription;
 
@@ -78,9 +80,23 @@ impl Backend {
     }
 
     pub fn render(&self, job: &RenderJob) -> Result<(Image, RenderStats)> {
+        let mut film = Film::new(job.desc.film.width, job.desc.film.height);
+        let stats = self.render_into(job, &mut film, 0..job.options.spp)?;
+        Ok((film.image(job.options.spp), stats))
+    }
+
+    /// Adds samples `samples` of every pixel to `film`, which holds the samples before them.
+    pub fn render_into(
+        &self,
+        job: &RenderJob,
+        film: &mut Film,
+        samples: Range<u32>,
+    ) -> Result<RenderStats> {
         let visitor = Render {
             backend: self,
             options: job.options,
+            film,
+            samples,
             progress: progress_bar(job.show_progress),
         };
         with_scene_as(job.desc, job.settings, job.effects, visitor)
@@ -90,11 +106,13 @@ impl Backend {
 struct Render<'a> {
     backend: &'a Backend,
     options: RenderOptions,
+    film: &'a mut Film,
+    samples: Range<u32>,
     progress: ProgressBar,
 }
 
 impl SceneVisitor for Render<'_> {
-    type Output = Result<(Image, RenderStats)>;
+    type Output = Result<RenderStats>;
 
     fn visit<S: RenderScene>(self, scene: &S) -> Self::Output {
         let bar = &self.progress;
@@ -102,14 +120,15 @@ impl SceneVisitor for Render<'_> {
             bar.set_length(total);
             bar.set_position(done);
         };
-        let result = match self.backend {
-            Backend::Cpu => render(scene, &self.options, &report)?,
+        let (film, samples, options) = (self.film, self.samples, &self.options);
+        let stats = match self.backend {
+            Backend::Cpu => render_samples(scene, film, samples, options, &report)?,
             Backend::Cuda { renderer, strategy } => {
-                renderer.render(scene, *strategy, &self.options, &report)?
+                renderer.render_samples(scene, *strategy, film, samples, options, &report)?
             }
         };
         bar.finish_and_clear();
-        Ok(result)
+        Ok(stats)
     }
 }
 

@@ -2,6 +2,7 @@
 
 mod backend;
 mod bench;
+mod checkpoint;
 mod compare;
 mod converge;
 mod info;
@@ -143,6 +144,17 @@ struct RenderArgs {
     /// Output OpenEXR file; the PNG preview gets the same name with `.png`.
     #[arg(short, long, default_value = "out.exr")]
     output: PathBuf,
+    /// Save the render's progress to FILE periodically and on Ctrl-C, to continue it with
+    /// --resume FILE.
+    #[arg(long, value_name = "FILE")]
+    checkpoint: Option<PathBuf>,
+    /// Continue the render saved in FILE (same scene, settings and seed; --spp may grow), saving
+    /// progress back to it unless --checkpoint names another file.
+    #[arg(long, value_name = "FILE")]
+    resume: Option<PathBuf>,
+    /// Seconds of rendering between checkpoints.
+    #[arg(long, value_name = "SECONDS", default_value_t = 60.0)]
+    checkpoint_interval: f64,
 }
 
 #[derive(Args)]
@@ -268,7 +280,34 @@ fn render_command(args: RenderArgs) -> Result<()> {
         strategy = ?backend.strategy(),
         "rendering"
     );
-    let (image, stats) = backend.render(&job)?;
+    let save = checkpoint::save_path(args.checkpoint.as_deref(), args.resume.as_deref());
+    let (image, stats) = match save {
+        None => backend.render(&job)?,
+        Some(save) => {
+            if !(args.checkpoint_interval.is_finite() && args.checkpoint_interval > 0.0) {
+                bail!("--checkpoint-interval must be a positive number of seconds");
+            }
+            let checkpointing = checkpoint::Checkpointing {
+                save,
+                resume: args.resume.clone(),
+                interval: std::time::Duration::from_secs_f64(args.checkpoint_interval),
+            };
+            match checkpoint::render(&backend, &job, &checkpointing)? {
+                Ok(done) => done,
+                Err(stopped) => {
+                    println!(
+                        "interrupted after {} of {} samples per pixel: saved to {}; continue \
+                         with --resume {}",
+                        stopped.samples,
+                        job.options.spp,
+                        stopped.path.display(),
+                        stopped.path.display()
+                    );
+                    std::process::exit(130);
+                }
+            }
+        }
+    };
     image
         .write_exr(&args.output)
         .with_context(|| format!("writing {}", args.output.display()))?;

@@ -4,6 +4,7 @@
 //! CPU) lives on the device for the whole render, and only the final sums come back. The kernel is
 //! the scene type's own ([`entry_name`]), so the GPU simulates exactly the effects the CPU would.
 
+use std::ops::Range;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -83,13 +84,36 @@ impl CudaRenderer {
         progress: &dyn Fn(u64, u64),
     ) -> Result<(Image, RenderStats), CudaError> {
         let (width, height) = (scene.camera().width, scene.camera().height);
-        if width == 0 || height == 0 || options.spp == 0 {
+        let mut film = Film::new(width, height);
+        let samples = 0..options.spp;
+        let stats = self.render_samples(scene, strategy, &mut film, samples, options, progress)?;
+        Ok((film.image(options.spp), stats))
+    }
+
+    /// Adds samples `samples` of every pixel to `film`, which holds the sums of the samples before
+    /// them (zeros when `samples` starts at 0); `progress(done, total)` counts this call's paths.
+    pub fn render_samples<S: SceneAbi>(
+        &self,
+        scene: &S,
+        strategy: Strategy,
+        film: &mut Film,
+        samples: Range<u32>,
+        options: &RenderOptions,
+        progress: &dyn Fn(u64, u64),
+    ) -> Result<RenderStats, CudaError> {
+        let (width, height) = (scene.camera().width, scene.camera().height);
+        if width == 0 || height == 0 || samples.is_empty() {
             return Err(CudaError::Empty {
                 width,
                 height,
-                spp: options.spp,
+                spp: samples.len() as u32,
             });
         }
+        assert_eq!(
+            (film.width, film.height),
+            (width, height),
+            "the film must be the camera's"
+        );
         let name = entry_name::<S>(strategy);
         let kernel = self
             .module
@@ -116,9 +140,16 @@ impl CudaRenderer {
         }
 
         let pixels = width as u64 * height as u64;
-        let film: CudaSlice<f64> = stream
+        let mut device_film: CudaSlice<f64> = stream
             .alloc_zeros(3 * pixels as usize)
             .doing("allocating the film")?;
+        // A resumed render: the sums of the samples before `samples` continue on the device.
+        if samples.start > 0 {
+            let flat: Vec<f64> = film.sums.iter().flatten().copied().collect();
+            stream
+                .memcpy_htod(&flat, &mut device_film)
+                .doing("copying the film to the GPU")?;
+        }
         let counters: CudaSlice<u64> = stream
             .alloc_zeros(COUNTERS)
             .doing("allocating the counters")?;
@@ -138,7 +169,7 @@ impl CudaRenderer {
         let mut params = LaunchParams {
             scene: scene_params,
             seed: options.seed,
-            film: film.device_ptr(stream).0,
+            film: device_film.device_ptr(stream).0,
             counters: counters.device_ptr(stream).0,
             next_path: next_path.device_ptr(stream).0,
             first_sample: 0,
@@ -146,13 +177,13 @@ impl CudaRenderer {
             padding: 0,
             total_paths: 0,
         };
-        let total = pixels * options.spp as u64;
+        let total = pixels * samples.len() as u64;
         stream.synchronize().doing("copying the scene")?;
         let start = Instant::now();
-        for (first_sample, samples) in strategy.launches(pixels, options.spp) {
-            params.first_sample = first_sample;
-            params.samples = samples;
-            params.total_paths = pixels * samples as u64;
+        for (first, count) in strategy.launches(pixels, samples.len() as u32) {
+            params.first_sample = samples.start + first;
+            params.samples = count;
+            params.total_paths = pixels * count as u64;
             stream
                 .memset_zeros(&mut next_path)
                 .doing("resetting the path counter")?;
@@ -166,18 +197,14 @@ impl CudaRenderer {
             unsafe { stream.launch_builder(&kernel).arg(&address).launch(config) }
                 .doing("launching the kernel")?;
             stream.synchronize().doing("running the kernel")?;
-            progress(pixels * (first_sample + samples) as u64, total);
+            progress(pixels * (first + count) as u64, total);
         }
         let elapsed = start.elapsed();
 
-        let sums = stream.clone_dtoh(&film).doing("reading the film")?;
+        let sums = stream.clone_dtoh(&device_film).doing("reading the film")?;
         let totals = stream.clone_dtoh(&counters).doing("reading the counters")?;
         drop(grids);
-        let film = Film {
-            width,
-            height,
-            sums: sums.chunks_exact(3).map(|s| [s[0], s[1], s[2]]).collect(),
-        };
+        film.sums = sums.chunks_exact(3).map(|s| [s[0], s[1], s[2]]).collect();
         let counters = PathCounters {
             paths: totals[0],
             segments: totals[1],
@@ -185,6 +212,6 @@ impl CudaRenderer {
             truncated: totals[3],
             truncated_tracking: totals[4],
         };
-        Ok((film.image(options.spp), RenderStats { elapsed, counters }))
+        Ok(RenderStats { elapsed, counters })
     }
 }
