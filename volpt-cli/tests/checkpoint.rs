@@ -75,7 +75,7 @@ fn ctrl_c_saves_the_finished_samples() {
     let ckpt = p("c.ckpt");
     let example = example();
     // Many samples, a checkpoint after every chunk: Ctrl-C arrives long before the end.
-    let mut child = Command::new(env!("CARGO_BIN_EXE_volpt"))
+    let child = Command::new(env!("CARGO_BIN_EXE_volpt"))
         .args([
             "render",
             &example,
