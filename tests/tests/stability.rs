@@ -704,9 +704,11 @@ fn extreme_extinction_renders_right_or_is_refused() {
 /// black), quickly.
 #[test]
 fn hopeless_majorants_hit_the_step_budget() {
+    // Two different voxels: a one-valued grid would be specialised to a homogeneous medium
+    // (`volpt_render::factory::Simplification`), which tracks without the budget's loop.
     let overflowing = MediumDesc {
         scale: 1e38,
-        ..grid_medium(grid([1, 1, 1], vec![10.0]), 0.9)
+        ..grid_medium(grid([2, 1, 1], vec![10.0, 5.0]), 0.9)
     };
     for (case, medium) in [
         ("infinite majorant", overflowing),
