@@ -1,16 +1,15 @@
-//! From a scene description to an image on the CPU.
+//! From a scene description to a render-ready scene.
 //!
-//! - [`factory`]: which monomorphised scene variant a description needs, and building it.
-//! - [`cpu`]: the CPU backend, rayon over the shared path step.
+//! - [`factory`]: which monomorphised scene variant a description needs, and building it, for any
+//!   backend (a [`SceneVisitor`] receives the scene).
 //!
-//! What a render produces (the film, the image and its files, the statistics) is `volpt-film`'s,
-//! shared with the GPU backend; it is re-exported here for convenience.
+//! For convenience it re-exports the CPU backend (`volpt-cpu`) and what a render produces, on any
+//! backend (`volpt-film`: the film, the image and its files, the statistics).
 
-pub mod cpu;
 pub mod factory;
 
-pub use cpu::{render, render_samples, RenderError};
 pub use factory::{
     path_settings, with_scene, with_scene_as, Effects, RenderScene, SceneVisitor, Variant,
 };
+pub use volpt_cpu::{render, render_samples, RenderError};
 pub use volpt_film::{image, Checkpoint, Film, Image, ImageError, RenderOptions, RenderStats};
