@@ -17,7 +17,7 @@ pub trait SceneBuilder {
     /// What the scene comes from, for logs and `volpt info` (a path, a generator's name).
     fn source(&self) -> String;
 
-    /// Builds the scene; `params` are `(name, value)` pairs from `-D name=value`, which the source
+    /// Builds the scene (the [`SceneAssembler`] validates it, [`crate::validate`]); `params` are `(name, value)` pairs from `-D name=value`, which the source
     /// may use or ignore.
     fn build(&self, params: &[(String, String)]) -> Result<SceneDescription, SceneError>;
 }
@@ -66,6 +66,15 @@ impl SceneBuilder for GridFile {
         let crate::DensityDesc::Grid(grid) = &mut desc.medium.density else {
             unreachable!("a grid file gives a grid density");
         };
+        let b = grid.bounds;
+        if !(0..3).all(|i| b.min[i].is_finite() && b.max[i].is_finite() && b.min[i] < b.max[i]) {
+            return Err(SceneError::InvalidScene {
+                source_name: self.source(),
+                field: "the grid's bounding box".into(),
+                expected: "finite min < max on every axis".into(),
+                found: format!("min {:?} max {:?}", b.min, b.max),
+            });
+        }
         grid.bounds = fit_unit_cube(grid.bounds);
         desc.boundary.bounds = grid.bounds;
         *grid = crate::normalise(std::mem::replace(grid, empty_grid()), GRID_FILE_DENSITY);
@@ -165,6 +174,7 @@ impl SceneAssembler {
         if let Some(rr_depth) = c.rr_depth {
             desc.integrator.rr_depth = rr_depth;
         }
+        crate::validate::validate(&desc, &builder.source())?;
         Ok(desc)
     }
 }

@@ -279,10 +279,7 @@ pub fn parse(path: &Path) -> Result<SceneFile, SceneError> {
 }
 
 fn parse_with_text(path: &Path) -> Result<(SceneFile, String), SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|error| SceneError::Io {
-        path: path.to_owned(),
-        error,
-    })?;
+    let text = crate::limits::read_text(path)?;
     let file = toml::from_str(&text).map_err(|e| SceneError::Toml {
         path: path.to_owned(),
         line: e

@@ -11,11 +11,13 @@
 //! [`crate::description::GridConvention::Cell`] with bounds
 //! `[offset - spacing/2, offset + (dim - 1/2) * spacing]` per axis.
 //!
-//! **Limits**: before `vtkio` sees the file, volpt reads the sizes it declares (legacy:
-//! `DIMENSIONS`, `POINT_DATA`, `CELL_DATA` and the first array's header; XML: `WholeExtent` and each
-//! `Piece`'s `Extent`) and rejects more than [`crate::raw::MAX_VALUES`] values, or more values than
-//! the file has bytes, because `vtkio` reserves memory for the counts it parses. The arrays after
-//! the first one in a legacy file are left to `vtkio`. zlib-compressed XML is rejected: `vtkio`
+//! **Limits**: the file is read whole (a regular file within [`crate::limits::memory_limit`]).
+//! Before `vtkio` sees it, volpt reads every size it declares (legacy: `DATASET`, which must be
+//! `STRUCTURED_POINTS`, `DIMENSIONS`, `POINT_DATA`, `CELL_DATA`, every attribute array, lookup
+//! table and field array; XML: `WholeExtent`, each `Piece`'s `Extent` and each `DataArray`'s
+//! components and tuples) and rejects more than [`crate::raw::MAX_VALUES`] values, or more values
+//! than the file has bytes, because `vtkio` reserves memory for the counts it parses.
+//! zlib-compressed XML is rejected: `vtkio`
 //! sizes its decompression buffer from the untrusted block headers. A file `vtkio` panics on (it
 //! indexes its input by declared offsets) is reported as a decode error. Only single-piece image
 //! data with an axis-aligned `Direction` (or none) is read.
@@ -64,10 +66,7 @@ fn format_of(path: &Path) -> Result<Format, SceneError> {
 /// takes the first scalar one.
 pub fn read_vtk(path: &Path, array: Option<&str>) -> Result<GridDesc, SceneError> {
     let format = format_of(path)?;
-    let bytes = std::fs::read(path).map_err(|error| SceneError::Io {
-        path: path.to_path_buf(),
-        error,
-    })?;
+    let bytes = crate::limits::read_file(path)?;
     match format {
         Format::Legacy => prescan_legacy(path, &bytes)?,
         Format::Xml => prescan_xml(path, &bytes)?,
@@ -349,22 +348,47 @@ fn convert(
         .collect()
 }
 
-/// Checks the sizes a legacy file declares before its first data block (see the module docs).
+/// Checks every size a legacy file declares before `vtkio` reserves memory for it (see the module
+/// docs). Every line is scanned, binary data included: a header line inside binary data would have
+/// to be there by accident, and its count is only compared with the file's length, which a real
+/// file's data never exceeds.
 fn prescan_legacy(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
     let file_bytes = bytes.len() as u64;
-    let mut points = None;
+    // The points (or cells) each attribute array has one entry per.
+    let mut elements: Option<u64> = None;
     for (index, line) in bytes.split(|&b| b == b'\n').enumerate() {
-        let Ok(text) = std::str::from_utf8(line) else {
-            break; // binary data
-        };
-        let tokens: Vec<&str> = text.split_whitespace().collect();
+        let tokens: Vec<&[u8]> = line
+            .split(|b| b.is_ascii_whitespace())
+            .filter(|t| !t.is_empty())
+            .collect();
         let Some(keyword) = tokens.first().map(|k| k.to_ascii_uppercase()) else {
             continue;
         };
-        let number = |i: usize| tokens.get(i).and_then(|t| t.parse::<u64>().ok());
+        let number = |i: usize| {
+            tokens
+                .get(i)
+                .and_then(|t| std::str::from_utf8(t).ok())
+                .and_then(|t| t.parse::<u64>().ok())
+        };
+        let per_element = |n: Option<u64>| elements.map(|e| e.saturating_mul(n.unwrap_or(1)));
         let line = index + 1;
-        let declared = match keyword.as_str() {
-            "DIMENSIONS" => {
+        let keyword_text = String::from_utf8_lossy(&keyword).into_owned();
+        let declared = match keyword.as_slice() {
+            b"DATASET" => {
+                let kind = tokens.get(1).map(|t| t.to_ascii_uppercase());
+                if kind.as_deref() != Some(b"STRUCTURED_POINTS".as_slice()) {
+                    return Err(unsupported(
+                        path,
+                        &format!(
+                            "line {line}: DATASET {}",
+                            String::from_utf8_lossy(tokens.get(1).copied().unwrap_or_default())
+                        ),
+                        "volpt reads image data (DATASET STRUCTURED_POINTS) only",
+                    ));
+                }
+                None
+            }
+            b"DIMENSIONS" => {
                 let dims = [number(1), number(2), number(3)];
                 if let [Some(x), Some(y), Some(z)] = dims {
                     let resolution = [x, y, z].map(|d| u32::try_from(d).unwrap_or(u32::MAX));
@@ -384,35 +408,50 @@ fn prescan_legacy(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
                     None // vtkio reports the malformed line
                 }
             }
-            "POINT_DATA" | "CELL_DATA" => {
-                points = number(1);
-                points
+            b"POINT_DATA" | b"CELL_DATA" => {
+                elements = number(1);
+                elements
             }
-            // The first attribute: its data follows, possibly binary, so the scan ends here.
-            "SCALARS"
-            | "COLOR_SCALARS"
-            | "VECTORS"
-            | "NORMALS"
-            | "TEXTURE_COORDINATES"
-            | "TENSORS"
-            | "FIELD"
-            | "LOOKUP_TABLE" => {
-                let per_point = match keyword.as_str() {
-                    "SCALARS" => number(3).unwrap_or(1),
-                    "COLOR_SCALARS" | "TEXTURE_COORDINATES" => number(2).unwrap_or(1),
-                    "VECTORS" | "NORMALS" => 3,
-                    "TENSORS" => 9,
-                    _ => 1,
-                };
-                let declared = points.map(|p| p.saturating_mul(per_point));
-                check_declared(path, line, &keyword, declared, file_bytes)?;
-                return Ok(());
-            }
+            b"SCALARS" => per_element(number(3)),
+            b"COLOR_SCALARS" | b"TEXTURE_COORDINATES" => per_element(number(2)),
+            b"VECTORS" | b"NORMALS" => per_element(Some(3)),
+            b"TENSORS" => per_element(Some(9)),
+            // `LOOKUP_TABLE name size` defines a table of `size` RGBA colours; `LOOKUP_TABLE
+            // default` after `SCALARS` only names one.
+            b"LOOKUP_TABLE" => number(2).map(|n| n.saturating_mul(4)),
+            // `FIELD name arrays`, then per array `name components tuples type`.
+            b"FIELD" | b"METADATA" | b"INFORMATION" => number(2).or(number(1)),
+            _ if tokens.len() == 4 && is_data_type(tokens[3]) => match (number(1), number(2)) {
+                (Some(components), Some(tuples)) => Some(components.saturating_mul(tuples)),
+                _ => None,
+            },
             _ => None,
         };
-        check_declared(path, line, &keyword, declared, file_bytes)?;
+        check_declared(path, line, &keyword_text, declared, file_bytes)?;
     }
     Ok(())
+}
+
+/// A legacy VTK data type name (`float`, `unsigned_char`, ...).
+fn is_data_type(token: &[u8]) -> bool {
+    const TYPES: [&str; 13] = [
+        "bit",
+        "unsigned_char",
+        "char",
+        "unsigned_short",
+        "short",
+        "unsigned_int",
+        "int",
+        "unsigned_long",
+        "long",
+        "float",
+        "double",
+        "vtktypeint64",
+        "vtktypeuint64",
+    ];
+    TYPES
+        .iter()
+        .any(|t| t.as_bytes().eq_ignore_ascii_case(token))
 }
 
 /// Every declared value takes at least one byte of the file.
@@ -441,6 +480,8 @@ fn check_declared(
 /// Checks an XML file's compressor, direction and extents before `vtkio` reads its data.
 fn prescan_xml(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
     let file_bytes = bytes.len() as u64;
+    // Points of the current piece, which its arrays have one tuple per.
+    let mut points: Option<u64> = None;
     let mut reader = quick_xml::Reader::from_reader(bytes);
     let mut buffer = Vec::new();
     loop {
@@ -488,9 +529,28 @@ fn prescan_xml(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
                         ));
                     }
                 }
-                check_extent(path, line, attribute(&element, b"WholeExtent"), file_bytes)?;
+                let extent = attribute(&element, b"WholeExtent");
+                points = extent.as_deref().and_then(extent_points);
+                check_extent(path, line, extent, file_bytes)?;
             }
-            b"Piece" => check_extent(path, line, attribute(&element, b"Extent"), file_bytes)?,
+            b"Piece" => {
+                let extent = attribute(&element, b"Extent");
+                points = extent.as_deref().and_then(extent_points);
+                check_extent(path, line, extent, file_bytes)?
+            }
+            // vtkio reserves components x tuples values for an array before reading it.
+            b"DataArray" => {
+                let number =
+                    |name: &[u8]| attribute(&element, name).map(|v| v.trim().parse::<u64>().ok());
+                let components = number(b"NumberOfComponents").unwrap_or(Some(1));
+                let tuples = number(b"NumberOfTuples").unwrap_or(points);
+                let declared = match (components, tuples) {
+                    (Some(c), Some(t)) => Some(c.saturating_mul(t)),
+                    // A count that is not a number: vtkio reports it.
+                    _ => None,
+                };
+                check_declared(path, line, "DataArray", declared, file_bytes)?
+            }
             // Raw appended data is not XML: stop before it.
             b"AppendedData" => return Ok(()),
             _ => {}
@@ -530,7 +590,9 @@ fn check_extent(
             extent,
         ));
     };
-    let dims = [x1 - x0 + 1, y1 - y0 + 1, z1 - z0 + 1];
+    // Saturating: a hostile extent must not overflow; a huge one is refused below.
+    let dims =
+        [(x0, x1), (y0, y1), (z0, z1)].map(|(lo, hi)| hi.saturating_sub(lo).saturating_add(1));
     if dims.iter().any(|&d| d <= 0) {
         return Err(bad_field(
             path,
@@ -553,6 +615,23 @@ fn check_extent(
         ));
     }
     check_declared(path, line, "extent", values, file_bytes)
+}
+
+/// The points an extent `x0 x1 y0 y1 z0 z1` spans, if it is well-formed.
+fn extent_points(extent: &str) -> Option<u64> {
+    let numbers: Option<Vec<i64>> = extent
+        .split_whitespace()
+        .map(|t| t.parse::<i64>().ok())
+        .collect();
+    let &[x0, x1, y0, y1, z0, z1] = numbers?.as_slice() else {
+        return None;
+    };
+    [(x0, x1), (y0, y1), (z0, z1)]
+        .iter()
+        .try_fold(1u64, |acc, &(lo, hi)| {
+            let points = hi.checked_sub(lo)?.checked_add(1)?;
+            acc.checked_mul(u64::try_from(points).ok()?)
+        })
 }
 
 fn unsupported(path: &Path, what: &str, reason: &str) -> SceneError {
