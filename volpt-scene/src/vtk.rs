@@ -349,40 +349,46 @@ fn convert(
 }
 
 /// Checks every size a legacy file declares before `vtkio` reserves memory for it (see the module
-/// docs). Every line is scanned, binary data included: a header line inside binary data would have
-/// to be there by accident, and its count is only compared with the file's length, which a real
-/// file's data never exceeds.
+/// docs). The scan is by whitespace-separated tokens, as `vtkio` parses (a count may sit on the
+/// next line), over the whole file, binary data included: a keyword inside binary data would be
+/// there by accident, and its count is only compared with the file's length, which a real file's
+/// data never exceeds.
 fn prescan_legacy(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
     let file_bytes = bytes.len() as u64;
+    let mut tokens: Vec<(usize, &[u8])> = Vec::new();
+    let mut start = None;
+    for (i, b) in bytes.iter().enumerate() {
+        match (b.is_ascii_whitespace(), start) {
+            (true, Some(s)) => {
+                tokens.push((s, &bytes[s..i]));
+                start = None;
+            }
+            (false, None) => start = Some(i),
+            _ => {}
+        }
+    }
+    if let Some(s) = start {
+        tokens.push((s, &bytes[s..]));
+    }
     // The points (or cells) each attribute array has one entry per.
     let mut elements: Option<u64> = None;
-    for (index, line) in bytes.split(|&b| b == b'\n').enumerate() {
-        let tokens: Vec<&[u8]> = line
-            .split(|b| b.is_ascii_whitespace())
-            .filter(|t| !t.is_empty())
-            .collect();
-        let Some(keyword) = tokens.first().map(|k| k.to_ascii_uppercase()) else {
-            continue;
-        };
-        let number = |i: usize| {
+    for (index, &(offset, token)) in tokens.iter().enumerate() {
+        let number = |k: usize| {
             tokens
-                .get(i)
-                .and_then(|t| std::str::from_utf8(t).ok())
+                .get(index + k)
+                .and_then(|(_, t)| std::str::from_utf8(t).ok())
                 .and_then(|t| t.parse::<u64>().ok())
         };
         let per_element = |n: Option<u64>| elements.map(|e| e.saturating_mul(n.unwrap_or(1)));
-        let line = index + 1;
-        let keyword_text = String::from_utf8_lossy(&keyword).into_owned();
+        let line = || 1 + bytes[..offset].iter().filter(|&&b| b == b'\n').count();
+        let keyword = token.to_ascii_uppercase();
         let declared = match keyword.as_slice() {
             b"DATASET" => {
-                let kind = tokens.get(1).map(|t| t.to_ascii_uppercase());
-                if kind.as_deref() != Some(b"STRUCTURED_POINTS".as_slice()) {
+                let kind = tokens.get(index + 1).map_or(&b""[..], |(_, t)| t);
+                if !kind.eq_ignore_ascii_case(b"STRUCTURED_POINTS") {
                     return Err(unsupported(
                         path,
-                        &format!(
-                            "line {line}: DATASET {}",
-                            String::from_utf8_lossy(tokens.get(1).copied().unwrap_or_default())
-                        ),
+                        &format!("line {}: DATASET {}", line(), String::from_utf8_lossy(kind)),
                         "volpt reads image data (DATASET STRUCTURED_POINTS) only",
                     ));
                 }
@@ -419,15 +425,26 @@ fn prescan_legacy(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
             // `LOOKUP_TABLE name size` defines a table of `size` RGBA colours; `LOOKUP_TABLE
             // default` after `SCALARS` only names one.
             b"LOOKUP_TABLE" => number(2).map(|n| n.saturating_mul(4)),
-            // `FIELD name arrays`, then per array `name components tuples type`.
+            // `FIELD name arrays`; `METADATA` / `INFORMATION count`.
             b"FIELD" | b"METADATA" | b"INFORMATION" => number(2).or(number(1)),
-            _ if tokens.len() == 4 && is_data_type(tokens[3]) => match (number(1), number(2)) {
-                (Some(components), Some(tuples)) => Some(components.saturating_mul(tuples)),
-                _ => None,
-            },
+            // A field array, `name components tuples type`: checked at its type.
+            _ if index >= 2 && is_data_type(token) => {
+                let before = |k: usize| {
+                    std::str::from_utf8(tokens[index - k].1)
+                        .ok()
+                        .and_then(|t| t.parse::<u64>().ok())
+                };
+                match (before(2), before(1)) {
+                    (Some(components), Some(tuples)) => Some(components.saturating_mul(tuples)),
+                    _ => None,
+                }
+            }
             _ => None,
         };
-        check_declared(path, line, &keyword_text, declared, file_bytes)?;
+        if declared.is_some_and(|values| values > file_bytes) {
+            let keyword = String::from_utf8_lossy(&keyword).into_owned();
+            check_declared(path, line(), &keyword, declared, file_bytes)?;
+        }
     }
     Ok(())
 }
