@@ -76,8 +76,11 @@ impl Target {
     pub fn run(self, data: &[u8]) {
         static LIMIT: Once = Once::new();
         LIMIT.call_once(|| volpt_scene::limits::set_memory_limit(FUZZ_MEMORY_LIMIT));
-        let dir = tempfile::tempdir().expect("a temporary directory");
-        let dir = dir.path();
+        DIR.with(|dir| self.run_in(dir.path(), data));
+    }
+
+    /// [`Self::run`] in `dir`, which holds no other files of this target's.
+    fn run_in(self, dir: &Path, data: &[u8]) {
         let parts = split(data);
         let part = |i: usize| parts.get(i).copied().unwrap_or_default();
         match self {
@@ -96,6 +99,8 @@ impl Target {
                     write(dir, "d.raw", part(1));
                     write(dir, "g.mhd", part(0))
                 } else {
+                    // A header naming `d.raw` must not find the last input's.
+                    let _ = std::fs::remove_file(dir.join("d.raw"));
                     write(dir, "g.mha", data)
                 };
                 let _ = volpt_scene::read_metaimage(&path);
@@ -126,6 +131,20 @@ impl Target {
             }
         }
     }
+}
+
+thread_local! {
+    /// Each thread's directory for input files, made once and overwritten by every run (a fresh
+    /// directory per input costs more than most parsers), in memory where Linux offers it.
+    static DIR: tempfile::TempDir = {
+        let shm = Path::new("/dev/shm");
+        if shm.is_dir() {
+            tempfile::tempdir_in(shm)
+        } else {
+            tempfile::tempdir()
+        }
+        .expect("a temporary directory")
+    };
 }
 
 /// The scene an [`Target::ExrEnvmap`] input is the map of.

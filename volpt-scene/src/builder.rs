@@ -66,15 +66,13 @@ impl SceneBuilder for GridFile {
         let crate::DensityDesc::Grid(grid) = &mut desc.medium.density else {
             unreachable!("a grid file gives a grid density");
         };
-        let b = grid.bounds;
-        if !(0..3).all(|i| b.min[i].is_finite() && b.max[i].is_finite() && b.min[i] < b.max[i]) {
-            return Err(SceneError::InvalidScene {
-                source_name: self.source(),
-                field: "the grid's bounding box".into(),
-                expected: "finite min < max on every axis".into(),
-                found: format!("min {:?} max {:?}", b.min, b.max),
-            });
-        }
+        // Checked before it is scaled: an empty box has no longest side to scale by.
+        crate::validate::check_bounds(grid.bounds).map_err(|found| SceneError::InvalidScene {
+            source_name: self.source(),
+            field: "the grid's bounding box".into(),
+            expected: crate::validate::BOX.into(),
+            found,
+        })?;
         grid.bounds = fit_unit_cube(grid.bounds);
         desc.boundary.bounds = grid.bounds;
         *grid = crate::normalise(std::mem::replace(grid, empty_grid()), GRID_FILE_DENSITY);

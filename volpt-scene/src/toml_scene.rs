@@ -495,6 +495,15 @@ fn assemble(
         d if d >= 0 && d <= u32::MAX as i64 => Ok(Some(d as u32)),
         d => Err(cx.invalid(field, "-1 (unlimited) or a depth >= 0", d)),
     };
+    // As the XML loader requires of a constant emitter's radiance.
+    let radiance = file.environment.radiance.rgb();
+    if !radiance.iter().all(|v| v.is_finite() && *v >= 0.0) {
+        return Err(cx.invalid(
+            "environment.radiance",
+            "a finite radiance >= 0 (one number or three)",
+            format!("{radiance:?}"),
+        ));
+    }
     Ok(SceneDescription {
         camera: CameraDesc {
             to_world,
@@ -517,7 +526,7 @@ fn assemble(
             albedo,
             phase,
         },
-        environment: EnvironmentDesc::Constant(file.environment.radiance.rgb()),
+        environment: EnvironmentDesc::Constant(radiance),
     })
 }
 

@@ -185,9 +185,11 @@ pub fn validate(desc: &SceneDescription, source: &str) -> Result<(), SceneError>
     Ok(())
 }
 
-const BOX: &str = "finite min < max on every axis";
+/// What a box must be.
+pub(crate) const BOX: &str = "finite min < max on every axis";
 
-fn check_bounds(b: Bounds) -> Result<(), String> {
+/// `Ok` for a box with finite `min < max` on every axis, else the box as the error's "found".
+pub(crate) fn check_bounds(b: Bounds) -> Result<(), String> {
     let ok = (0..3).all(|i| b.min[i].is_finite() && b.max[i].is_finite() && b.min[i] < b.max[i]);
     if ok {
         Ok(())
