@@ -191,3 +191,13 @@ fn max_depth_zero_renders_black_as_in_mitsuba() {
     let pixels = image.layer_data.channel_data.pixels;
     assert!(pixels.iter().all(|&v| v == 0.0), "{pixels:?}");
 }
+
+#[test]
+fn a_file_the_vtk_parser_panics_on_is_a_clean_error() {
+    // Found by fuzzing: vtkio indexes an empty array; the panic is caught, and its message must
+    // not reach the user either.
+    let file = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../volpt-scene/tests/fixtures/hostile/vtkio-panics.vti");
+    let out = volpt(&["info", file.to_str().unwrap()]);
+    assert_clean_error(&out, &["vtkio-panics.vti", "malformed"]);
+}

@@ -155,13 +155,34 @@ pub fn check_exr(path: &Path, what: &str, extra_bytes_per_pixel: u64) -> Result<
     else {
         return Ok(());
     };
+    // The decoder reserves a block's declared size before reading it, one block per thread.
+    let blocks_at_once = std::thread::available_parallelism().map_or(1, usize::from) as u64 + 1;
     for header in &meta.headers {
         let size = header.layer_size;
-        let per_pixel = (header.channels.bytes_per_pixel as u64).checked_add(extra_bytes_per_pixel);
-        let bytes = per_pixel.and_then(|p| bytes_of(size.area() as u64, p));
+        let stored_per_pixel = header.channels.bytes_per_pixel as u64;
+        let per_pixel = stored_per_pixel.checked_add(extra_bytes_per_pixel);
+        let layer = per_pixel.and_then(|p| bytes_of(size.area() as u64, p));
+        let block_pixels = match header.blocks {
+            exr::meta::BlockDescription::Tiles(tiles) => bytes_of(
+                tiles.tile_size.width() as u64,
+                tiles.tile_size.height() as u64,
+            ),
+            exr::meta::BlockDescription::ScanLines => bytes_of(
+                header.compression.scan_lines_per_block() as u64,
+                size.width() as u64,
+            ),
+        };
+        let blocks = block_pixels
+            .and_then(|p| bytes_of(p, stored_per_pixel))
+            .and_then(|b| bytes_of(b, blocks_at_once));
+        let bytes = layer.zip(blocks).and_then(|(l, b)| l.checked_add(b));
         check_memory(
             path,
-            &format!("{what} of {} x {} pixels", size.width(), size.height()),
+            &format!(
+                "{what} of {} x {} pixels (with its decoder's blocks)",
+                size.width(),
+                size.height()
+            ),
             bytes,
         )?;
         let table_bytes = (header.chunk_count as u64).saturating_mul(8);

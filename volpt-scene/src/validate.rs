@@ -135,7 +135,8 @@ pub fn validate(desc: &SceneDescription, source: &str) -> Result<(), SceneError>
         .sum::<f64>()
         .sqrt();
     let depth = majorant * diagonal;
-    if !(depth <= MAX_OPTICAL_DEPTH) {
+    // NaN (an infinite majorant times a zero diagonal) is refused too.
+    if depth.is_nan() || depth > MAX_OPTICAL_DEPTH {
         return Err(invalid(
             "medium",
             &format!(
@@ -173,7 +174,7 @@ pub fn validate(desc: &SceneDescription, source: &str) -> Result<(), SceneError>
                     v.to_string(),
                 ));
             }
-            if !(map.scale.is_finite() && map.scale >= 0.0) || !finite_matrix(&map.to_world) {
+            if !(map.scale.is_finite() && map.scale >= 0.0 && finite_matrix(&map.to_world)) {
                 return Err(invalid(
                     "environment map scale and to_world",
                     "finite numbers, the scale >= 0",

@@ -43,6 +43,22 @@ fn declared_sizes_over_the_memory_limit_are_refused_before_allocating() {
     let err = volpt_scene::read_vol(&path).unwrap_err();
     message_of(&err, &["big.vol", "128 x 128 x 32", "memory limit"]);
 
+    // Found by fuzzing: an EXR whose header declares tiles so large that the decoder reserved
+    // 1.8 GB for one block of a 542-byte file.
+    let fixtures = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/hostile");
+    let (_scene_dir, scene) = common::scene_file(&format!(
+        "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"/>\n\
+         <emitter type=\"envmap\"><string name=\"filename\" value=\"{}\"/></emitter>\n\
+         <shape type=\"cube\"><bsdf type=\"null\"/>\
+         <medium type=\"homogeneous\" name=\"interior\"/></shape>\n</scene>\n",
+        fixtures.join("huge-tiles.exr").display()
+    ));
+    let err = volpt_scene::load_mitsuba(&scene).unwrap_err();
+    message_of(
+        &err,
+        &["huge-tiles.exr", "decoder's blocks", "memory limit"],
+    );
+
     // A small one still loads.
     let grid = common::density_grid([8, 8, 8], common::unit_bounds());
     let path = common::write_grid(dir.path(), "small.vol", &grid);
