@@ -4,8 +4,8 @@
 
 use volpt_fuzz::{seeds, Mutator, Target};
 
-/// Mutated inputs per target: a few seconds each on the 2-core CI machine.
-const MUTATIONS: usize = 3000;
+/// Mutated inputs per target: about a second each on the 2-core CI machine.
+const MUTATIONS: usize = 20_000;
 
 fn short_run(target: Target) {
     let seeds = seeds(target);
