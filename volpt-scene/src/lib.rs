@@ -18,6 +18,7 @@
 //! - [`normalise`]: rescaling a grid's values onto `[0, target]` (raw counts to densities).
 
 pub mod builder;
+mod contain;
 pub mod description;
 pub mod error;
 pub mod generate;

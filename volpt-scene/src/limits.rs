@@ -151,8 +151,8 @@ fn kind_name(kind: std::fs::FileType) -> &'static str {
 /// parse is left for the decoder to report.
 pub fn check_exr(path: &Path, what: &str, extra_bytes_per_pixel: u64) -> Result<(), SceneError> {
     let (file, file_bytes) = open_regular(path)?;
-    let Ok(meta) = exr::meta::MetaData::read_from_buffered(std::io::BufReader::new(file), false)
-    else {
+    let read = || exr::meta::MetaData::read_from_buffered(std::io::BufReader::new(file), false);
+    let Ok(Ok(meta)) = crate::contain::contain_panics(read) else {
         return Ok(());
     };
     // The decoder reserves a block's declared size before reading it, one block per thread.

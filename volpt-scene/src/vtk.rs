@@ -22,10 +22,7 @@
 //! indexes its input by declared offsets) is reported as a decode error. Only single-piece image
 //! data with an axis-aligned `Direction` (or none) is read.
 
-use std::cell::Cell;
-use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
-use std::sync::Once;
 
 use quick_xml::events::{BytesStart, Event};
 use vtkio::model::{
@@ -37,31 +34,6 @@ use vtkio::{IOBuffer, Vtk};
 use crate::description::{GridConvention, GridDesc};
 use crate::error::{GridProblem, SceneError};
 use crate::raw::{self, grid_error, RawLayout, ScalarType, MAX_VALUES};
-
-thread_local! {
-    /// Whether this thread is inside `vtkio`'s parser, whose panics [`quietly`] catches.
-    static IN_VTKIO: Cell<bool> = const { Cell::new(false) };
-}
-
-/// Runs `parse` (`vtkio`, which panics on some malformed files), catching a panic and keeping its
-/// message off stderr: the caller reports it as a decode error, and a user should see only that.
-/// The panic hook is wrapped once, per process, to skip panics on a thread inside `vtkio`; every
-/// other panic reaches the previous hook.
-fn quietly<T>(parse: impl FnOnce() -> T) -> std::thread::Result<T> {
-    static WRAP_HOOK: Once = Once::new();
-    WRAP_HOOK.call_once(|| {
-        let previous = std::panic::take_hook();
-        std::panic::set_hook(Box::new(move |info| {
-            if !IN_VTKIO.with(Cell::get) {
-                previous(info);
-            }
-        }));
-    });
-    IN_VTKIO.with(|flag| flag.set(true));
-    let result = catch_unwind(AssertUnwindSafe(parse));
-    IN_VTKIO.with(|flag| flag.set(false));
-    result
-}
 
 /// Which of VTK's file formats a path holds, by its extension.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -98,7 +70,7 @@ pub fn read_vtk(path: &Path, array: Option<&str>) -> Result<GridDesc, SceneError
         Format::Legacy => prescan_legacy(path, &bytes)?,
         Format::Xml => prescan_xml(path, &bytes)?,
     }
-    let parsed = quietly(|| match format {
+    let parsed = crate::contain::contain_panics(|| match format {
         Format::Legacy => Vtk::parse_legacy_be(bytes.as_slice()),
         Format::Xml => Vtk::parse_xml(bytes.as_slice()),
     });

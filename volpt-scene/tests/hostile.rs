@@ -325,3 +325,19 @@ fn errors_quote_at_most_a_short_excerpt_of_a_long_line() {
     let message = message_of(&err, &["long.txt", "bytes in all"]);
     assert!(message.len() < 1000, "{} bytes of message", message.len());
 }
+
+#[test]
+fn an_envmap_the_exr_decoder_asserts_on_is_a_decode_error() {
+    // Found by fuzzing: exr's debug assertions fire on this file (its release build reads a
+    // 4 x 2 image); either way the loader reports an error about the file.
+    let map = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/hostile/exr-asserts.exr");
+    let (_dir, path) = scene_file(&format!(
+        "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"/>\n\
+         <emitter type=\"envmap\"><string name=\"filename\" value=\"{}\"/></emitter>\n\
+         <shape type=\"cube\"><bsdf type=\"null\"/>\
+         <medium type=\"homogeneous\" name=\"interior\"/></shape>\n</scene>\n",
+        map.display()
+    ));
+    let err = load(&path).unwrap_err();
+    message_of(&err, &["exr-asserts.exr"]);
+}
