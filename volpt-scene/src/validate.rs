@@ -14,6 +14,11 @@ use crate::limits::{bytes_of, check_memory, MAX_OPTICAL_DEPTH};
 /// rounded up.
 pub const FILM_BYTES_PER_PIXEL: u64 = 40;
 
+/// The roughest GGX boundary volpt renders. Mitsuba sets no upper bound, and neither does GGX, but
+/// its terms hold `alpha^2` and `alpha^4` in f32: 1e4 keeps them finite with room to spare, and
+/// any alpha above a few is already as rough as a surface gets.
+pub const MAX_ALPHA: f32 = 1e4;
+
 /// Checks `desc`; `source` names the scene file (or builder) in errors.
 pub fn validate(desc: &SceneDescription, source: &str) -> Result<(), SceneError> {
     let invalid = |field: &str, expected: &str, found: String| SceneError::InvalidScene {
@@ -69,10 +74,10 @@ pub fn validate(desc: &SceneDescription, source: &str) -> Result<(), SceneError>
             ext_ior,
         } => {
             check_iors(int_ior, ext_ior, &invalid)?;
-            if !(alpha.is_finite() && alpha > 0.0) {
+            if !(alpha > 0.0 && alpha <= MAX_ALPHA) {
                 return Err(invalid(
                     "boundary alpha",
-                    "a finite roughness > 0",
+                    &format!("a roughness in (0, {MAX_ALPHA:e}]"),
                     alpha.to_string(),
                 ));
             }

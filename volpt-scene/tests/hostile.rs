@@ -341,3 +341,22 @@ fn an_envmap_the_exr_decoder_asserts_on_is_a_decode_error() {
     let err = load(&path).unwrap_err();
     message_of(&err, &["exr-asserts.exr"]);
 }
+
+#[test]
+fn ggx_alpha_above_one_loads_as_in_mitsuba_and_absurd_alpha_is_refused() {
+    let scene = |alpha: &str| {
+        scene_file(&common::bsdf_scene(&format!(
+            "<bsdf type=\"roughdielectric\"><string name=\"distribution\" value=\"ggx\"/>\
+             <float name=\"alpha\" value=\"{alpha}\"/></bsdf>"
+        )))
+    };
+    let (_dir, path) = scene("2");
+    let desc = load(&path).expect("alpha 2 loads, with a warning");
+    assert!(matches!(
+        desc.boundary.bsdf,
+        volpt_scene::BsdfDesc::RoughDielectric { alpha, .. } if alpha == 2.0
+    ));
+    let (_dir, path) = scene("1e30");
+    let err = load(&path).unwrap_err();
+    message_of(&err, &["scene.xml", "alpha", "1e4"]);
+}
