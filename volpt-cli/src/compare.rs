@@ -2,9 +2,10 @@
 //!
 //! Renders of one scene and seed on the CPU and with the GPU's naiveSK trace the same paths and
 //! sum them in the same order, so they must be bit-identical; other strategies sum in another
-//! order and differ by rounding only. The report says which case holds.
+//! order and differ by rounding only. The report says which case holds. An image holding NaN or
+//! Inf fails the comparison.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Result};
 use clap::Args;
@@ -18,13 +19,44 @@ pub struct CompareArgs {
     #[arg(long)]
     identical: bool,
     /// Fail if any pixel channel differs by more than this, relative to max(|a|, |b|, 1e-3).
-    #[arg(long)]
+    #[arg(long, value_parser = parse_bound)]
     max_relative: Option<f64>,
 }
 
+/// A tolerance: a finite number >= 0 (NaN would make every comparison pass).
+fn parse_bound(s: &str) -> Result<f64, String> {
+    s.parse::<f64>()
+        .ok()
+        .filter(|b| b.is_finite() && *b >= 0.0)
+        .ok_or_else(|| format!("expected a finite number >= 0, found {s:?}"))
+}
+
+/// Reads an EXR after checking what its header claims against the memory limit, and refuses
+/// non-finite pixels: a render holding NaN or Inf is broken, whatever the other image holds.
+fn read(path: &Path) -> Result<Image> {
+    // `Image` keeps three f32 per pixel beside the decoded channels.
+    volpt_scene::limits::check_exr(path, "the image", 12)?;
+    let image = Image::read_exr(path)?;
+    if let Some(i) = image
+        .pixels
+        .iter()
+        .position(|p| p.iter().any(|v| !v.is_finite()))
+    {
+        let width = image.width as usize;
+        bail!(
+            "{}: pixel (x={}, y={}) is {:?}: expected finite values",
+            path.display(),
+            i % width,
+            i / width,
+            image.pixels[i]
+        );
+    }
+    Ok(image)
+}
+
 pub fn run(args: &CompareArgs) -> Result<()> {
-    let a = Image::read_exr(&args.a)?;
-    let b = Image::read_exr(&args.b)?;
+    let a = read(&args.a)?;
+    let b = read(&args.b)?;
     if (a.width, a.height) != (b.width, b.height) {
         bail!(
             "{} is {}x{} but {} is {}x{}",

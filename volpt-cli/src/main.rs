@@ -30,6 +30,11 @@ use volpt_cuda::Strategy;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// The most memory one piece of loaded data (a grid, a map, the film) may take, in bytes or
+    /// with a K, M, G suffix (powers of 1024); input that claims more is refused before it is read.
+    #[arg(long, global = true, value_name = "BYTES", value_parser = parse_bytes,
+          default_value_t = volpt_scene::limits::DEFAULT_MEMORY_LIMIT)]
+    memory_limit: u64,
 }
 
 #[derive(Subcommand)]
@@ -141,7 +146,8 @@ struct RenderArgs {
     scene: SceneArgs,
     #[command(flatten)]
     sampling: SamplingArgs,
-    /// Output OpenEXR file; the PNG preview gets the same name with `.png`.
+    /// Output OpenEXR file, named `.exr`; the PNG preview gets the same name with `.png`. A path
+    /// that exists and is not a regular file (`/dev/null`, a pipe) gets the EXR and no preview.
     #[arg(short, long, default_value = "out.exr")]
     output: PathBuf,
     /// Save the render's progress to FILE periodically and on Ctrl-C, to continue it with
@@ -163,12 +169,41 @@ struct BenchArgs {
     scene: SceneArgs,
     #[command(flatten)]
     sampling: SamplingArgs,
-    /// Timed trials, after one discarded warm-up trial.
-    #[arg(long, default_value_t = 5)]
-    trials: usize,
+    /// Timed trials, after one discarded warm-up trial (at most 10000).
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=MAX_TRIALS))]
+    trials: u32,
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
+}
+
+/// The most `bench --trials`: more is a typo, not a benchmark.
+const MAX_TRIALS: i64 = 10_000;
+
+/// `1234`, `512K`, `64M`, `8G` (powers of 1024) as bytes.
+fn parse_bytes(s: &str) -> Result<u64, String> {
+    let (digits, unit) = match s.char_indices().last() {
+        Some((i, c)) if c.is_ascii_alphabetic() => (&s[..i], c.to_ascii_uppercase()),
+        _ => (s, 'B'),
+    };
+    let shift = match unit {
+        'B' => 0,
+        'K' => 10,
+        'M' => 20,
+        'G' => 30,
+        'T' => 40,
+        _ => {
+            return Err(format!(
+                "expected bytes with an optional K, M, G or T, found {s:?}"
+            ))
+        }
+    };
+    digits
+        .parse::<u64>()
+        .ok()
+        .and_then(|n| n.checked_mul(1 << shift))
+        .filter(|&n| n > 0)
+        .ok_or_else(|| format!("expected a positive number of bytes such as 8G, found {s:?}"))
 }
 
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
@@ -200,7 +235,9 @@ fn main() -> Result<()> {
         )
         .with_writer(std::io::stderr)
         .init();
-    match Cli::parse().command {
+    let cli = Cli::parse();
+    volpt_scene::limits::set_memory_limit(cli.memory_limit);
+    match cli.command {
         Command::Render(args) => render_command(args),
         Command::Bench(args) => bench_command(args),
         Command::Info(args) => {
@@ -249,8 +286,17 @@ fn load(args: &SceneArgs) -> Result<SceneDescription> {
 }
 
 fn options(desc: &SceneDescription, sampling: &SamplingArgs) -> Result<RenderOptions> {
-    if sampling.threads == Some(0) {
-        bail!("--threads must be at least 1");
+    if let Some(threads) = sampling.threads {
+        // Threads beyond the cores only cost memory and start-up; tens of thousands of them
+        // exhaust the system before the render starts.
+        let cores = std::thread::available_parallelism().map_or(1, usize::from);
+        let most = 4 * cores;
+        if !(1..=most).contains(&threads) {
+            bail!(
+                "--threads: expected 1 to {most} (4 x the {cores} cores of this machine), \
+                 found {threads}"
+            );
+        }
     }
     Ok(RenderOptions {
         spp: desc.spp,
@@ -260,6 +306,8 @@ fn options(desc: &SceneDescription, sampling: &SamplingArgs) -> Result<RenderOpt
 }
 
 fn render_command(args: RenderArgs) -> Result<()> {
+    // Before the render, so that a bad name costs nothing.
+    let preview = preview_for(&args.output)?;
     let desc = load(&args.scene)?;
     let job = RenderJob {
         desc: &desc,
@@ -311,11 +359,38 @@ fn render_command(args: RenderArgs) -> Result<()> {
     image
         .write_exr(&args.output)
         .with_context(|| format!("writing {}", args.output.display()))?;
-    let preview = preview_path(&args.output);
-    image.write_png(&preview)?;
     println!("{}", summary(&image, job.options.spp, &stats, variant));
-    println!("wrote {} and {}", args.output.display(), preview.display());
+    match preview {
+        Some(preview) => {
+            image.write_png(&preview)?;
+            println!("wrote {} and {}", args.output.display(), preview.display());
+        }
+        None => println!(
+            "wrote {} (no preview for a non-file)",
+            args.output.display()
+        ),
+    }
     Ok(())
+}
+
+/// Where the preview goes: beside the EXR with `.png`, or nowhere when the output is not a file
+/// path (`/dev/null`, a pipe). An output not named `.exr` is an error, so that the preview can
+/// never overwrite the image (`-o x.png`) and a typo does not write an EXR under another name.
+fn preview_for(output: &Path) -> Result<Option<PathBuf>> {
+    if output.metadata().is_ok_and(|m| !m.is_file() && !m.is_dir()) {
+        return Ok(None);
+    }
+    let is_exr = output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    if !is_exr {
+        bail!(
+            "-o {}: expected a file name ending in .exr (the image is OpenEXR; its PNG preview \
+             is written beside it as NAME.png)",
+            output.display()
+        );
+    }
+    Ok(Some(preview_path(output)))
 }
 
 fn summary(image: &Image, spp: u32, stats: &RenderStats, variant: Variant) -> String {
@@ -355,9 +430,6 @@ fn truncation_warning(c: &volpt_core::PathCounters) -> Option<String> {
 }
 
 fn bench_command(args: BenchArgs) -> Result<()> {
-    if args.trials == 0 {
-        bail!("--trials must be at least 1");
-    }
     let desc = load(&args.scene)?;
     let job = RenderJob {
         desc: &desc,
@@ -367,7 +439,7 @@ fn bench_command(args: BenchArgs) -> Result<()> {
         show_progress: false,
     };
     let backend = Backend::open(args.sampling.backend, args.sampling.strategy)?;
-    let mut trials = Vec::with_capacity(args.trials);
+    let mut trials = Vec::new();
     let mut last = None;
     for trial in 0..=args.trials {
         let (image, stats) = backend.render(&job)?;

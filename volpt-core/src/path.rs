@@ -146,6 +146,11 @@ impl PathState {
 /// Advances `path` by one free flight and the event that ends it.
 #[inline(always)]
 pub fn step<S: Scene>(scene: &S, path: &mut PathState) {
+    // Mitsuba's max_depth 0 allows no segment at all: the image is black.
+    if scene.settings().max_depth == 0 {
+        path.alive = false;
+        return;
+    }
     path.segments += 1;
     if path.segments > scene.settings().max_segments {
         path.truncated = Truncation::Segments;

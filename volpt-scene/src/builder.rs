@@ -17,7 +17,7 @@ pub trait SceneBuilder {
     /// What the scene comes from, for logs and `volpt info` (a path, a generator's name).
     fn source(&self) -> String;
 
-    /// Builds the scene; `params` are `(name, value)` pairs from `-D name=value`, which the source
+    /// Builds the scene (the [`SceneAssembler`] validates it, [`crate::validate`]); `params` are `(name, value)` pairs from `-D name=value`, which the source
     /// may use or ignore.
     fn build(&self, params: &[(String, String)]) -> Result<SceneDescription, SceneError>;
 }
@@ -66,6 +66,13 @@ impl SceneBuilder for GridFile {
         let crate::DensityDesc::Grid(grid) = &mut desc.medium.density else {
             unreachable!("a grid file gives a grid density");
         };
+        // Checked before it is scaled: an empty box has no longest side to scale by.
+        crate::validate::check_bounds(grid.bounds).map_err(|found| SceneError::InvalidScene {
+            source_name: self.source(),
+            field: "the grid's bounding box".into(),
+            expected: crate::validate::BOX.into(),
+            found,
+        })?;
         grid.bounds = fit_unit_cube(grid.bounds);
         desc.boundary.bounds = grid.bounds;
         *grid = crate::normalise(std::mem::replace(grid, empty_grid()), GRID_FILE_DENSITY);
@@ -166,6 +173,7 @@ impl SceneAssembler {
         if let Some(rr_depth) = c.rr_depth {
             desc.integrator.rr_depth = rr_depth;
         }
+        crate::validate::validate(&desc, &builder.source())?;
         crate::numerics::check_position_resolution(&desc, Path::new(&builder.source()))?;
         Ok(desc)
     }

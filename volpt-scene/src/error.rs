@@ -22,7 +22,7 @@ pub enum SceneError {
     },
 
     /// The file is not well-formed XML (or not UTF-8).
-    #[error("{}:{line}: malformed XML: {message}", path.display())]
+    #[error("{}:{line}: malformed XML: {}", path.display(), excerpt(message))]
     Xml {
         path: PathBuf,
         line: usize,
@@ -30,7 +30,7 @@ pub enum SceneError {
     },
 
     /// Valid Mitsuba that volpt does not render (an unknown element, plugin or combination).
-    #[error("{}:{line}: {what} is not supported: {reason}", path.display())]
+    #[error("{}:{line}: {} is not supported: {}", path.display(), excerpt(what), excerpt(reason))]
     Unsupported {
         path: PathBuf,
         line: usize,
@@ -39,7 +39,7 @@ pub enum SceneError {
     },
 
     /// A value that cannot be parsed or is out of range.
-    #[error("{}:{line}: {field}: expected {expected}, found {found}", path.display())]
+    #[error("{}:{line}: {}: expected {expected}, found {}", path.display(), excerpt(field), excerpt(found))]
     InvalidValue {
         path: PathBuf,
         line: usize,
@@ -49,7 +49,7 @@ pub enum SceneError {
     },
 
     /// Something required is absent; `element` is the element that should contain it.
-    #[error("{}:{line}: {element}: missing {what}", path.display())]
+    #[error("{}:{line}: {element}: missing {}", path.display(), excerpt(what))]
     Missing {
         path: PathBuf,
         line: usize,
@@ -58,7 +58,7 @@ pub enum SceneError {
     },
 
     /// A volpt TOML scene file is malformed: bad TOML, an unknown key, or a value of the wrong type.
-    #[error("{}:{line}: {message}", path.display())]
+    #[error("{}:{line}: {}", path.display(), excerpt(message))]
     Toml {
         path: PathBuf,
         line: usize,
@@ -83,6 +83,37 @@ pub enum SceneError {
     /// A scene that cannot be written in the requested format without changing it.
     #[error("{}: cannot write this scene: {reason}", path.display())]
     Export { path: PathBuf, reason: String },
+
+    /// A path that is not a regular file (a FIFO, a device, a directory): reading one could block
+    /// or never end, so loaders refuse it before opening it.
+    #[error("{}: expected a regular file, found {kind}", path.display())]
+    NotAFile { path: PathBuf, kind: &'static str },
+
+    /// Data whose declared size would take more memory than volpt's limit
+    /// ([`crate::limits::memory_limit`]); nothing was allocated for it.
+    #[error(
+        "{}: {what} would take {}, over the memory limit of {limit} bytes \
+         (--memory-limit raises it)",
+        path.display(),
+        bytes.map_or("more than 2^64 bytes".to_owned(), |b| format!("{b} bytes"))
+    )]
+    OverMemoryLimit {
+        path: PathBuf,
+        what: String,
+        /// `None` when the size overflows 64 bits.
+        bytes: Option<u64>,
+        limit: u64,
+    },
+
+    /// An assembled scene that no renderer can use (checked for every source, see
+    /// [`crate::validate`]); `source` names the scene file or builder.
+    #[error("{source_name}: {field}: expected {expected}, found {found}")]
+    InvalidScene {
+        source_name: String,
+        field: String,
+        expected: String,
+        found: String,
+    },
 
     /// An error in a file that a scene file refers to (a grid, a mesh): says which element
     /// referred to it, then the error itself (which names the referred-to file).
@@ -297,9 +328,16 @@ impl fmt::Display for GridProblem {
                 if let Some(line) = line {
                     write!(f, "line {line}: ")?;
                 }
-                write!(f, "{field}: expected {expected}, found {found:?}")
+                write!(
+                    f,
+                    "{}: expected {expected}, found {:?}",
+                    excerpt(field),
+                    excerpt(found)
+                )
             }
-            Self::Unsupported { what, reason } => write!(f, "{what} is not supported: {reason}"),
+            Self::Unsupported { what, reason } => {
+                write!(f, "{} is not supported: {reason}", excerpt(what))
+            }
             Self::TooLarge {
                 resolution: [x, y, z],
                 channels,
@@ -321,7 +359,7 @@ impl fmt::Display for GridProblem {
                 what,
                 expected_bytes,
             } => write!(f, "{what}: expected {expected_bytes} bytes, found more"),
-            Self::Decode { what, message } => write!(f, "{what}: {message}"),
+            Self::Decode { what, message } => write!(f, "{what}: {}", excerpt(message)),
             Self::BadValue {
                 voxel: [x, y, z],
                 channel,
@@ -372,7 +410,9 @@ impl fmt::Display for EnvmapProblem {
                 ".{extension} environment maps are not supported: volpt reads OpenEXR only, \
                  so convert it to .exr (linear RGB, half or float)"
             ),
-            Self::Decode { message } => write!(f, "not a readable OpenEXR image: {message}"),
+            Self::Decode { message } => {
+                write!(f, "not a readable OpenEXR image: {}", excerpt(message))
+            }
             Self::Channels { found } => write!(
                 f,
                 "expected R, G and B channels (or one Y channel), found {}",
@@ -403,4 +443,20 @@ impl fmt::Display for EnvmapProblem {
             ),
         }
     }
+}
+
+/// The longest piece of input text an error message quotes, in bytes.
+pub const MAX_QUOTED_BYTES: usize = 200;
+
+/// `text`, or its beginning and its length when it is longer than [`MAX_QUOTED_BYTES`]: a
+/// message quotes input so that the user can find it, and a 10 MB line helps nobody.
+pub fn excerpt(text: &str) -> std::borrow::Cow<'_, str> {
+    if text.len() <= MAX_QUOTED_BYTES {
+        return text.into();
+    }
+    let mut end = MAX_QUOTED_BYTES;
+    while !text.is_char_boundary(end) {
+        end -= 1;
+    }
+    format!("{}... ({} bytes in all)", &text[..end], text.len()).into()
 }

@@ -13,13 +13,17 @@
 //! - [`metaimage`]: MetaImage `.mha`/`.mhd` grids, read and written.
 //! - [`vtk`]: VTK image data (legacy `STRUCTURED_POINTS` `.vtk`, XML `.vti`), read and written.
 //! - [`transfer`]: transfer functions from density to RGB albedo, and their text files.
+//! - [`limits`]: what untrusted input may make volpt allocate or do, checked before it does.
+//! - [`validate`]: the check every assembled scene passes, whatever its format.
 //! - [`normalise`]: rescaling a grid's values onto `[0, target]` (raw counts to densities).
 //! - [`numerics`]: whether `f32` positions resolve a scene's free flights (checked on assembly).
 
 pub mod builder;
+mod contain;
 pub mod description;
 pub mod error;
 pub mod generate;
+pub mod limits;
 pub mod metaimage;
 pub mod mitsuba;
 pub mod normalise;
@@ -28,6 +32,7 @@ mod output;
 pub mod raw;
 pub mod toml_scene;
 pub mod transfer;
+pub mod validate;
 pub mod vol;
 pub mod vtk;
 

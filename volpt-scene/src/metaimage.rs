@@ -33,7 +33,6 @@
 //! size; every value must be finite and non-negative. Every error names the file, and header errors
 //! the line and field.
 
-use std::fs::File;
 use std::io::{BufRead, BufReader, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
@@ -71,11 +70,8 @@ impl Default for MetaImageOptions {
 
 /// Reads a `.mha` or `.mhd` file (see the module docs for the fields and checks).
 pub fn read_metaimage(path: &Path) -> Result<GridDesc, SceneError> {
-    let io = |error| SceneError::Io {
-        path: path.to_path_buf(),
-        error,
-    };
-    let mut reader = BufReader::new(File::open(path).map_err(io)?);
+    let (file, _) = crate::limits::open_regular(path)?;
+    let mut reader = BufReader::new(file);
     let (fields, header_len) = read_fields(path, &mut reader)?;
     let header = Header::parse(path, &fields)?;
     let (_, data_bytes) = header.layout.checked_size(path)?;
@@ -94,10 +90,7 @@ pub fn read_metaimage(path: &Path) -> Result<GridDesc, SceneError> {
         None => (reader.into_inner(), path.to_path_buf(), header_len),
         Some(name) => {
             let data_path = path.parent().unwrap_or(Path::new("")).join(name);
-            let file = File::open(&data_path).map_err(|error| SceneError::Io {
-                path: data_path.clone(),
-                error,
-            })?;
+            let (file, _) = crate::limits::open_regular(&data_path)?;
             (file, data_path, 0)
         }
     };
@@ -158,6 +151,22 @@ pub fn read_metaimage(path: &Path) -> Result<GridDesc, SceneError> {
             (skip, stored)
         }
     };
+    // Deflate cannot expand past its own ratio: a header declaring more data than the stored
+    // bytes can hold is refused before anything is reserved for it.
+    if header.compressed && data_bytes > stored.saturating_mul(crate::limits::DEFLATE_MAX_RATIO) {
+        return Err(grid_error(
+            path,
+            GridProblem::SizeMismatch {
+                what: format!(
+                    "{} (at most {} times the compressed size, zlib's limit)",
+                    what("decompressed voxel data"),
+                    crate::limits::DEFLATE_MAX_RATIO
+                ),
+                expected_bytes: data_bytes,
+                actual_bytes: stored.saturating_mul(crate::limits::DEFLATE_MAX_RATIO),
+            },
+        ));
+    }
     data_file
         .seek(SeekFrom::Start(region_start + skip))
         .map_err(data_io)?;

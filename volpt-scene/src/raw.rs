@@ -199,6 +199,15 @@ impl RawLayout {
             .filter(|&v| v <= MAX_VALUES)
             .ok_or_else(too_large)?;
         let count = usize::try_from(values).map_err(|_| too_large())?;
+        let [x, y, z] = self.resolution;
+        crate::limits::check_memory(
+            path,
+            &format!(
+                "the grid of {x} x {y} x {z} voxels x {} channels as f32",
+                self.channels
+            ),
+            crate::limits::bytes_of(values, 4),
+        )?;
         // At most 2^32 values of at most 8 bytes: no overflow.
         Ok((count, values * self.scalar.bytes() as u64))
     }
@@ -213,8 +222,7 @@ pub fn read_raw(path: &Path, layout: &RawLayout, bounds: Bounds) -> Result<GridD
         path: path.to_path_buf(),
         error,
     };
-    let mut file = File::open(path).map_err(io)?;
-    let file_bytes = file.metadata().map_err(io)?.len();
+    let (mut file, file_bytes) = crate::limits::open_regular(path)?;
     let what = || {
         format!(
             "{} header bytes + data of {} x {} x {} voxels x {} channels x {} bytes",

@@ -307,10 +307,7 @@ pub fn parse(path: &Path) -> Result<SceneFile, SceneError> {
 }
 
 fn parse_with_text(path: &Path) -> Result<(SceneFile, String), SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|error| SceneError::Io {
-        path: path.to_owned(),
-        error,
-    })?;
+    let text = crate::limits::read_text(path)?;
     let file = toml::from_str(&text).map_err(|e| {
         let start = e.span().map(|span| span.start);
         SceneError::Toml {
@@ -535,6 +532,15 @@ fn assemble(
         d if d >= 0 && d <= u32::MAX as i64 => Ok(Some(d as u32)),
         d => Err(cx.invalid(field, "-1 (unlimited) or a depth >= 0", d)),
     };
+    // As the XML loader requires of a constant emitter's radiance.
+    let radiance = file.environment.radiance.rgb();
+    if !radiance.iter().all(|v| v.is_finite() && *v >= 0.0) {
+        return Err(cx.invalid(
+            "environment.radiance",
+            "a finite radiance >= 0 (one number or three)",
+            format!("{radiance:?}"),
+        ));
+    }
     Ok(SceneDescription {
         camera: CameraDesc {
             to_world,
@@ -557,7 +563,7 @@ fn assemble(
             albedo,
             phase,
         },
-        environment: EnvironmentDesc::Constant(file.environment.radiance.rgb()),
+        environment: EnvironmentDesc::Constant(radiance),
     })
 }
 

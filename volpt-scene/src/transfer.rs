@@ -33,10 +33,7 @@ pub struct TransferFunction {
 impl TransferFunction {
     /// Reads a transfer-function file (format in the module docs).
     pub fn read(path: &Path) -> Result<Self, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|error| SceneError::Io {
-            path: path.to_path_buf(),
-            error,
-        })?;
+        let text = crate::limits::read_text(path)?;
         Self::parse(&text, path)
     }
 

@@ -153,8 +153,7 @@ pub fn read_vol(path: &Path) -> Result<VolGrid, SceneError> {
         path: path.to_path_buf(),
         error,
     };
-    let mut file = File::open(path).map_err(io)?;
-    let file_bytes = file.metadata().map_err(io)?.len();
+    let (mut file, file_bytes) = crate::limits::open_regular(path)?;
     if file_bytes < VOL_HEADER_BYTES {
         return Err(vol_error(
             path,
@@ -168,6 +167,15 @@ pub fn read_vol(path: &Path) -> Result<VolGrid, SceneError> {
     file.read_exact(&mut raw).map_err(io)?;
     let header =
         parse_header(&raw, file_bytes - VOL_HEADER_BYTES).map_err(|p| vol_error(path, p))?;
+    let [x, y, z] = header.resolution;
+    crate::limits::check_memory(
+        path,
+        &format!(
+            "the grid of {x} x {y} x {z} voxels x {} channels as f32",
+            header.channels
+        ),
+        crate::limits::bytes_of(header.value_count as u64, 4),
+    )?;
 
     let mut data = Vec::new();
     if data.try_reserve_exact(header.value_count).is_err() {

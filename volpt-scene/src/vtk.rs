@@ -11,16 +11,17 @@
 //! [`crate::description::GridConvention::Cell`] with bounds
 //! `[offset - spacing/2, offset + (dim - 1/2) * spacing]` per axis.
 //!
-//! **Limits**: before `vtkio` sees the file, volpt reads the sizes it declares (legacy:
-//! `DIMENSIONS`, `POINT_DATA`, `CELL_DATA` and the first array's header; XML: `WholeExtent` and each
-//! `Piece`'s `Extent`) and rejects more than [`crate::raw::MAX_VALUES`] values, or more values than
-//! the file has bytes, because `vtkio` reserves memory for the counts it parses. The arrays after
-//! the first one in a legacy file are left to `vtkio`. zlib-compressed XML is rejected: `vtkio`
+//! **Limits**: the file is read whole (a regular file within [`crate::limits::memory_limit`]).
+//! Before `vtkio` sees it, volpt reads every size it declares (legacy: `DATASET`, which must be
+//! `STRUCTURED_POINTS`, `DIMENSIONS`, `POINT_DATA`, `CELL_DATA`, every attribute array, lookup
+//! table and field array; XML: `WholeExtent`, each `Piece`'s `Extent` and each `DataArray`'s
+//! components and tuples) and rejects more than [`crate::raw::MAX_VALUES`] values, or more values
+//! than the file has bytes, because `vtkio` reserves memory for the counts it parses.
+//! zlib-compressed XML is rejected: `vtkio`
 //! sizes its decompression buffer from the untrusted block headers. A file `vtkio` panics on (it
 //! indexes its input by declared offsets) is reported as a decode error. Only single-piece image
 //! data with an axis-aligned `Direction` (or none) is read.
 
-use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
 
 use quick_xml::events::{BytesStart, Event};
@@ -64,18 +65,15 @@ fn format_of(path: &Path) -> Result<Format, SceneError> {
 /// takes the first scalar one.
 pub fn read_vtk(path: &Path, array: Option<&str>) -> Result<GridDesc, SceneError> {
     let format = format_of(path)?;
-    let bytes = std::fs::read(path).map_err(|error| SceneError::Io {
-        path: path.to_path_buf(),
-        error,
-    })?;
+    let bytes = crate::limits::read_file(path)?;
     match format {
         Format::Legacy => prescan_legacy(path, &bytes)?,
         Format::Xml => prescan_xml(path, &bytes)?,
     }
-    let parsed = catch_unwind(AssertUnwindSafe(|| match format {
+    let parsed = crate::contain::contain_panics(|| match format {
         Format::Legacy => Vtk::parse_legacy_be(bytes.as_slice()),
         Format::Xml => Vtk::parse_xml(bytes.as_slice()),
-    }));
+    });
     let decode = |message: String| {
         grid_error(
             path,
@@ -349,22 +347,53 @@ fn convert(
         .collect()
 }
 
-/// Checks the sizes a legacy file declares before its first data block (see the module docs).
+/// Checks every size a legacy file declares before `vtkio` reserves memory for it (see the module
+/// docs). The scan is by whitespace-separated tokens, as `vtkio` parses (a count may sit on the
+/// next line), over the whole file, binary data included: a keyword inside binary data would be
+/// there by accident, and its count is only compared with the file's length, which a real file's
+/// data never exceeds.
 fn prescan_legacy(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
     let file_bytes = bytes.len() as u64;
-    let mut points = None;
-    for (index, line) in bytes.split(|&b| b == b'\n').enumerate() {
-        let Ok(text) = std::str::from_utf8(line) else {
-            break; // binary data
+    let mut tokens: Vec<(usize, &[u8])> = Vec::new();
+    let mut start = None;
+    for (i, b) in bytes.iter().enumerate() {
+        match (b.is_ascii_whitespace(), start) {
+            (true, Some(s)) => {
+                tokens.push((s, &bytes[s..i]));
+                start = None;
+            }
+            (false, None) => start = Some(i),
+            _ => {}
+        }
+    }
+    if let Some(s) = start {
+        tokens.push((s, &bytes[s..]));
+    }
+    // The points (or cells) each attribute array has one entry per.
+    let mut elements: Option<u64> = None;
+    for (index, &(offset, token)) in tokens.iter().enumerate() {
+        let number = |k: usize| {
+            tokens
+                .get(index + k)
+                .and_then(|(_, t)| std::str::from_utf8(t).ok())
+                .and_then(|t| t.parse::<u64>().ok())
         };
-        let tokens: Vec<&str> = text.split_whitespace().collect();
-        let Some(keyword) = tokens.first().map(|k| k.to_ascii_uppercase()) else {
-            continue;
-        };
-        let number = |i: usize| tokens.get(i).and_then(|t| t.parse::<u64>().ok());
-        let line = index + 1;
-        let declared = match keyword.as_str() {
-            "DIMENSIONS" => {
+        let per_element = |n: Option<u64>| elements.map(|e| e.saturating_mul(n.unwrap_or(1)));
+        let line = || 1 + bytes[..offset].iter().filter(|&&b| b == b'\n').count();
+        let keyword = token.to_ascii_uppercase();
+        let declared = match keyword.as_slice() {
+            b"DATASET" => {
+                let kind = tokens.get(index + 1).map_or(&b""[..], |(_, t)| t);
+                if !kind.eq_ignore_ascii_case(b"STRUCTURED_POINTS") {
+                    return Err(unsupported(
+                        path,
+                        &format!("line {}: DATASET {}", line(), String::from_utf8_lossy(kind)),
+                        "volpt reads image data (DATASET STRUCTURED_POINTS) only",
+                    ));
+                }
+                None
+            }
+            b"DIMENSIONS" => {
                 let dims = [number(1), number(2), number(3)];
                 if let [Some(x), Some(y), Some(z)] = dims {
                     let resolution = [x, y, z].map(|d| u32::try_from(d).unwrap_or(u32::MAX));
@@ -384,35 +413,61 @@ fn prescan_legacy(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
                     None // vtkio reports the malformed line
                 }
             }
-            "POINT_DATA" | "CELL_DATA" => {
-                points = number(1);
-                points
+            b"POINT_DATA" | b"CELL_DATA" => {
+                elements = number(1);
+                elements
             }
-            // The first attribute: its data follows, possibly binary, so the scan ends here.
-            "SCALARS"
-            | "COLOR_SCALARS"
-            | "VECTORS"
-            | "NORMALS"
-            | "TEXTURE_COORDINATES"
-            | "TENSORS"
-            | "FIELD"
-            | "LOOKUP_TABLE" => {
-                let per_point = match keyword.as_str() {
-                    "SCALARS" => number(3).unwrap_or(1),
-                    "COLOR_SCALARS" | "TEXTURE_COORDINATES" => number(2).unwrap_or(1),
-                    "VECTORS" | "NORMALS" => 3,
-                    "TENSORS" => 9,
-                    _ => 1,
+            b"SCALARS" => per_element(number(3)),
+            b"COLOR_SCALARS" | b"TEXTURE_COORDINATES" => per_element(number(2)),
+            b"VECTORS" | b"NORMALS" => per_element(Some(3)),
+            b"TENSORS" => per_element(Some(9)),
+            // `LOOKUP_TABLE name size` defines a table of `size` RGBA colours; `LOOKUP_TABLE
+            // default` after `SCALARS` only names one.
+            b"LOOKUP_TABLE" => number(2).map(|n| n.saturating_mul(4)),
+            // `FIELD name arrays`; `METADATA` / `INFORMATION count`.
+            b"FIELD" | b"METADATA" | b"INFORMATION" => number(2).or(number(1)),
+            // A field array, `name components tuples type`: checked at its type.
+            _ if index >= 2 && is_data_type(token) => {
+                let before = |k: usize| {
+                    std::str::from_utf8(tokens[index - k].1)
+                        .ok()
+                        .and_then(|t| t.parse::<u64>().ok())
                 };
-                let declared = points.map(|p| p.saturating_mul(per_point));
-                check_declared(path, line, &keyword, declared, file_bytes)?;
-                return Ok(());
+                match (before(2), before(1)) {
+                    (Some(components), Some(tuples)) => Some(components.saturating_mul(tuples)),
+                    _ => None,
+                }
             }
             _ => None,
         };
-        check_declared(path, line, &keyword, declared, file_bytes)?;
+        if declared.is_some_and(|values| values > file_bytes) {
+            let keyword = String::from_utf8_lossy(&keyword).into_owned();
+            check_declared(path, line(), &keyword, declared, file_bytes)?;
+        }
     }
     Ok(())
+}
+
+/// A legacy VTK data type name (`float`, `unsigned_char`, ...).
+fn is_data_type(token: &[u8]) -> bool {
+    const TYPES: [&str; 13] = [
+        "bit",
+        "unsigned_char",
+        "char",
+        "unsigned_short",
+        "short",
+        "unsigned_int",
+        "int",
+        "unsigned_long",
+        "long",
+        "float",
+        "double",
+        "vtktypeint64",
+        "vtktypeuint64",
+    ];
+    TYPES
+        .iter()
+        .any(|t| t.as_bytes().eq_ignore_ascii_case(token))
 }
 
 /// Every declared value takes at least one byte of the file.
@@ -441,6 +496,8 @@ fn check_declared(
 /// Checks an XML file's compressor, direction and extents before `vtkio` reads its data.
 fn prescan_xml(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
     let file_bytes = bytes.len() as u64;
+    // Points of the current piece, which its arrays have one tuple per.
+    let mut points: Option<u64> = None;
     let mut reader = quick_xml::Reader::from_reader(bytes);
     let mut buffer = Vec::new();
     loop {
@@ -488,9 +545,28 @@ fn prescan_xml(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
                         ));
                     }
                 }
-                check_extent(path, line, attribute(&element, b"WholeExtent"), file_bytes)?;
+                let extent = attribute(&element, b"WholeExtent");
+                points = extent.as_deref().and_then(extent_points);
+                check_extent(path, line, extent, file_bytes)?;
             }
-            b"Piece" => check_extent(path, line, attribute(&element, b"Extent"), file_bytes)?,
+            b"Piece" => {
+                let extent = attribute(&element, b"Extent");
+                points = extent.as_deref().and_then(extent_points);
+                check_extent(path, line, extent, file_bytes)?
+            }
+            // vtkio reserves components x tuples values for an array before reading it.
+            b"DataArray" => {
+                let number =
+                    |name: &[u8]| attribute(&element, name).map(|v| v.trim().parse::<u64>().ok());
+                let components = number(b"NumberOfComponents").unwrap_or(Some(1));
+                let tuples = number(b"NumberOfTuples").unwrap_or(points);
+                let declared = match (components, tuples) {
+                    (Some(c), Some(t)) => Some(c.saturating_mul(t)),
+                    // A count that is not a number: vtkio reports it.
+                    _ => None,
+                };
+                check_declared(path, line, "DataArray", declared, file_bytes)?
+            }
             // Raw appended data is not XML: stop before it.
             b"AppendedData" => return Ok(()),
             _ => {}
@@ -530,7 +606,9 @@ fn check_extent(
             extent,
         ));
     };
-    let dims = [x1 - x0 + 1, y1 - y0 + 1, z1 - z0 + 1];
+    // Saturating: a hostile extent must not overflow; a huge one is refused below.
+    let dims =
+        [(x0, x1), (y0, y1), (z0, z1)].map(|(lo, hi)| hi.saturating_sub(lo).saturating_add(1));
     if dims.iter().any(|&d| d <= 0) {
         return Err(bad_field(
             path,
@@ -553,6 +631,23 @@ fn check_extent(
         ));
     }
     check_declared(path, line, "extent", values, file_bytes)
+}
+
+/// The points an extent `x0 x1 y0 y1 z0 z1` spans, if it is well-formed.
+fn extent_points(extent: &str) -> Option<u64> {
+    let numbers: Option<Vec<i64>> = extent
+        .split_whitespace()
+        .map(|t| t.parse::<i64>().ok())
+        .collect();
+    let &[x0, x1, y0, y1, z0, z1] = numbers?.as_slice() else {
+        return None;
+    };
+    [(x0, x1), (y0, y1), (z0, z1)]
+        .iter()
+        .try_fold(1u64, |acc, &(lo, hi)| {
+            let points = hi.checked_sub(lo)?.checked_add(1)?;
+            acc.checked_mul(u64::try_from(points).ok()?)
+        })
 }
 
 fn unsupported(path: &Path, what: &str, reason: &str) -> SceneError {

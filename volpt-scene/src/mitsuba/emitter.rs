@@ -161,7 +161,18 @@ fn read_exr(path: &Path, min_size: [usize; 2]) -> Result<(usize, usize, Vec<f32>
     if OTHER_FORMATS.contains(&extension.as_str()) {
         return Err(problem(EnvmapProblem::Format { extension }));
     }
-    let image = exr::prelude::read_first_flat_layer_from_file(path).map_err(|e| match e {
+    // The map is decoded (the stored channels), then split into three f32 planes and interleaved
+    // into one RGB f32 buffer.
+    crate::limits::check_exr(path, "the environment map", 24)?;
+    // exr asserts (in debug builds) on some malformed files: a decode error like any other.
+    let decoded =
+        crate::contain::contain_panics(|| exr::prelude::read_first_flat_layer_from_file(path))
+            .unwrap_or_else(|_| {
+                Err(exr::error::Error::Invalid(
+                    "malformed data (the exr decoder gave up)".into(),
+                ))
+            });
+    let image = decoded.map_err(|e| match e {
         exr::error::Error::Io(error) => SceneError::Io {
             path: path.to_path_buf(),
             error,

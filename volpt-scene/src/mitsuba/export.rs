@@ -37,6 +37,22 @@ pub fn write_mitsuba3(
     dir: &Path,
     name: &str,
 ) -> Result<Vec<PathBuf>, SceneError> {
+    // The name becomes part of file names inside `dir`: it must not lead out of it.
+    let plain = matches!(
+        Path::new(name).components().collect::<Vec<_>>().as_slice(),
+        [std::path::Component::Normal(n)] if *n == std::ffi::OsStr::new(name)
+    );
+    if !plain || name.contains(['/', '\\']) {
+        return Err(SceneError::Export {
+            path: dir.to_path_buf(),
+            reason: format!(
+                "the name {:?} must be a plain file name (no directories, no `..`), so that \
+                 every file is written inside {}",
+                crate::error::excerpt(name),
+                dir.display()
+            ),
+        });
+    }
     create_dir(dir)?;
     let xml_path = dir.join(format!("{name}.xml"));
     let mut written = vec![xml_path.clone()];

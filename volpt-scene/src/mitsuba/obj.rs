@@ -7,10 +7,7 @@ use crate::error::SceneError;
 
 /// The `v x y z [w]` positions of an OBJ file, in file order.
 pub(crate) fn obj_vertices(path: &Path) -> Result<Vec<[f64; 3]>, SceneError> {
-    let bytes = std::fs::read(path).map_err(|error| SceneError::Io {
-        path: path.to_path_buf(),
-        error,
-    })?;
+    let bytes = crate::limits::read_file(path)?;
     // OBJ is ASCII in practice; comments in other encodings should not stop us.
     let text = String::from_utf8_lossy(&bytes);
     let mut vertices = Vec::new();

@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 
 use super::xml::{parse_file, Element};
 use crate::error::SceneError;
+use crate::limits::{MAX_EXPANDED_XML_BYTES, MAX_INCLUDES};
 
 /// Which generation of Mitsuba the scene was written for (from `<scene version="...">`). It
 /// decides the meaning of a few things, notably where a grid's samples sit.
@@ -37,6 +38,8 @@ pub(crate) fn load(path: &Path, params: &[(String, String)]) -> Result<Document,
     let mut state = State {
         params: params.iter().map(|(k, v)| Param::new(k, v, true)).collect(),
         include_stack: vec![canonical(path)],
+        includes: 0,
+        expanded_bytes: Cell::new(0),
     };
     let mut root = substitute(root, &state)?;
     let children = std::mem::take(&mut root.children);
@@ -79,7 +82,15 @@ struct State {
     params: Vec<Param>,
     /// Canonical paths of the files being expanded, to refuse include cycles.
     include_stack: Vec<PathBuf>,
+    /// `<include>`s expanded so far, repeats counted ([`MAX_INCLUDES`]).
+    includes: usize,
+    /// What the scene has expanded to so far ([`MAX_EXPANDED_XML_BYTES`]): attribute values after
+    /// substitution plus [`ELEMENT_BYTES`] per element.
+    expanded_bytes: Cell<u64>,
 }
+
+/// What one element counts for in the expansion budget besides its attribute values.
+const ELEMENT_BYTES: u64 = 64;
 
 impl State {
     /// Expands the children of a `<scene>`: handles `<default>` and `<include>`, substitutes
@@ -128,6 +139,18 @@ impl State {
                 ),
             });
         }
+        self.includes += 1;
+        if self.includes > MAX_INCLUDES {
+            return Err(SceneError::Unsupported {
+                path: el.file.to_path_buf(),
+                line: el.line,
+                what: format!("<include filename=\"{filename}\">"),
+                reason: format!(
+                    "the scene expands more than {MAX_INCLUDES} includes (files that include \
+                     other files several times multiply)"
+                ),
+            });
+        }
         if self.include_stack.len() > MAX_INCLUDE_DEPTH {
             return Err(SceneError::Unsupported {
                 path: el.file.to_path_buf(),
@@ -161,6 +184,25 @@ impl State {
         expanded
     }
 
+    /// Counts `bytes` more of expanded scene; an error about `el` past the budget.
+    fn charge(&self, el: &Element, bytes: u64) -> Result<(), SceneError> {
+        let total = self.expanded_bytes.get().saturating_add(bytes);
+        self.expanded_bytes.set(total);
+        if total > MAX_EXPANDED_XML_BYTES {
+            return Err(SceneError::Unsupported {
+                path: el.file.to_path_buf(),
+                line: el.line,
+                what: el.describe(),
+                reason: format!(
+                    "the scene expands to more than {MAX_EXPANDED_XML_BYTES} bytes (parameters \
+                     whose values repeat other parameters, or includes that repeat includes, \
+                     multiply)"
+                ),
+            });
+        }
+        Ok(())
+    }
+
     fn lookup(&self, name: &str) -> Option<&str> {
         let p = self.params.iter().find(|p| p.name == name)?;
         p.used.set(true);
@@ -181,8 +223,10 @@ fn substitute_descendants(mut el: Element, state: &State) -> Result<Element, Sce
 /// `[A-Za-z0-9_]` after the `$` (Mitsuba replaces plain substrings, which makes `$a` clobber
 /// `$ab`; the longest match is what users mean). A `$` not followed by a name is kept as is.
 fn substitute(mut el: Element, state: &State) -> Result<Element, SceneError> {
+    state.charge(&el, ELEMENT_BYTES)?;
     for i in 0..el.attrs.len() {
         if !el.attrs[i].1.contains('$') {
+            state.charge(&el, el.attrs[i].1.len() as u64)?;
             continue;
         }
         let value = &el.attrs[i].1;
@@ -209,6 +253,8 @@ fn substitute(mut el: Element, state: &State) -> Result<Element, SceneError> {
                         ),
                     });
                 };
+                // Charged before it is copied, so no value outgrows the budget.
+                state.charge(&el, v.len() as u64)?;
                 out.push_str(v);
             }
             rest = &after[len..];

@@ -55,10 +55,7 @@ impl Element {
 
 /// Reads and parses an XML file into its root element.
 pub(crate) fn parse_file(path: &Path) -> Result<Element, SceneError> {
-    let bytes = std::fs::read(path).map_err(|error| SceneError::Io {
-        path: path.to_path_buf(),
-        error,
-    })?;
+    let bytes = crate::limits::read_file(path)?;
     let text = match std::str::from_utf8(&bytes) {
         Ok(text) => text,
         Err(e) => {

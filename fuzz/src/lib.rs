@@ -1,0 +1,415 @@
+//! Fuzz targets for every parser of volpt's scene inputs (issue 12), shared by two drivers:
+//!
+//! - `cargo test -p volpt-fuzz` runs every target on its seeds and a few thousand deterministic
+//!   mutations of them (stable Rust, no tools, seconds): CI's short run.
+//! - `fuzz/run TARGET SECONDS` builds the targets with libFuzzer's coverage instrumentation (on
+//!   stable rustc) and fuzzes one for real, seeded from [`seeds`], under a 2 GB memory limit and
+//!   a per-input timeout (`docs/reliability.md`).
+//!
+//! A target turns the fuzzer's bytes into files (several files are split at [`SPLIT`]), loads
+//! them the way `volpt` does, and returns; any error is fine, a panic, abort, hang or huge
+//! allocation is a bug. Loaded scenes go through the [`SceneAssembler`], so validation runs too.
+
+use std::path::{Path, PathBuf};
+use std::sync::Once;
+
+use volpt_scene::{
+    builder_for, Bounds, Config, GridConvention, GridDesc, MetaImageOptions, SceneAssembler,
+    TransferFunction,
+};
+
+/// Separates the files of a multi-file input.
+pub const SPLIT: &[u8] = b"\n@@@\n";
+
+/// The memory limit while fuzzing: a quarter of the 2 GB the fuzzer allows a process, so that
+/// what the limit admits (plus a decoder's temporary copies) fits.
+pub const FUZZ_MEMORY_LIMIT: u64 = 256 << 20;
+
+/// One parser, or one way into the scene loader.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Target {
+    /// Mitsuba XML: `scene.xml`, an included `inc.xml`, and `name=value` parameter lines.
+    MitsubaXml,
+    /// A bare `.vol` grid, as `volpt render grid.vol` loads it.
+    Vol,
+    /// MetaImage: one `.mha`, or a `.mhd` header and its data file `d.raw`.
+    MetaImage,
+    /// Legacy VTK (`.vtk`).
+    VtkLegacy,
+    /// VTK XML image data (`.vti`).
+    VtkXml,
+    /// A volpt TOML scene with a raw grid `g.raw` and a transfer function `t.tf`.
+    TomlRaw,
+    /// A transfer-function file, applied to a small grid.
+    TransferFunction,
+    /// An OpenEXR environment map under a fixed scene.
+    ExrEnvmap,
+}
+
+impl Target {
+    pub const ALL: [Target; 8] = [
+        Self::MitsubaXml,
+        Self::Vol,
+        Self::MetaImage,
+        Self::VtkLegacy,
+        Self::VtkXml,
+        Self::TomlRaw,
+        Self::TransferFunction,
+        Self::ExrEnvmap,
+    ];
+
+    /// The name `fuzz/run` knows the target by.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::MitsubaXml => "mitsuba_xml",
+            Self::Vol => "vol",
+            Self::MetaImage => "metaimage",
+            Self::VtkLegacy => "vtk_legacy",
+            Self::VtkXml => "vtk_xml",
+            Self::TomlRaw => "toml_raw",
+            Self::TransferFunction => "transfer_function",
+            Self::ExrEnvmap => "exr_envmap",
+        }
+    }
+
+    /// Loads `data` as this target's input; errors are expected and ignored.
+    pub fn run(self, data: &[u8]) {
+        static LIMIT: Once = Once::new();
+        LIMIT.call_once(|| volpt_scene::limits::set_memory_limit(FUZZ_MEMORY_LIMIT));
+        DIR.with(|dir| self.run_in(dir.path(), data));
+    }
+
+    /// [`Self::run`] in `dir`, which holds no other files of this target's.
+    fn run_in(self, dir: &Path, data: &[u8]) {
+        let parts = split(data);
+        let part = |i: usize| parts.get(i).copied().unwrap_or_default();
+        match self {
+            Self::MitsubaXml => {
+                write(dir, "inc.xml", part(1));
+                let params = String::from_utf8_lossy(part(2))
+                    .lines()
+                    .filter_map(|l| l.split_once('='))
+                    .map(|(k, v)| (k.to_owned(), v.to_owned()))
+                    .collect();
+                assemble(&write(dir, "scene.xml", part(0)), params);
+            }
+            Self::Vol => assemble(&write(dir, "g.vol", data), Vec::new()),
+            Self::MetaImage => {
+                let path = if parts.len() > 1 {
+                    write(dir, "d.raw", part(1));
+                    write(dir, "g.mhd", part(0))
+                } else {
+                    // A header naming `d.raw` must not find the last input's.
+                    let _ = std::fs::remove_file(dir.join("d.raw"));
+                    write(dir, "g.mha", data)
+                };
+                let _ = volpt_scene::read_metaimage(&path);
+            }
+            Self::VtkLegacy => {
+                let _ = volpt_scene::read_vtk(&write(dir, "g.vtk", data), None);
+            }
+            Self::VtkXml => {
+                let _ = volpt_scene::read_vtk(&write(dir, "g.vti", data), None);
+            }
+            Self::TomlRaw => {
+                write(dir, "g.raw", part(1));
+                write(dir, "t.tf", part(2));
+                assemble(&write(dir, "scene.toml", part(0)), Vec::new());
+            }
+            Self::TransferFunction => {
+                let path = write(dir, "t.tf", data);
+                if let Ok(tf) = TransferFunction::read(&path) {
+                    let _ = tf.apply(&small_grid());
+                }
+            }
+            Self::ExrEnvmap => {
+                write(dir, "map.exr", data);
+                assemble(
+                    &write(dir, "scene.xml", ENVMAP_SCENE.as_bytes()),
+                    Vec::new(),
+                );
+            }
+        }
+    }
+}
+
+thread_local! {
+    /// Each thread's directory for input files, made once and overwritten by every run (a fresh
+    /// directory per input costs more than most parsers), in memory where Linux offers it.
+    static DIR: tempfile::TempDir = {
+        let shm = Path::new("/dev/shm");
+        if shm.is_dir() {
+            tempfile::tempdir_in(shm)
+        } else {
+            tempfile::tempdir()
+        }
+        .expect("a temporary directory")
+    };
+}
+
+/// The scene an [`Target::ExrEnvmap`] input is the map of.
+const ENVMAP_SCENE: &str = "<scene version=\"3.0.0\">\n<sensor type=\"perspective\">\
+    <film type=\"hdrfilm\"><integer name=\"width\" value=\"4\"/>\
+    <integer name=\"height\" value=\"4\"/></film></sensor>\n\
+    <emitter type=\"envmap\"><string name=\"filename\" value=\"map.exr\"/></emitter>\n\
+    <shape type=\"cube\"><bsdf type=\"null\"/><medium type=\"homogeneous\" name=\"interior\"/>\
+    </shape>\n</scene>\n";
+
+fn split(data: &[u8]) -> Vec<&[u8]> {
+    let mut parts = Vec::new();
+    let mut rest = data;
+    while let Some(at) = rest.windows(SPLIT.len()).position(|w| w == SPLIT) {
+        parts.push(&rest[..at]);
+        rest = &rest[at + SPLIT.len()..];
+    }
+    parts.push(rest);
+    parts
+}
+
+fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).expect("write a fuzz input file");
+    path
+}
+
+fn assemble(path: &Path, params: Vec<(String, String)>) {
+    let config = Config {
+        params,
+        ..Config::default()
+    };
+    if let Ok(builder) = builder_for(path) {
+        let _ = SceneAssembler::new(config).assemble(builder.as_ref());
+    }
+}
+
+fn small_grid() -> GridDesc {
+    GridDesc {
+        resolution: [2, 2, 2],
+        channels: 1,
+        bounds: Bounds {
+            min: [0.0; 3],
+            max: [1.0; 3],
+        },
+        convention: GridConvention::Cell,
+        data: vec![0.0, 1.0, 2.0, 5.0, 10.0, 20.0, 40.0, 255.0],
+    }
+}
+
+/// Seed inputs for `target`: the repository's fixtures and scenes where they fit, and small
+/// files written by volpt's own writers (every element type and compression where it matters).
+pub fn seeds(target: Target) -> Vec<Vec<u8>> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let fixture = |p: &str| std::fs::read(root.join(p)).unwrap_or_default();
+    let join = |parts: &[&[u8]]| parts.join(SPLIT);
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let written = |name: &str, f: &dyn Fn(&Path)| {
+        let path = dir.path().join(name);
+        f(&path);
+        std::fs::read(&path).expect("a written seed")
+    };
+    let grid = small_grid();
+    match target {
+        Target::MitsubaXml => vec![
+            join(&[
+                &fixture("volpt-scene/tests/fixtures/mitsuba06/scene.xml"),
+                b"",
+                b"",
+            ]),
+            join(&[&fixture("volpt-scene/tests/fixtures/mitsuba3/scene.xml")]),
+            join(&[
+                &fixture("volpt-scene/tests/fixtures/params/scene.xml"),
+                b"",
+                b"scale=2\nalbedo=0.5",
+            ]),
+            join(&[
+                b"<scene version=\"0.6.0\">\n<default name=\"s\" value=\"2\"/>\n\
+                  <include filename=\"inc.xml\"/>\n<shape type=\"cube\"><bsdf type=\"null\"/>\
+                  <ref name=\"interior\" id=\"fog\"/></shape>\n</scene>\n",
+                &fixture("volpt-scene/tests/fixtures/include/parts/media.xml"),
+                b"s=3",
+            ]),
+            join(&[&fixture("scenes/homogeneous-cube/scene.xml")]),
+            join(&[&fixture("scenes/example/cube.xml")]),
+        ],
+        Target::Vol => vec![{
+            written("g.vol", &|p| {
+                volpt_scene::write_vol(
+                    p,
+                    &volpt_scene::VolGrid {
+                        resolution: grid.resolution,
+                        channels: 1,
+                        bbox: grid.bounds,
+                        data: grid.data.clone(),
+                    },
+                )
+                .expect("write a .vol seed")
+            })
+        }],
+        Target::MetaImage => {
+            let mut seeds = vec![
+                fixture("volpt-scene/tests/fixtures/metaimage/msb.mha"),
+                join(&[
+                    &fixture("volpt-scene/tests/fixtures/metaimage/tiny.mhd")
+                        .replace_ascii("tiny.raw", "d.raw"),
+                    &fixture("volpt-scene/tests/fixtures/metaimage/tiny.raw"),
+                ]),
+            ];
+            for (scalar, compressed) in [
+                (volpt_scene::ScalarType::U8, false),
+                (volpt_scene::ScalarType::F32, true),
+                (volpt_scene::ScalarType::I16, true),
+            ] {
+                let options = MetaImageOptions {
+                    scalar,
+                    byte_order: volpt_scene::ByteOrder::Little,
+                    compressed,
+                };
+                seeds.push(written("g.mha", &|p| {
+                    volpt_scene::write_metaimage(p, &grid, &options).expect("write a .mha seed")
+                }));
+            }
+            seeds
+        }
+        Target::VtkLegacy => vec![
+            fixture("volpt-scene/tests/fixtures/vtk/tiny_ascii.vtk"),
+            written("g.vtk", &|p| {
+                volpt_scene::write_vtk(p, &grid, "density").expect("write a .vtk seed")
+            }),
+        ],
+        Target::VtkXml => vec![
+            fixture("volpt-scene/tests/fixtures/vtk/tiny_ascii.vti"),
+            written("g.vti", &|p| {
+                volpt_scene::write_vtk(p, &grid, "density").expect("write a .vti seed")
+            }),
+        ],
+        Target::TomlRaw => vec![
+            join(&[
+                &fixture("volpt-cli/tests/fixtures/toml/raw-transfer.toml")
+                    .replace_ascii("$dir/tiny.raw", "g.raw")
+                    .replace_ascii("tiny.tf", "t.tf"),
+                &fixture("volpt-cli/tests/fixtures/toml/tiny.raw"),
+                &fixture("volpt-cli/tests/fixtures/toml/tiny.tf"),
+            ]),
+            join(&[
+                &fixture("volpt-cli/tests/fixtures/toml/minimal.toml")
+                    .replace_ascii("tiny.raw", "g.raw"),
+                &fixture("volpt-cli/tests/fixtures/toml/tiny.raw"),
+            ]),
+        ],
+        Target::TransferFunction => vec![
+            fixture("volpt-scene/tests/fixtures/transfer/bucky.txt"),
+            fixture("volpt-cli/tests/fixtures/toml/tiny.tf"),
+            fixture("scenes/bucky/bucky.tf"),
+        ],
+        Target::ExrEnvmap => vec![
+            written("rgb.exr", &|p| {
+                exr::prelude::write_rgb_file(p, 8, 4, |x, y| (x as f32, y as f32, 0.5f32))
+                    .expect("write an EXR seed")
+            }),
+            written("rgba.exr", &|p| {
+                exr::prelude::write_rgba_file(p, 4, 2, |x, _| (1.0f32, x as f32, 0.5f32, 1.0f32))
+                    .expect("write an EXR seed")
+            }),
+        ],
+    }
+    .into_iter()
+    .filter(|s| !s.is_empty())
+    .collect()
+}
+
+/// Text replacement in a byte seed (fixtures name their files; the targets use fixed names).
+trait ReplaceAscii {
+    fn replace_ascii(&self, from: &str, to: &str) -> Vec<u8>;
+}
+
+impl ReplaceAscii for Vec<u8> {
+    fn replace_ascii(&self, from: &str, to: &str) -> Vec<u8> {
+        String::from_utf8_lossy(self).replace(from, to).into_bytes()
+    }
+}
+
+/// A small deterministic mutator for the short run in `cargo test` (libFuzzer has its own):
+/// bit flips, boundary bytes, numbers swapped for extreme ones, insertions, deletions, splices.
+pub struct Mutator {
+    state: u64,
+}
+
+impl Mutator {
+    pub fn new(seed: u64) -> Self {
+        Self {
+            state: seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1,
+        }
+    }
+
+    fn next(&mut self) -> u64 {
+        // xorshift64*
+        self.state ^= self.state >> 12;
+        self.state ^= self.state << 25;
+        self.state ^= self.state >> 27;
+        self.state.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    }
+
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n.max(1) as u64) as usize
+    }
+
+    /// `input` changed in one to four places.
+    pub fn mutate(&mut self, input: &[u8]) -> Vec<u8> {
+        const NUMBERS: [&str; 10] = [
+            "0",
+            "-1",
+            "4294967295",
+            "2147483648",
+            "18446744073709551615",
+            "1e38",
+            "3e38",
+            "nan",
+            "inf",
+            "65536",
+        ];
+        const BYTES: [u8; 6] = [0, 0xff, 0x7f, 0x80, b'\n', b'$'];
+        let mut out = input.to_vec();
+        for _ in 0..1 + self.below(4) {
+            let at = self.below(out.len() + 1);
+            match self.below(6) {
+                0 if !out.is_empty() => {
+                    let i = at.min(out.len() - 1);
+                    out[i] ^= 1 << self.below(8);
+                }
+                1 if !out.is_empty() => {
+                    let i = at.min(out.len() - 1);
+                    out[i] = BYTES[self.below(BYTES.len())];
+                }
+                2 => {
+                    // Replace the number at or after `at` with an extreme one.
+                    let start = (at..out.len()).find(|&i| out[i].is_ascii_digit());
+                    if let Some(start) = start {
+                        let end = (start..out.len())
+                            .find(|&i| !out[i].is_ascii_digit())
+                            .unwrap_or(out.len());
+                        let number = NUMBERS[self.below(NUMBERS.len())].as_bytes();
+                        out.splice(start..end, number.iter().copied());
+                    }
+                }
+                3 => {
+                    let len = self.below(16);
+                    out.splice(at..at, (0..len).map(|_| self.next() as u8));
+                }
+                4 if !out.is_empty() => {
+                    let end = (at + 1 + self.below(32)).min(out.len());
+                    out.drain(at.min(end)..end);
+                }
+                _ if !out.is_empty() => {
+                    // Repeat a slice of the input somewhere else (duplicated elements, lines).
+                    let from = self.below(out.len());
+                    let len = 1 + self.below(64.min(out.len() - from));
+                    let piece = out[from..from + len].to_vec();
+                    let to = self.below(out.len() + 1);
+                    out.splice(to..to, piece);
+                }
+                _ => {}
+            }
+        }
+        out
+    }
+}

@@ -1,0 +1,262 @@
+//! One check of an assembled scene, whatever built it: every number a renderer relies on is
+//! finite and in range, the film and the data fit the memory limit, and the medium is thin enough
+//! for delta tracking to cross it in bounded work.
+//!
+//! The loaders check what they read where they read it (and name the line); this is the backstop
+//! that makes the formats agree (a TOML radiance is held to what an XML one is) and that covers
+//! scenes built by code.
+
+use crate::description::*;
+use crate::error::SceneError;
+use crate::limits::{bytes_of, check_memory, MAX_OPTICAL_DEPTH};
+
+/// Bytes a renderer keeps per film pixel: f64 RGB sums, the f32 RGB image and the 8-bit preview,
+/// rounded up.
+pub const FILM_BYTES_PER_PIXEL: u64 = 40;
+
+/// The roughest GGX boundary volpt renders. Mitsuba sets no upper bound, and neither does GGX, but
+/// its terms hold `alpha^2` and `alpha^4` in f32: 1e4 keeps them finite with room to spare, and
+/// any alpha above a few is already as rough as a surface gets.
+pub const MAX_ALPHA: f32 = 1e4;
+
+/// Checks `desc`; `source` names the scene file (or builder) in errors.
+pub fn validate(desc: &SceneDescription, source: &str) -> Result<(), SceneError> {
+    let invalid = |field: &str, expected: &str, found: String| SceneError::InvalidScene {
+        source_name: source.to_owned(),
+        field: field.to_owned(),
+        expected: expected.to_owned(),
+        found,
+    };
+    let path = std::path::Path::new(source);
+
+    let FilmDesc { width, height } = desc.film;
+    let pixels = u64::from(width) * u64::from(height);
+    // Renderers index pixels with u32.
+    if width == 0 || height == 0 || pixels > u64::from(u32::MAX) {
+        return Err(invalid(
+            "film",
+            "between 1 and 2^32 - 1 pixels, at least 1 on each side",
+            format!("{width} x {height}"),
+        ));
+    }
+    check_memory(
+        path,
+        &format!("the film of {width} x {height} pixels"),
+        bytes_of(pixels, FILM_BYTES_PER_PIXEL),
+    )?;
+    if desc.spp == 0 {
+        return Err(invalid("spp", "at least 1 sample per pixel", "0".into()));
+    }
+    let camera = &desc.camera;
+    if !(camera.fov_degrees > 0.0 && camera.fov_degrees < 180.0) {
+        return Err(invalid(
+            "camera fov",
+            "an angle in degrees in (0, 180)",
+            camera.fov_degrees.to_string(),
+        ));
+    }
+    if !finite_matrix(&camera.to_world) {
+        return Err(invalid(
+            "camera to_world",
+            "a matrix of finite numbers",
+            format!("{:?}", camera.to_world),
+        ));
+    }
+
+    let bounds = desc.boundary.bounds;
+    check_bounds(bounds).map_err(|found| invalid("boundary box", BOX, found))?;
+    match desc.boundary.bsdf {
+        BsdfDesc::Null => {}
+        BsdfDesc::Dielectric { int_ior, ext_ior } => check_iors(int_ior, ext_ior, &invalid)?,
+        BsdfDesc::RoughDielectric {
+            alpha,
+            int_ior,
+            ext_ior,
+        } => {
+            check_iors(int_ior, ext_ior, &invalid)?;
+            if !(alpha > 0.0 && alpha <= MAX_ALPHA) {
+                return Err(invalid(
+                    "boundary alpha",
+                    &format!("a roughness in (0, {MAX_ALPHA:e}]"),
+                    alpha.to_string(),
+                ));
+            }
+            if alpha > 1.0 {
+                // Mitsuba accepts it too: GGX is defined for any alpha, the surface is just
+                // rougher than any real one.
+                tracing::warn!(
+                    "{source}: boundary alpha {alpha} is above 1, rougher than any real surface; \
+                     rendered as GGX with that alpha, as Mitsuba does"
+                );
+            }
+        }
+    }
+
+    let medium = &desc.medium;
+    if !(medium.scale.is_finite() && medium.scale >= 0.0) {
+        return Err(invalid(
+            "medium scale",
+            "a finite number >= 0",
+            medium.scale.to_string(),
+        ));
+    }
+    let max_density = match &medium.density {
+        DensityDesc::Constant(d) => {
+            if !(d.is_finite() && *d >= 0.0) {
+                return Err(invalid(
+                    "medium density",
+                    "a finite number >= 0",
+                    d.to_string(),
+                ));
+            }
+            *d
+        }
+        DensityDesc::Grid(grid) => check_grid(grid, "density grid", f32::MAX, &invalid)?,
+    };
+    match &medium.albedo {
+        AlbedoDesc::Constant(rgb) => {
+            if !rgb.iter().all(|a| (0.0..=1.0).contains(a)) {
+                return Err(invalid(
+                    "medium albedo",
+                    "three numbers in [0, 1]",
+                    format!("{rgb:?}"),
+                ));
+            }
+        }
+        AlbedoDesc::Grid(grid) => {
+            check_grid(grid, "albedo grid", 1.0, &invalid)?;
+        }
+    }
+    if let PhaseDesc::HenyeyGreenstein { g } = medium.phase {
+        if !(g > -1.0 && g < 1.0) {
+            return Err(invalid("phase g", "a number in (-1, 1)", g.to_string()));
+        }
+    }
+    // Delta tracking takes about majorant x distance tentative collisions per crossing.
+    let majorant = f64::from(medium.scale) * f64::from(max_density);
+    let diagonal = (0..3)
+        .map(|i| f64::from(bounds.max[i]) - f64::from(bounds.min[i]))
+        .map(|e| e * e)
+        .sum::<f64>()
+        .sqrt();
+    let depth = majorant * diagonal;
+    // NaN (an infinite majorant times a zero diagonal) is refused too.
+    if depth.is_nan() || depth > MAX_OPTICAL_DEPTH {
+        return Err(invalid(
+            "medium",
+            &format!(
+                "an optical depth (majorant extinction x box diagonal) of at most \
+                 {MAX_OPTICAL_DEPTH:e}: delta tracking takes about that many steps to cross the \
+                 box, and shorter steps fall below f32's precision"
+            ),
+            format!("majorant {majorant:e} x diagonal {diagonal} = {depth:e}"),
+        ));
+    }
+
+    match &desc.environment {
+        EnvironmentDesc::Constant(rgb) => {
+            if !rgb.iter().all(|v| v.is_finite() && *v >= 0.0) {
+                return Err(invalid(
+                    "environment radiance",
+                    "three finite numbers >= 0",
+                    format!("{rgb:?}"),
+                ));
+            }
+        }
+        EnvironmentDesc::LatLong(map) => {
+            let texels = bytes_of(u64::from(map.width), u64::from(map.height));
+            if texels.and_then(|t| bytes_of(t, 3)) != Some(map.rgb.len() as u64) {
+                return Err(invalid(
+                    "environment map",
+                    "3 x width x height values",
+                    format!("{} for {} x {}", map.rgb.len(), map.width, map.height),
+                ));
+            }
+            if let Some(v) = map.rgb.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
+                return Err(invalid(
+                    "environment map",
+                    "finite radiances >= 0",
+                    v.to_string(),
+                ));
+            }
+            if !(map.scale.is_finite() && map.scale >= 0.0 && finite_matrix(&map.to_world)) {
+                return Err(invalid(
+                    "environment map scale and to_world",
+                    "finite numbers, the scale >= 0",
+                    format!("scale {}, to_world {:?}", map.scale, map.to_world),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// What a box must be.
+pub(crate) const BOX: &str = "finite min < max on every axis";
+
+/// `Ok` for a box with finite `min < max` on every axis, else the box as the error's "found".
+pub(crate) fn check_bounds(b: Bounds) -> Result<(), String> {
+    let ok = (0..3).all(|i| b.min[i].is_finite() && b.max[i].is_finite() && b.min[i] < b.max[i]);
+    if ok {
+        Ok(())
+    } else {
+        Err(format!("min {:?} max {:?}", b.min, b.max))
+    }
+}
+
+fn finite_matrix(m: &Matrix4) -> bool {
+    m.iter().flatten().all(|v| v.is_finite())
+}
+
+fn check_iors(
+    int_ior: f32,
+    ext_ior: f32,
+    invalid: &impl Fn(&str, &str, String) -> SceneError,
+) -> Result<(), SceneError> {
+    if int_ior.is_finite() && ext_ior.is_finite() && int_ior > 0.0 && ext_ior > 0.0 {
+        Ok(())
+    } else {
+        Err(invalid(
+            "boundary int_ior and ext_ior",
+            "finite indices of refraction > 0",
+            format!("{int_ior} and {ext_ior}"),
+        ))
+    }
+}
+
+/// Checks a grid's shape, box and values (finite, in `[0, max]`); returns its largest value.
+fn check_grid(
+    grid: &GridDesc,
+    role: &str,
+    max: f32,
+    invalid: &impl Fn(&str, &str, String) -> SceneError,
+) -> Result<f32, SceneError> {
+    let [x, y, z] = grid.resolution;
+    let expected = [y, z, grid.channels]
+        .iter()
+        .try_fold(u64::from(x), |acc, &n| acc.checked_mul(u64::from(n)));
+    if expected != Some(grid.data.len() as u64) {
+        return Err(invalid(
+            role,
+            "resolution x channels values",
+            format!(
+                "{} values for {x} x {y} x {z} x {}",
+                grid.data.len(),
+                grid.channels
+            ),
+        ));
+    }
+    check_bounds(grid.bounds).map_err(|found| invalid(&format!("{role} box"), BOX, found))?;
+    let mut largest = 0.0f32;
+    for &v in &grid.data {
+        if !(v >= 0.0 && v <= max) {
+            return Err(invalid(
+                role,
+                &format!("values in [0, {max:e}]"),
+                v.to_string(),
+            ));
+        }
+        largest = largest.max(v);
+    }
+    Ok(largest)
+}
