@@ -173,8 +173,9 @@ impl SceneAssembler {
         if let Some(rr_depth) = c.rr_depth {
             desc.integrator.rr_depth = rr_depth;
         }
-        crate::validate::validate(&desc, &builder.source())?;
+        // Too dense for f32 positions first: its message says how to rescale the scene.
         crate::numerics::check_position_resolution(&desc, Path::new(&builder.source()))?;
+        crate::validate::validate(&desc, &builder.source())?;
         Ok(desc)
     }
 }
