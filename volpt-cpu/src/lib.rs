@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use thiserror::Error;
 use volpt_core::path::{sample_pixel, PathCounters};
 use volpt_core::Scene;
-use volpt_film::{Film, Image, RenderOptions, RenderStats};
+use volpt_film::{Film, Image, NothingToRender, RenderOptions, RenderStats};
 
 #[derive(Debug, Error)]
 pub enum RenderError {
@@ -22,8 +22,8 @@ pub enum RenderError {
         threads: usize,
         source: rayon::ThreadPoolBuildError,
     },
-    #[error("nothing to render: the image is {width}x{height} with {spp} samples per pixel")]
-    Empty { width: u32, height: u32, spp: u32 },
+    #[error(transparent)]
+    Empty(#[from] NothingToRender),
 }
 
 /// Samples per pixel in one pass: small enough for a live progress report, large enough that the
@@ -52,18 +52,7 @@ pub fn render_samples<S: Scene + Sync>(
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> Result<RenderStats, RenderError> {
     let (width, height) = (scene.camera().width, scene.camera().height);
-    if width == 0 || height == 0 || samples.is_empty() {
-        return Err(RenderError::Empty {
-            width,
-            height,
-            spp: samples.len() as u32,
-        });
-    }
-    assert_eq!(
-        (film.width, film.height),
-        (width, height),
-        "the film must be the camera's"
-    );
+    film.check_pass((width, height), &samples)?;
     let threads = options.threads.unwrap_or(0);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)

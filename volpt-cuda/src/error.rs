@@ -23,8 +23,8 @@ pub enum CudaError {
          or no kernels crate exports this scene type (`volpt_device::export_kernels!`)"
     )]
     MissingKernel(String),
-    #[error("nothing to render: the image is {width}x{height} with {spp} samples per pixel")]
-    Empty { width: u32, height: u32, spp: u32 },
+    #[error(transparent)]
+    Empty(#[from] volpt_film::NothingToRender),
     #[error("CUDA driver call failed while {doing}: {source}")]
     Driver {
         doing: &'static str,

@@ -102,18 +102,7 @@ impl CudaRenderer {
         progress: &dyn Fn(u64, u64),
     ) -> Result<RenderStats, CudaError> {
         let (width, height) = (scene.camera().width, scene.camera().height);
-        if width == 0 || height == 0 || samples.is_empty() {
-            return Err(CudaError::Empty {
-                width,
-                height,
-                spp: samples.len() as u32,
-            });
-        }
-        assert_eq!(
-            (film.width, film.height),
-            (width, height),
-            "the film must be the camera's"
-        );
+        film.check_pass((width, height), &samples)?;
         let name = entry_name::<S>(strategy);
         let kernel = self
             .module

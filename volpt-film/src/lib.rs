@@ -9,8 +9,10 @@
 pub mod checkpoint;
 pub mod image;
 
+use std::ops::Range;
 use std::time::Duration;
 
+use thiserror::Error;
 use volpt_core::PathCounters;
 
 pub use checkpoint::{Checkpoint, CheckpointError};
@@ -44,6 +46,31 @@ impl Film {
         }
     }
 
+    /// Checks that samples `samples` of a `width` x `height` camera can be added to this film: the
+    /// precondition of every backend's `render_samples`.
+    ///
+    /// # Panics
+    /// If the film is not the camera's size (a caller's bug, not bad input).
+    pub fn check_pass(
+        &self,
+        (width, height): (u32, u32),
+        samples: &Range<u32>,
+    ) -> Result<(), NothingToRender> {
+        if width == 0 || height == 0 || samples.is_empty() {
+            return Err(NothingToRender {
+                width,
+                height,
+                spp: samples.len() as u32,
+            });
+        }
+        assert_eq!(
+            (self.width, self.height),
+            (width, height),
+            "the film must be the camera's"
+        );
+        Ok(())
+    }
+
     /// The image of `spp` samples per pixel: each sum times `1 / spp`, rounded to `f32`.
     pub fn image(&self, spp: u32) -> Image {
         let inv_spp = 1.0 / spp as f64;
@@ -57,6 +84,15 @@ impl Film {
                 .collect(),
         }
     }
+}
+
+/// A render of no pixels or no samples.
+#[derive(Clone, Copy, Debug, Error, PartialEq, Eq)]
+#[error("nothing to render: the image is {width}x{height} with {spp} samples per pixel")]
+pub struct NothingToRender {
+    pub width: u32,
+    pub height: u32,
+    pub spp: u32,
 }
 
 /// How long a render took and what it traced.
