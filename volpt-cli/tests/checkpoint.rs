@@ -6,27 +6,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-fn volpt(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_volpt"))
-        .args(args)
-        .env("RUST_LOG", "warn")
-        .output()
-        .expect("run volpt")
-}
-
-fn example() -> String {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/example/cube.xml");
-    path.to_str().unwrap().to_owned()
-}
-
-fn ok(out: Output) -> Output {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
+mod common;
+use common::{assert_success, example_arg as example, volpt};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -57,14 +38,18 @@ fn render(spp: u32, extra: &[&str], out: &Path) -> Output {
 fn a_resumed_render_equals_the_uninterrupted_one() {
     let dir = tempfile::tempdir().unwrap();
     let p = |name: &str| -> PathBuf { dir.path().join(name) };
-    ok(render(9, &[], &p("whole.exr")));
-    ok(render(
+    assert_success(&render(9, &[], &p("whole.exr")));
+    assert_success(&render(
         4,
         &["--checkpoint", s(&p("c.ckpt"))],
         &p("part.exr"),
     ));
     // The resumed render adds samples 4..9 to the saved sums of 0..4.
-    ok(render(9, &["--resume", s(&p("c.ckpt"))], &p("resumed.exr")));
+    assert_success(&render(
+        9,
+        &["--resume", s(&p("c.ckpt"))],
+        &p("resumed.exr"),
+    ));
     assert_identical(&p("whole.exr"), &p("resumed.exr"));
 }
 
@@ -116,8 +101,8 @@ fn ctrl_c_saves_the_finished_samples() {
     assert!(!p("never.exr").exists());
     // Resumed to two more samples, it is the render of that many samples from scratch.
     let total = samples + 2;
-    ok(render(total, &["--resume", s(&ckpt)], &p("resumed.exr")));
-    ok(render(total, &[], &p("whole.exr")));
+    assert_success(&render(total, &["--resume", s(&ckpt)], &p("resumed.exr")));
+    assert_success(&render(total, &[], &p("whole.exr")));
     assert_identical(&p("whole.exr"), &p("resumed.exr"));
 }
 
@@ -126,7 +111,7 @@ fn damaged_or_foreign_checkpoints_are_clear_errors() {
     let dir = tempfile::tempdir().unwrap();
     let p = |name: &str| -> PathBuf { dir.path().join(name) };
     let ckpt = p("c.ckpt");
-    ok(render(2, &["--checkpoint", s(&ckpt)], &p("a.exr")));
+    assert_success(&render(2, &["--checkpoint", s(&ckpt)], &p("a.exr")));
     let good = std::fs::read(&ckpt).unwrap();
 
     let err = |out: Output| {

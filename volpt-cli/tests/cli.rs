@@ -2,36 +2,12 @@
 //! (never a panic) for bad input.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+
+mod common;
+use common::{assert_clean_error, example, stderr, volpt};
 
 use volpt_scene::vol::{write_vol, VolGrid};
 use volpt_scene::Bounds;
-
-fn volpt(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_volpt"))
-        .args(args)
-        .env("RUST_LOG", "warn")
-        .output()
-        .expect("run volpt")
-}
-
-fn example() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/example/cube.xml")
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-/// Fails with a message that contains every one of `needles`, and does not panic.
-fn assert_clean_error(out: &Output, needles: &[&str]) {
-    let err = stderr(out);
-    assert!(!out.status.success(), "expected failure, stderr: {err}");
-    assert!(!err.contains("panicked"), "panicked: {err}");
-    for n in needles {
-        assert!(err.contains(n), "error lacks {n:?}: {err}");
-    }
-}
 
 #[test]
 fn renders_the_example_to_exr_and_png() {

@@ -2,15 +2,9 @@
 //! analytic), the CSV, the plots and the table; and a rendered, cached reference.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn volpt(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_volpt"))
-        .args(args)
-        .env("RUST_LOG", "warn")
-        .output()
-        .expect("run volpt")
-}
+mod common;
+use common::volpt;
 
 fn stability_cube() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/stability/cube.xml")

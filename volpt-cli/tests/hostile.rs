@@ -3,41 +3,10 @@
 //! sensible result), never a panic, a hang or an abort.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn volpt(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_volpt"))
-        .args(args)
-        .env("RUST_LOG", "warn")
-        .output()
-        .expect("run volpt")
-}
-
-fn example() -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../scenes/example/cube.xml")
-        .to_str()
-        .unwrap()
-        .to_owned()
-}
-
-/// Fails with a message that contains every one of `needles`, and does not panic.
-fn assert_clean_error(out: &Output, needles: &[&str]) {
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success(), "expected failure, stderr: {err}");
-    assert!(!err.contains("panicked"), "panicked: {err}");
-    for n in needles {
-        assert!(err.contains(n), "error lacks {n:?}: {err}");
-    }
-}
-
-fn assert_success(out: &Output) {
-    assert!(
-        out.status.success(),
-        "stderr: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
+mod common;
+use common::{assert_clean_error, assert_success, example_arg as example, volpt};
 
 /// A quick render of the example to `output`, with `extra` arguments.
 fn render(output: &Path, extra: &[&str]) -> Output {
