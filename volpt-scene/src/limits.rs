@@ -67,6 +67,20 @@ pub fn check_memory(path: &Path, what: &str, bytes: Option<u64>) -> Result<(), S
 }
 
 /// `count` values of `size` bytes each, or `None` if that overflows.
+/// [`check_memory`] for a grid of `values` `f32`s with `resolution` voxels of `channels` each.
+pub fn check_grid_memory(
+    path: &Path,
+    [x, y, z]: [u32; 3],
+    channels: u32,
+    values: u64,
+) -> Result<(), SceneError> {
+    check_memory(
+        path,
+        &format!("the grid of {x} x {y} x {z} voxels x {channels} channels as f32"),
+        bytes_of(values, 4),
+    )
+}
+
 pub fn bytes_of(count: u64, size: u64) -> Option<u64> {
     count.checked_mul(size)
 }

@@ -199,15 +199,7 @@ impl RawLayout {
             .filter(|&v| v <= MAX_VALUES)
             .ok_or_else(too_large)?;
         let count = usize::try_from(values).map_err(|_| too_large())?;
-        let [x, y, z] = self.resolution;
-        crate::limits::check_memory(
-            path,
-            &format!(
-                "the grid of {x} x {y} x {z} voxels x {} channels as f32",
-                self.channels
-            ),
-            crate::limits::bytes_of(values, 4),
-        )?;
+        crate::limits::check_grid_memory(path, self.resolution, self.channels, values)?;
         // At most 2^32 values of at most 8 bytes: no overflow.
         Ok((count, values * self.scalar.bytes() as u64))
     }

@@ -167,15 +167,8 @@ pub fn read_vol(path: &Path) -> Result<VolGrid, SceneError> {
     file.read_exact(&mut raw).map_err(io)?;
     let header =
         parse_header(&raw, file_bytes - VOL_HEADER_BYTES).map_err(|p| vol_error(path, p))?;
-    let [x, y, z] = header.resolution;
-    crate::limits::check_memory(
-        path,
-        &format!(
-            "the grid of {x} x {y} x {z} voxels x {} channels as f32",
-            header.channels
-        ),
-        crate::limits::bytes_of(header.value_count as u64, 4),
-    )?;
+    let values = header.value_count as u64;
+    crate::limits::check_grid_memory(path, header.resolution, header.channels, values)?;
 
     let mut data = Vec::new();
     if data.try_reserve_exact(header.value_count).is_err() {
