@@ -30,6 +30,7 @@ log "date $(date -u +%Y-%m-%dT%H:%MZ)"
 nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.max.sm --format=csv,noheader | tee "$OUT/device.txt"
 nvcc --version | tail -n 2 >>"$OUT/device.txt"
 ARCH=sm_$(nvidia-smi --query-gpu=compute_cap --format=csv,noheader | head -n 1 | tr -d '.')
+gunzip -kf volpt_kernels.ptx.gz
 ptxas -arch="$ARCH" -v volpt_kernels.ptx -o /dev/null >"$OUT/ptxas-$ARCH.txt" 2>&1
 log "ptxas -arch=$ARCH: $(grep -c 'Used' "$OUT/ptxas-$ARCH.txt") kernels reported"
 

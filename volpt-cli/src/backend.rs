@@ -7,7 +7,7 @@ use anyhow::Result;
 use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressStyle};
 use volpt_core::PathSettings;
-use volpt_cuda::{CudaRenderer, Strategy};
+use volpt_cuda::{CudaRenderer, Math, Schedule, Strategy};
 use volpt_render::{
     render_samples, with_scene_as, Effects, Film, Image, RenderOptions, RenderScene, RenderStats,
     SceneVisitor,
@@ -20,6 +20,22 @@ pub enum BackendKind {
     Cpu,
     /// An NVIDIA GPU through the CUDA driver.
     Cuda,
+}
+
+/// The flags that only the GPU backend takes: how it schedules and computes.
+#[derive(Clone, Copy, Debug, Default, clap::Args)]
+pub struct GpuArgs {
+    /// GPU scheduling strategy (default: regeneration-sk).
+    #[arg(long, value_enum)]
+    pub strategy: Option<Strategy>,
+    /// GPU arithmetic: `exact` is bit-identical to the CPU (default), `fast` uses the GPU's
+    /// approximate instructions.
+    #[arg(long, value_enum)]
+    pub math: Option<Math>,
+    /// Cap the GPU kernel's registers per thread (the JIT spills the rest): more threads resident
+    /// per multiprocessor, at the price of spills.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(16..=255))]
+    pub max_registers: Option<u32>,
 }
 
 /// One render: the scene, the integrator's limits and the sampling options.
@@ -37,27 +53,47 @@ pub enum Backend {
     Cpu,
     Cuda {
         renderer: CudaRenderer,
-        strategy: Strategy,
+        schedule: Schedule,
+        math: Math,
     },
 }
 
 impl Backend {
-    /// Opens `kind`; `strategy` is the GPU scheduling strategy (regeneration-sk by default).
-    pub fn open(kind: BackendKind, strategy: Option<Strategy>) -> Result<Self> {
+    /// Opens `kind`; `gpu` holds the GPU's flags (regeneration-sk and exact math by default).
+    pub fn open(kind: BackendKind, gpu: GpuArgs) -> Result<Self> {
         match kind {
             BackendKind::Cpu => {
-                if let Some(strategy) = strategy {
+                if let Some(strategy) = gpu.strategy {
                     anyhow::bail!(
                         "--strategy {strategy} schedules GPU work; the CPU backend has no \
                          strategies (use --backend cuda, or drop --strategy)"
                     );
                 }
+                if let Some(n) = gpu.max_registers {
+                    anyhow::bail!(
+                        "--max-registers {n} caps the GPU kernels' registers; the CPU backend has \
+                         none (use --backend cuda, or drop --max-registers)"
+                    );
+                }
+                if let Some(math) = gpu.math {
+                    anyhow::bail!(
+                        "--math {math} chooses the GPU's kernels; the CPU backend always computes \
+                         exactly (use --backend cuda, or drop --math)"
+                    );
+                }
                 Ok(Backend::Cpu)
             }
-            BackendKind::Cuda => Ok(Backend::Cuda {
-                renderer: CudaRenderer::new(0)?,
-                strategy: strategy.unwrap_or(Strategy::RegenerationSk),
-            }),
+            BackendKind::Cuda => {
+                let math = gpu.math.unwrap_or_default();
+                Ok(Backend::Cuda {
+                    renderer: CudaRenderer::new(0, math)?,
+                    schedule: Schedule {
+                        strategy: gpu.strategy.unwrap_or(Strategy::RegenerationSk),
+                        max_registers: gpu.max_registers,
+                    },
+                    math,
+                })
+            }
         }
     }
 
@@ -75,7 +111,14 @@ impl Backend {
     pub fn strategy(&self) -> Option<Strategy> {
         match self {
             Backend::Cpu => None,
-            Backend::Cuda { strategy, .. } => Some(*strategy),
+            Backend::Cuda { schedule, .. } => Some(schedule.strategy),
+        }
+    }
+
+    pub fn math(&self) -> Option<Math> {
+        match self {
+            Backend::Cpu => None,
+            Backend::Cuda { math, .. } => Some(*math),
         }
     }
 
@@ -123,9 +166,9 @@ impl SceneVisitor for Render<'_> {
         let (film, samples, options) = (self.film, self.samples, &self.options);
         let stats = match self.backend {
             Backend::Cpu => render_samples(scene, film, samples, options, &report)?,
-            Backend::Cuda { renderer, strategy } => {
-                renderer.render_samples(scene, *strategy, film, samples, options, &report)?
-            }
+            Backend::Cuda {
+                renderer, schedule, ..
+            } => renderer.render_samples(scene, *schedule, film, samples, options, &report)?,
         };
         bar.finish_and_clear();
         Ok(stats)

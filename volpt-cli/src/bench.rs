@@ -9,6 +9,8 @@ pub struct BenchReport {
     pub scene: String,
     pub backend: String,
     pub strategy: Option<String>,
+    /// The GPU's arithmetic (`exact` or `fast`).
+    pub math: Option<String>,
     pub device: String,
     pub variant: String,
     pub width: u32,

@@ -293,7 +293,7 @@ fn render_once(
 pub fn run(args: &ConvergeArgs) -> Result<()> {
     let desc = load(&args.scene)?;
     let base = options(&desc, &args.sampling)?;
-    let backend = Backend::open(args.sampling.backend, args.sampling.strategy)?;
+    let backend = Backend::open(args.sampling.backend, args.sampling.gpu)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let reference = reference(args, &desc, &backend, base)?;

@@ -18,8 +18,7 @@ use volpt_render::image::preview_path;
 use volpt_render::{path_settings, Image, RenderOptions, RenderStats, Variant};
 use volpt_scene::{Config, SceneAssembler, SceneDescription};
 
-use backend::{Backend, BackendKind, RenderJob};
-use volpt_cuda::Strategy;
+use backend::{Backend, BackendKind, GpuArgs, RenderJob};
 
 #[derive(Parser)]
 #[command(
@@ -135,9 +134,8 @@ struct SamplingArgs {
     /// Where to render.
     #[arg(long, value_enum, default_value_t = BackendKind::Cpu)]
     backend: BackendKind,
-    /// GPU scheduling strategy (default: regeneration-sk).
-    #[arg(long, value_enum)]
-    strategy: Option<Strategy>,
+    #[command(flatten)]
+    gpu: GpuArgs,
 }
 
 #[derive(Args)]
@@ -316,7 +314,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
         effects: args.scene.effects(),
         show_progress: true,
     };
-    let backend = Backend::open(args.sampling.backend, args.sampling.strategy)?;
+    let backend = Backend::open(args.sampling.backend, args.sampling.gpu)?;
     let variant = Parts::of(&desc, job.effects).variant();
     tracing::info!(
         scene = %args.scene.scene.display(),
@@ -326,6 +324,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
         spp = job.options.spp,
         device = %backend.device_name(),
         strategy = ?backend.strategy(),
+        math = ?backend.math(),
         "rendering"
     );
     let save = checkpoint::save_path(args.checkpoint.as_deref(), args.resume.as_deref());
@@ -438,7 +437,7 @@ fn bench_command(args: BenchArgs) -> Result<()> {
         effects: args.scene.effects(),
         show_progress: false,
     };
-    let backend = Backend::open(args.sampling.backend, args.sampling.strategy)?;
+    let backend = Backend::open(args.sampling.backend, args.sampling.gpu)?;
     let mut trials = Vec::new();
     let mut last = None;
     for trial in 0..=args.trials {
@@ -462,6 +461,7 @@ fn bench_command(args: BenchArgs) -> Result<()> {
         scene: args.scene.scene.display().to_string(),
         backend: format!("{:?}", args.sampling.backend).to_lowercase(),
         strategy: backend.strategy().map(|s| s.name().to_owned()),
+        math: backend.math().map(|m| m.name().to_owned()),
         device: backend.device_name(),
         variant: Parts::of(&desc, job.effects).variant().to_string(),
         width: image.width,

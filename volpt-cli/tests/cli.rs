@@ -202,6 +202,16 @@ fn strategy_on_the_cpu_is_a_clear_error() {
     );
 }
 
+#[test]
+fn gpu_math_on_the_cpu_is_a_clear_error() {
+    let scene = example();
+    let out = volpt(&["render", scene.to_str().unwrap(), "--math", "fast"]);
+    assert_clean_error(
+        &out,
+        &["--math fast", "CPU backend always computes exactly"],
+    );
+}
+
 /// `volpt scene export` writes the scene as volpt loads it in Mitsuba 3 spelling: the example (a
 /// Mitsuba 0.6 file with parameters) exported and rendered again gives the very same image.
 #[test]

@@ -1,9 +1,12 @@
 //! Scalar math used by the estimators, in one place so that every backend computes the same bits.
 //!
 //! `core` has no `sqrt`/`ln`/`sin` on stable; `libm` is pure Rust and compiles for every target,
-//! including nvptx64. A GPU backend may later swap in hardware approximations behind the same names
-//! (an accuracy/time knob that must be measured: with `lg2.approx`-style intrinsics a kernel is
-//! 8-12% faster but no longer bit-identical to the CPU, `docs/gpu.md`).
+//! including nvptx64, and gives every backend the same bits.
+//!
+//! The GPU's fast-math kernels (`--math fast`: built with `--cfg volpt_fast_math`, see
+//! `cargo xtask ptx`) swap in the hardware approximations behind the same names: `lg2.approx`,
+//! `ex2.approx` and `sqrt.approx` (relative errors of a few ulp, PTX ISA 9.7.3), an accuracy/time
+//! knob measured in `docs/strategies.md`; they are no longer bit-identical to the CPU.
 
 pub const PI: f32 = core::f32::consts::PI;
 pub const INV_PI: f32 = core::f32::consts::FRAC_1_PI;
@@ -12,7 +15,11 @@ pub const INV_4PI: f32 = 0.25 * core::f32::consts::FRAC_1_PI;
 /// The correctly rounded square root (IEEE 754), so every backend gets the same bits.
 #[inline]
 pub fn sqrt(x: f32) -> f32 {
-    #[cfg(target_arch = "nvptx64")]
+    #[cfg(all(target_arch = "nvptx64", volpt_fast_math))]
+    {
+        approx::sqrt(x)
+    }
+    #[cfg(all(target_arch = "nvptx64", not(volpt_fast_math)))]
     {
         // `sqrt.rn` is IEEE round-to-nearest, the value libm's software square root computes, in one
         // instruction instead of an integer loop.
@@ -38,12 +45,46 @@ pub fn safe_sqrt(x: f32) -> f32 {
 
 #[inline]
 pub fn ln(x: f32) -> f32 {
-    libm::logf(x)
+    #[cfg(all(target_arch = "nvptx64", volpt_fast_math))]
+    {
+        approx::lg2(x) * core::f32::consts::LN_2
+    }
+    #[cfg(not(all(target_arch = "nvptx64", volpt_fast_math)))]
+    {
+        libm::logf(x)
+    }
 }
 
 #[inline]
 pub fn exp(x: f32) -> f32 {
-    libm::expf(x)
+    #[cfg(all(target_arch = "nvptx64", volpt_fast_math))]
+    {
+        approx::ex2(x * core::f32::consts::LOG2_E)
+    }
+    #[cfg(not(all(target_arch = "nvptx64", volpt_fast_math)))]
+    {
+        libm::expf(x)
+    }
+}
+
+/// The GPU's approximate unary instructions, one function each.
+#[cfg(all(target_arch = "nvptx64", volpt_fast_math))]
+mod approx {
+    macro_rules! unary {
+        ($($name:ident: $op:literal),*) => {$(
+            #[inline(always)]
+            pub fn $name(x: f32) -> f32 {
+                let r: f32;
+                // SAFETY: a pure arithmetic instruction on registers.
+                unsafe {
+                    core::arch::asm!(concat!($op, " {r}, {x};"), r = out(reg32) r, x = in(reg32) x,
+                        options(pure, nomem, nostack))
+                };
+                r
+            }
+        )*};
+    }
+    unary!(sqrt: "sqrt.approx.f32", lg2: "lg2.approx.f32", ex2: "ex2.approx.f32");
 }
 
 #[inline]

@@ -36,6 +36,52 @@ pub fn ptx_entries(ptx: &str) -> Vec<&str> {
         .collect()
 }
 
+/// The module `ptx` reduced to one kernel, `entry`, with everything it may use (the header, globals,
+/// shared variables and functions), or `None` if `ptx` has no such entry. The driver JIT-compiles a
+/// module as a whole; one kernel compiles in a fraction of the time of every kernel of the registry.
+///
+/// With `max_registers`, the entry gets a `.maxnreg` directive: the JIT caps its registers per thread
+/// there (spilling what does not fit), the register cap of the thesis's occupancy study.
+pub fn single_kernel_ptx(ptx: &str, entry: &str, max_registers: Option<u32>) -> Option<String> {
+    let mut out = String::with_capacity(ptx.len() / 8);
+    let mut found = false;
+    let mut lines = ptx.lines();
+    while let Some(line) = lines.next() {
+        let Some((_, rest)) = line.split_once(".entry ") else {
+            out.push_str(line);
+            out.push('\n');
+            continue;
+        };
+        let name = rest.trim_end_matches(['(', ' ']).trim();
+        let keep = name == entry;
+        found |= keep;
+        if keep {
+            out.push_str(line);
+            out.push('\n');
+        }
+        // The entry's parameter list ends at the line `)`, its body at the line `}`.
+        let mut in_body = false;
+        for line in lines.by_ref() {
+            if keep {
+                if !in_body && line == "{" {
+                    if let Some(n) = max_registers {
+                        out.push_str(&format!(".maxnreg {n}\n"));
+                    }
+                }
+                out.push_str(line);
+                out.push('\n');
+            }
+            if line == "{" {
+                in_body = true;
+            }
+            if in_body && line == "}" {
+                break;
+            }
+        }
+    }
+    found.then_some(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -63,6 +109,41 @@ mod tests {
         entries.sort();
         entries.dedup();
         assert_eq!(entries.len(), Strategy::ALL.len() * 36);
+    }
+
+    const MODULE: &str = ".version 6.0\n.shared .align 8 .b64 s[5];\n.func f(\n)\n{\n\tret;\n}\n\
+        \t// .globl\ta__x\n.visible .entry a__x(\n\t.param .u64 p\n)\n{\n\tcall f;\n}\n\
+        .visible .entry b__y(\n\t.param .u64 p\n)\n{\n\t{\n\t}\n\tret;\n}\n.global .b8 g[1];\n";
+
+    #[test]
+    fn one_kernel_keeps_everything_but_the_other_entries() {
+        let a = single_kernel_ptx(MODULE, "a__x", None).unwrap();
+        assert_eq!(ptx_entries(&a), ["a__x"]);
+        for kept in [
+            ".version 6.0",
+            ".shared .align 8 .b64 s[5];",
+            ".func f(",
+            "call f;",
+            ".global .b8 g[1];",
+        ] {
+            assert!(a.contains(kept), "{kept} missing from {a}");
+        }
+        let b = single_kernel_ptx(MODULE, "b__y", None).unwrap();
+        assert_eq!(ptx_entries(&b), ["b__y"]);
+        // The nested block is inside b's body; the module's tail follows b.
+        assert!(b.contains("\t{\n\t}\n\tret;\n}\n.global .b8 g[1];"), "{b}");
+        assert!(!b.contains("call f;"));
+        assert_eq!(single_kernel_ptx(MODULE, "c__z", None), None);
+    }
+
+    #[test]
+    fn a_register_cap_goes_before_the_kernels_body() {
+        let a = single_kernel_ptx(MODULE, "a__x", Some(64)).unwrap();
+        assert!(
+            a.contains("\t.param .u64 p\n)\n.maxnreg 64\n{\n\tcall f;"),
+            "{a}"
+        );
+        assert_eq!(a.matches(".maxnreg").count(), 1);
     }
 
     #[test]

@@ -9,10 +9,10 @@ pub enum CudaError {
     )]
     NoDriver,
     #[error(
-        "this volpt was built without GPU kernels: run `cargo xtask ptx` (it installs the rust-src \
-         component if needed), then rebuild volpt"
+        "this volpt was built without the GPU's {0} kernels: run `cargo xtask ptx` (it builds both \
+         and installs the rust-src component if needed), then rebuild volpt"
     )]
-    NoKernels,
+    NoKernels(volpt_device::Math),
     #[error("cannot read the kernels' PTX from {path} (VOLPT_PTX): {source}")]
     PtxFile {
         path: std::path::PathBuf,

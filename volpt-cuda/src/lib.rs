@@ -3,7 +3,8 @@
 //!
 //! - [`renderer`]: device volumes, the device film, launching a strategy's kernel for a scene type.
 //! - [`entry`]: the kernel entry point of a scene type, derived from its parts' names.
-//! - [`Strategy`]: the GPU scheduling strategies, selectable at run time (`volpt_device`).
+//! - [`Strategy`]: the GPU scheduling strategies, selectable at run time (`volpt_device`), and
+//!   [`Math`]: exact or fast kernels.
 //! - [`error`]: what can go wrong, from "no GPU here" to a failed launch.
 //!
 //! The CUDA driver is loaded at run time, so a binary with this crate builds and runs on machines
@@ -14,20 +15,23 @@ pub mod error;
 pub mod renderer;
 
 pub use error::CudaError;
-pub use renderer::CudaRenderer;
-pub use volpt_device::Strategy;
+pub use renderer::{CudaRenderer, Schedule};
+pub use volpt_device::{Math, Strategy};
 
 /// The kernels' PTX, if `cargo xtask ptx` wrote it before this crate was built.
 mod ptx {
     include!(concat!(env!("OUT_DIR"), "/ptx.rs"));
 }
 
-/// The PTX of the workspace's kernels, if this build carries them.
-pub fn kernels_ptx() -> Option<&'static str> {
-    ptx::PTX
+/// The PTX of the workspace's kernels built for `math`, if this build carries it.
+pub fn kernels_ptx(math: Math) -> Option<&'static str> {
+    match math {
+        Math::Exact => ptx::EXACT,
+        Math::Fast => ptx::FAST,
+    }
 }
 
 /// Whether this build carries GPU kernels.
 pub fn has_kernels() -> bool {
-    ptx::PTX.is_some()
+    ptx::EXACT.is_some()
 }

@@ -4,35 +4,60 @@
 //! CPU) lives on the device for the whole render, and only the final sums come back. The kernel is
 //! the scene type's own ([`entry_name`]), so the GPU simulates exactly the effects the CPU would.
 
+use std::collections::HashMap;
 use std::ops::Range;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use cudarc::driver::{
-    sys, CudaContext, CudaModule, CudaSlice, CudaStream, DevicePtr, LaunchConfig, PushKernelArg,
+    sys, CudaContext, CudaFunction, CudaModule, CudaSlice, CudaStream, DevicePtr, LaunchConfig,
+    PushKernelArg,
 };
 use cudarc::nvrtc::Ptx;
 use volpt_core::abi::SceneAbi;
 use volpt_core::path::PathCounters;
 use volpt_device::launch::{BLOCK_SIZE, COUNTERS};
-use volpt_device::{LaunchParams, Strategy};
+use volpt_device::{LaunchParams, Math, Strategy};
 use volpt_film::{Film, Image, RenderOptions, RenderStats};
 
-use crate::entry::entry_name;
+use crate::entry::{entry_name, single_kernel_ptx};
 use crate::error::{CudaError, Doing};
 
-/// One GPU with volpt's kernels loaded.
+/// How a render is scheduled on the GPU.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Schedule {
+    pub strategy: Strategy,
+    /// A cap on the kernel's registers per thread (the JIT's `.maxnreg`), or the compiler's choice.
+    pub max_registers: Option<u32>,
+}
+
+impl From<Strategy> for Schedule {
+    fn from(strategy: Strategy) -> Self {
+        Self {
+            strategy,
+            max_registers: None,
+        }
+    }
+}
+
+/// A compiled kernel: its entry point and register cap.
+type KernelKey = (String, Option<u32>);
+
+/// One GPU and volpt's kernels, each JIT-compiled on first use.
 pub struct CudaRenderer {
+    ctx: Arc<CudaContext>,
     stream: Arc<CudaStream>,
-    module: Arc<CudaModule>,
+    ptx: String,
+    /// The modules compiled so far, one kernel each, by entry point and register cap.
+    modules: Mutex<HashMap<KernelKey, Arc<CudaModule>>>,
     device_name: String,
     multiprocessors: u32,
 }
 
 impl CudaRenderer {
-    /// Opens GPU `ordinal` and loads the workspace's kernels (the driver JIT-compiles the PTX for
-    /// this GPU on first use and caches the result).
-    pub fn new(ordinal: usize) -> Result<Self, CudaError> {
+    /// Opens GPU `ordinal` and loads the workspace's kernels built for `math` (the driver
+    /// JIT-compiles the PTX for this GPU on first use and caches the result).
+    pub fn new(ordinal: usize, math: Math) -> Result<Self, CudaError> {
         // `VOLPT_PTX=file.ptx` runs other kernels with this binary: A/B measurements of a kernel
         // change in one device session.
         let ptx = match std::env::var_os("VOLPT_PTX") {
@@ -40,7 +65,9 @@ impl CudaRenderer {
                 path: path.into(),
                 source,
             })?,
-            None => crate::kernels_ptx().ok_or(CudaError::NoKernels)?.to_owned(),
+            None => crate::kernels_ptx(math)
+                .ok_or(CudaError::NoKernels(math))?
+                .to_owned(),
         };
         Self::with_ptx(ordinal, ptx)
     }
@@ -57,36 +84,58 @@ impl CudaRenderer {
         let multiprocessors = ctx
             .attribute(sys::CUdevice_attribute::CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT)
             .doing("reading the multiprocessor count")? as u32;
-        let started = Instant::now();
-        let module = ctx
-            .load_module(Ptx::from_src(ptx))
-            .doing("loading the kernels' PTX")?;
-        tracing::debug!(elapsed = ?started.elapsed(), "loaded PTX");
         Ok(Self {
             stream: ctx.default_stream(),
-            module,
+            ctx,
+            ptx,
+            modules: Mutex::default(),
             device_name,
             multiprocessors,
         })
+    }
+
+    /// The kernel `entry` under the register cap `max_registers`, compiled on first use: the
+    /// driver JIT-compiles only that kernel (and caches the result on disk).
+    fn kernel(&self, entry: &str, max_registers: Option<u32>) -> Result<CudaFunction, CudaError> {
+        let key = (entry.to_owned(), max_registers);
+        let mut modules = self.modules.lock().unwrap_or_else(|e| e.into_inner());
+        let module = match modules.get(&key) {
+            Some(module) => module.clone(),
+            None => {
+                let ptx = single_kernel_ptx(&self.ptx, entry, max_registers)
+                    .ok_or_else(|| CudaError::MissingKernel(entry.to_owned()))?;
+                let started = Instant::now();
+                let module = self
+                    .ctx
+                    .load_module(Ptx::from_src(ptx))
+                    .doing("compiling the kernel's PTX")?;
+                tracing::debug!(entry, ?max_registers, elapsed = ?started.elapsed(), "loaded kernel");
+                modules.insert(key, module.clone());
+                module
+            }
+        };
+        module
+            .load_function(entry)
+            .map_err(|_| CudaError::MissingKernel(entry.to_owned()))
     }
 
     pub fn device_name(&self) -> &str {
         &self.device_name
     }
 
-    /// Renders `scene` with `strategy` and the kernel of `S`, calling `progress(done, total)` in
+    /// Renders `scene` as `schedule` says with the kernel of `S`, calling `progress(done, total)` in
     /// paths after each launch.
     pub fn render<S: SceneAbi>(
         &self,
         scene: &S,
-        strategy: Strategy,
+        schedule: impl Into<Schedule>,
         options: &RenderOptions,
         progress: &dyn Fn(u64, u64),
     ) -> Result<(Image, RenderStats), CudaError> {
         let (width, height) = (scene.camera().width, scene.camera().height);
         let mut film = Film::new(width, height);
         let samples = 0..options.spp;
-        let stats = self.render_samples(scene, strategy, &mut film, samples, options, progress)?;
+        let stats = self.render_samples(scene, schedule, &mut film, samples, options, progress)?;
         Ok((film.image(options.spp), stats))
     }
 
@@ -95,7 +144,7 @@ impl CudaRenderer {
     pub fn render_samples<S: SceneAbi>(
         &self,
         scene: &S,
-        strategy: Strategy,
+        schedule: impl Into<Schedule>,
         film: &mut Film,
         samples: Range<u32>,
         options: &RenderOptions,
@@ -103,11 +152,10 @@ impl CudaRenderer {
     ) -> Result<RenderStats, CudaError> {
         let (width, height) = (scene.camera().width, scene.camera().height);
         film.check_pass((width, height), &samples)?;
+        let schedule = schedule.into();
+        let strategy = schedule.strategy;
         let name = entry_name::<S>(strategy);
-        let kernel = self
-            .module
-            .load_function(&name)
-            .map_err(|_| CudaError::MissingKernel(name.clone()))?;
+        let kernel = self.kernel(&name, schedule.max_registers)?;
         let stream = &self.stream;
 
         // The scene: grids to the device, everything else by value.
@@ -176,15 +224,16 @@ impl CudaRenderer {
             stream
                 .memset_zeros(&mut next_path)
                 .doing("resetting the path counter")?;
-            // The kernel reads its parameters from device memory, copied once per launch.
-            let params_device = stream
-                .clone_htod(params.as_bytes())
-                .doing("copying the launch parameters")?;
-            let address = params_device.device_ptr(stream).0;
-            // SAFETY: the kernel takes one pointer to a `LaunchParams` whose film, counters, path
-            // counter and grids are the live allocations above, sized for this launch.
-            unsafe { stream.launch_builder(&kernel).arg(&address).launch(config) }
-                .doing("launching the kernel")?;
+            // SAFETY: the kernel takes one `LaunchParams` of this scene type by value, whose film,
+            // counters, path counter and grids are the live allocations above, sized for this
+            // launch.
+            unsafe {
+                stream
+                    .launch_builder(&kernel)
+                    .arg(&ByValue(params.checked()))
+                    .launch(config)
+            }
+            .doing("launching the kernel")?;
             stream.synchronize().doing("running the kernel")?;
             progress(pixels * (first + count) as u64, total);
         }
@@ -204,3 +253,12 @@ impl CudaRenderer {
         Ok(RenderStats { elapsed, counters })
     }
 }
+
+/// Launch parameters passed by value: the driver copies their bytes into the kernel's parameter
+/// space (the constant bank), as the kernel's signature asks.
+#[repr(transparent)]
+struct ByValue<P>(LaunchParams<P>);
+
+// SAFETY: `LaunchParams<P>` of `Pod` scene parameters is plain `repr(C)` data without padding
+// (`LaunchParams::LAYOUT`), the layout the kernel's parameter declares.
+unsafe impl<P: Copy> cudarc::driver::DeviceRepr for ByValue<P> {}

@@ -1,8 +1,8 @@
 //! Project automation: `cargo xtask <task>`.
 //!
 //! - `ptx [PACKAGE]`: compiles a kernels crate with rustc's NVPTX backend. By default the workspace's
-//!   (`volpt-kernels`), written to `volpt-cuda/ptx/volpt_kernels.ptx`, which `volpt-cuda` embeds at
-//!   its next build; any other kernels crate of the workspace (a library user's, see
+//!   (`volpt-kernels`), written to `volpt-cuda/ptx/volpt_kernels.ptx` and, built with fast math,
+//!   `volpt_kernels_fast.ptx`, which `volpt-cuda` embeds at its next build; any other kernels crate of the workspace (a library user's, see
 //!   `docs/extending.md`) to `<its directory>/ptx/<crate>.ptx`.
 //! - `device-bundle`: the PTX, a release `volpt` with it embedded, the library-user example and its
 //!   PTX, the scenes, the third-party data and the device scripts (`bench/device/*.sh`), in
@@ -62,21 +62,48 @@ const KERNELS: &str = "volpt-kernels";
 /// The library-user example's kernels crate (`examples/smooth-ball`), carried to the device too.
 const EXAMPLE_KERNELS: &str = "volpt-example-smooth-ball-kernels";
 
-/// Builds the kernels crate `package` and returns the path of its PTX.
+/// Builds the kernels crate `package` and returns the path of its PTX; the workspace's kernels
+/// crate is built twice, exact and fast (`--math fast`), and the path of the exact PTX returned.
+fn ptx(package: &str) -> Result<PathBuf> {
+    if package == KERNELS {
+        ptx_build(package, Flavour::Fast)?;
+    }
+    ptx_build(package, Flavour::Exact)
+}
+
+/// The kernels' arithmetic (`volpt_device::Math`).
+#[derive(Clone, Copy, PartialEq)]
+enum Flavour {
+    Exact,
+    Fast,
+}
+
+/// Builds the kernels crate `package` in `flavour` and returns the path of its PTX.
 ///
 /// Stable rustc with `RUSTC_BOOTSTRAP=1` (the `abi_ptx` feature); no linker is needed, because with
-/// fat LTO `--emit=asm` writes the whole linked module as PTX. A separate target directory keeps
-/// host builds from rebuilding `core`.
-fn ptx(package: &str) -> Result<PathBuf> {
+/// fat LTO `--emit=asm` writes the whole linked module as PTX. A separate target directory per
+/// flavour keeps host builds, and the other flavour, from rebuilding `core`.
+///
+/// The fast flavour sets `volpt_fast_math` (approximate `lg2`, `ex2`, `sqrt` in `volpt_core::math`)
+/// and lets LLVM's NVPTX backend use approximate division and square roots and fuse multiply-adds.
+fn ptx_build(package: &str, flavour: Flavour) -> Result<PathBuf> {
     ensure_rust_src()?;
     let root = root();
-    let target_dir = root.join("target-ptx");
+    let (target_dir, flags, suffix) = match flavour {
+        Flavour::Exact => (root.join("target-ptx"), "", ""),
+        Flavour::Fast => (
+            root.join("target-ptx/fast"),
+            " --cfg volpt_fast_math -C llvm-args=-nvptx-prec-divf32=0 \
+             -C llvm-args=-nvptx-prec-sqrtf32=0 -C llvm-args=-nvptx-fma-level=2",
+            "_fast",
+        ),
+    };
     run(Command::new(env!("CARGO"))
         .current_dir(&root)
         .env("RUSTC_BOOTSTRAP", "1")
         .env(
             "CARGO_TARGET_NVPTX64_NVIDIA_CUDA_RUSTFLAGS",
-            "-C target-cpu=sm_70 --emit=asm",
+            format!("-C target-cpu=sm_70 --emit=asm{flags}"),
         )
         .env("CARGO_TARGET_NVPTX64_NVIDIA_CUDA_LINKER", "/bin/true")
         .args([
@@ -96,9 +123,9 @@ fn ptx(package: &str) -> Result<PathBuf> {
         bail!("{} has no kernel entry points", built.display());
     }
     let out = if package == KERNELS {
-        root.join("volpt-cuda/ptx/volpt_kernels.ptx")
+        root.join(format!("volpt-cuda/ptx/volpt_kernels{suffix}.ptx"))
     } else {
-        package_dir(&root, package)?.join(format!("ptx/{crate_name}.ptx"))
+        package_dir(&root, package)?.join(format!("ptx/{crate_name}{suffix}.ptx"))
     };
     if let Some(dir) = out.parent() {
         std::fs::create_dir_all(dir)?;
@@ -182,7 +209,12 @@ fn device_bundle() -> Result<()> {
     )?;
     // Debug info is most of the binaries; the device carries at most 64 MiB.
     run(Command::new("strip").args([bundle.join("bin/volpt"), bundle.join("bin/smooth-ball")]))?;
-    std::fs::copy(&ptx, bundle.join("volpt_kernels.ptx"))?;
+    // The binary embeds both kernel builds; the scripts' ptxas reports read these copies,
+    // compressed (the device carries at most 64 MiB).
+    for file in ["volpt_kernels.ptx", "volpt_kernels_fast.ptx"] {
+        std::fs::copy(ptx.with_file_name(file), bundle.join(file))?;
+        run(Command::new("gzip").arg("-9").arg(bundle.join(file)))?;
+    }
     std::fs::copy(&example_ptx, bundle.join("smooth_ball_kernels.ptx"))?;
     // Generated grids are large and are regenerated on the device by `volpt scene generate`.
     copy_dir(&root.join("scenes"), &bundle.join("scenes"), &|p| {

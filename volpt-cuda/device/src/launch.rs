@@ -55,15 +55,15 @@ impl<P: Pod> LaunchParams<P> {
             && core::mem::size_of::<Self>() == core::mem::size_of::<P>() + 48
     );
 
-    /// The launch's bytes, as the host copies them to the device.
-    pub fn as_bytes(&self) -> &[u8] {
+    /// The parameters, once `LAYOUT` has been checked: the host ships only values built by this.
+    pub fn checked(self) -> Self {
         #[allow(clippy::let_unit_value)]
         let () = Self::LAYOUT;
-        bytemuck::bytes_of(self)
+        self
     }
 }
 
-// SAFETY: `repr(C)` of `Pod` fields; `LAYOUT` (evaluated by `as_bytes`, the only way the host ships
+// SAFETY: `repr(C)` of `Pod` fields; `LAYOUT` (evaluated by `checked`, the only way the host ships
 // the struct) proves that there is no padding.
 unsafe impl<P: Pod> Zeroable for LaunchParams<P> {}
 // SAFETY: as above.
@@ -92,7 +92,7 @@ impl Strategy {
             // One thread per pixel: several samples per launch would only lengthen the warp's
             // longest path, so each launch is one sample, and progress is reported per sample.
             Strategy::NaiveSk => remaining.min(1),
-            Strategy::RegenerationSk => {
+            _ => {
                 let fit = (PATHS_PER_REGENERATION_LAUNCH / pixels.max(1)).max(1);
                 remaining.min(u32::try_from(fit).unwrap_or(u32::MAX))
             }
@@ -119,7 +119,7 @@ impl Strategy {
         match self {
             Strategy::NaiveSk => pixels.div_ceil(BLOCK_SIZE as u64) as u32,
             // Persistent threads: exactly as many blocks as the GPU keeps resident.
-            Strategy::RegenerationSk => resident_blocks.max(1),
+            _ => resident_blocks.max(1),
         }
     }
 }

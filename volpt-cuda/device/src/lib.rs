@@ -4,6 +4,7 @@
 //!   scene's typed device ABI ([`volpt_core::abi`]), and the scheduling arithmetic of every
 //!   strategy as plain functions (tested on the CPU, used by host and kernels alike).
 //! - [`Strategy`]: the scheduling strategies, generated from one list with their entry names.
+//! - [`Math`]: exact (CPU-identical) or fast (approximate) kernels, two builds of one source.
 //! - [`export_kernels!`]: exports the kernels of every strategy for one scene type. The workspace's
 //!   kernels crate invokes it for every variant of the registry; a library user invokes it for a
 //!   scene of their own parts (see `docs/extending.md`).
@@ -19,6 +20,7 @@
 extern crate std;
 
 pub mod launch;
+mod math;
 mod strategies;
 
 #[cfg(target_arch = "nvptx64")]
@@ -27,4 +29,5 @@ pub mod nvptx;
 pub mod strategy;
 
 pub use launch::LaunchParams;
+pub use math::Math;
 pub use strategies::Strategy;

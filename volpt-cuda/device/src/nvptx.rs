@@ -89,6 +89,19 @@ fn shfl_down_u32(v: u32, delta: u32) -> u32 {
     r
 }
 
+/// `b`, hidden from the optimiser: an opaque copy at the top of a loop that runs collectives keeps
+/// LLVM from threading a value it knows on one edge (a path that just ended is inactive) into a
+/// copy of the loop's collective code, where lanes would vote or wait at different instructions.
+#[inline(always)]
+pub fn opaque(b: bool) -> bool {
+    let r: u32;
+    // SAFETY: a register copy; not `pure`, so it is neither folded nor moved.
+    unsafe {
+        asm!("mov.b32 {r}, {v};", r = out(reg32) r, v = in(reg32) b as u32, options(nomem, nostack))
+    };
+    r != 0
+}
+
 /// `v` of lane `src` (warp-collective).
 #[inline(always)]
 pub fn shfl_idx_u64(v: u64, src: u32) -> u64 {
@@ -163,4 +176,192 @@ pub unsafe fn red_add_f64(addr: *mut f64, v: f64) {
             options(nostack)
         )
     };
+}
+
+/// The index of this thread in its (one-dimensional) block.
+#[inline(always)]
+pub fn thread_index() -> u32 {
+    // SAFETY: a special-register read.
+    unsafe { nvptx::_thread_idx_x() }
+}
+
+/// Waits for every thread of the block (`bar.sync 0`): every thread must call it.
+#[inline(always)]
+pub fn sync_threads() {
+    // SAFETY: a barrier; the callers keep it in block-uniform control flow.
+    unsafe { nvptx::_syncthreads() }
+}
+
+/// Whether `pred` holds in any thread of the block, as a barrier (`bar.red.or`): every thread must
+/// call it.
+#[inline(always)]
+pub fn sync_threads_or(pred: bool) -> bool {
+    let r: u32;
+    // SAFETY: a barrier with a reduction; the callers keep it in block-uniform control flow.
+    unsafe {
+        asm!(
+            "{{ .reg .pred p, q; setp.ne.u32 p, {v}, 0; bar.red.or.pred q, 0, p; selp.u32 {r}, 1, 0, q; }}",
+            v = in(reg32) pred as u32,
+            r = out(reg32) r,
+            options(nostack)
+        )
+    };
+    r != 0
+}
+
+// Per-block path counters in shared memory: a thread adds a finished path's counts there with a
+// shared-memory reduction instead of holding five 64-bit totals in registers across its loop.
+core::arch::global_asm!(
+    ".shared .align 8 .b64 volpt_block_counters[{n}];",
+    n = const crate::launch::COUNTERS,
+);
+
+/// The shared-memory address of block counter `k`.
+#[inline(always)]
+fn block_counter(k: usize) -> u64 {
+    let base: u64;
+    // SAFETY: the address of a module-scope shared variable.
+    unsafe {
+        asm!("mov.u64 {b}, volpt_block_counters;", b = out(reg64) base,
+            options(pure, nomem, nostack))
+    };
+    base + 8 * k as u64
+}
+
+/// Zeroes the block's counters (thread `k < COUNTERS` zeroes counter `k`) and waits for it: every
+/// thread of the block must call it before any [`block_counter_add`].
+#[inline(always)]
+pub fn zero_block_counters() {
+    let k = thread_index() as usize;
+    if k < crate::launch::COUNTERS {
+        // SAFETY: counter `k` exists; shared memory is the block's own.
+        unsafe {
+            asm!("st.shared.u64 [{a}], 0;", a = in(reg64) block_counter(k), options(nostack))
+        };
+    }
+    sync_threads();
+}
+
+/// Adds `v` to the block's counter `k` (`k < COUNTERS`).
+#[inline(always)]
+pub fn block_counter_add(k: usize, v: u64) {
+    debug_assert!(k < crate::launch::COUNTERS);
+    // SAFETY: counter `k` exists; the reduction is atomic within the block.
+    unsafe {
+        asm!("red.shared.add.u64 [{a}], {v};", a = in(reg64) block_counter(k), v = in(reg64) v,
+            options(nostack))
+    };
+}
+
+/// Waits for the block, then adds its counters to the `COUNTERS` totals at `totals` (thread `k`
+/// adds counter `k`): every thread of the block must call it, after its last `block_counter_add`.
+///
+/// # Safety
+/// `totals` must be the device address of `COUNTERS` `u64`s.
+#[inline(always)]
+pub unsafe fn flush_block_counters(totals: *mut u64) {
+    sync_threads();
+    let k = thread_index() as usize;
+    if k < crate::launch::COUNTERS {
+        let v: u64;
+        // SAFETY: counter `k` exists.
+        unsafe {
+            asm!("ld.shared.u64 {v}, [{a}];", v = out(reg64) v, a = in(reg64) block_counter(k),
+                options(nostack))
+        };
+        if v != 0 {
+            // SAFETY: the caller's contract; `k < COUNTERS`.
+            unsafe { red_add_u64(totals.add(k), v) };
+        }
+    }
+}
+
+// Block-collective scratch: one count per warp of the block, and one value broadcast to the block.
+core::arch::global_asm!(
+    ".shared .align 4 .b32 volpt_warp_counts[32];",
+    ".shared .align 8 .b64 volpt_block_value;",
+);
+
+/// The shared-memory address of a module-scope shared variable, by name.
+macro_rules! shared_address {
+    ($name:literal) => {{
+        let a: u64;
+        // SAFETY: the address of a module-scope shared variable.
+        unsafe {
+            core::arch::asm!(concat!("mov.u64 {a}, ", $name, ";"), a = out(reg64) a,
+                options(pure, nomem, nostack))
+        };
+        a
+    }};
+}
+pub(crate) use shared_address;
+
+/// The number of threads before this one in the block (in thread order) whose `pred` is true, and
+/// the number over the whole block: a block-wide exclusive scan of `pred` by warp ballots and one
+/// count per warp in shared memory (block-collective: every thread must call it; two barriers).
+#[inline(always)]
+pub fn block_exclusive_count(pred: bool) -> (u32, u32) {
+    let votes = ballot(pred);
+    let warp = thread_index() / 32;
+    let warps = crate::launch::BLOCK_SIZE / 32;
+    let counts = shared_address!("volpt_warp_counts");
+    if lane_id() == 0 {
+        // SAFETY: `warp < 32` words of `volpt_warp_counts`.
+        unsafe {
+            asm!("st.shared.u32 [{a}], {v};", a = in(reg64) counts + 4 * warp as u64,
+                v = in(reg32) votes.count_ones(), options(nostack))
+        };
+    }
+    sync_threads();
+    let mut before = 0;
+    let mut total = 0;
+    for w in 0..warps {
+        let n: u32;
+        // SAFETY: `w < 32` words of `volpt_warp_counts`, written before the barrier.
+        unsafe {
+            asm!("ld.shared.u32 {n}, [{a}];", n = out(reg32) n, a = in(reg64) counts + 4 * w as u64,
+                options(nostack))
+        };
+        if w < warp {
+            before += n;
+        }
+        total += n;
+    }
+    // The counts are read before any thread can overwrite them in the next call.
+    sync_threads();
+    (before + (votes & lanemask_lt()).count_ones(), total)
+}
+
+/// Thread 0's `f()`, seen by every thread of the block (block-collective; two barriers).
+#[inline(always)]
+pub fn block_broadcast_u64(f: impl FnOnce() -> u64) -> u64 {
+    let slot = shared_address!("volpt_block_value");
+    if thread_index() == 0 {
+        let v = f();
+        // SAFETY: one `u64` of shared memory.
+        unsafe {
+            asm!("st.shared.u64 [{a}], {v};", a = in(reg64) slot, v = in(reg64) v, options(nostack))
+        };
+    }
+    sync_threads();
+    let v: u64;
+    // SAFETY: as above, written before the barrier.
+    unsafe {
+        asm!("ld.shared.u64 {v}, [{a}];", v = out(reg64) v, a = in(reg64) slot, options(nostack))
+    };
+    // Read before thread 0 can write the next value.
+    sync_threads();
+    v
+}
+
+/// A generic pointer to shared-memory address `shared` (`cvta.shared`), for plain loads and stores.
+#[inline(always)]
+pub fn shared_to_generic(shared: u64) -> u64 {
+    let p: u64;
+    // SAFETY: an address conversion.
+    unsafe {
+        asm!("cvta.shared.u64 {p}, {s};", p = out(reg64) p, s = in(reg64) shared,
+            options(pure, nomem, nostack))
+    };
+    p
 }

@@ -12,6 +12,9 @@ macro_rules! strategies {
         $callback! { $($args)* strategies [
             (NaiveSk, naive_sk, "naive-sk")
             (RegenerationSk, regeneration_sk, "regeneration-sk")
+            (RegenerationWarpSk, regeneration_warp_sk, "regeneration-warp-sk")
+            (RegenerationBlockSk, regeneration_block_sk, "regeneration-block-sk")
+            (StreamingSk, streaming_sk, "streaming-sk")
         ] }
     };
 }
@@ -32,18 +35,19 @@ macro_rules! export_kernels {
     (@each ($m:ident: $mt:ty, $b:ident: $bt:ty, $p:ident: $pt:ty, $e:ident: $et:ty)
      strategies [$(($camel:ident, $s:ident, $cli:literal))*]) => {$(
         const _: () = {
+            /// The launch parameters come by value: they live in the kernel's constant bank, where
+            /// every instruction can read them, instead of ~40 registers held across the path loop.
+            ///
             /// # Safety
-            /// `params` must be the device address of an initialised `LaunchParams` for this
-            /// scene type, whose buffers, grids and maps stay allocated until the kernel ends.
+            /// The grid, map and buffer addresses in `lp` must be device allocations that stay
+            /// alive until the kernel ends, sized for this launch and scene type.
             #[export_name = concat!(stringify!($s), "__", stringify!($m), "__", stringify!($b),
                 "__", stringify!($p), "__", stringify!($e))]
             pub unsafe extern "ptx-kernel" fn kernel(
-                params: *const $crate::LaunchParams<
+                lp: $crate::LaunchParams<
                     <$crate::launch::Scene<$mt, $bt, $pt, $et> as $crate::launch::SceneAbi>::Params,
                 >,
             ) {
-                // SAFETY: the caller's contract.
-                let lp = unsafe { *params };
                 // SAFETY: the grid and map addresses in `lp` are device allocations the host keeps
                 // alive.
                 let scene = unsafe {

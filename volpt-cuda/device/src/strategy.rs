@@ -13,13 +13,15 @@
 //!   Radiance reaches the film through `f64` atomic additions, whose order varies: the image agrees
 //!   with the CPU's up to the rounding of the sums.
 
-use volpt_core::path::{sample_pixel, step, PathCounters, PathState};
+use volpt_core::path::{sample_pixel, step, PathCounters, PathState, Truncation};
 use volpt_core::Scene;
 
-use crate::launch::{path_of, pixel_xy, LaunchParams};
+use crate::launch::{path_of, pixel_xy, LaunchParams, BLOCK_SIZE};
 use crate::nvptx::{
-    atomic_add_u64, ballot, global_thread_index, lane_id, lanemask_lt, red_add_f64, red_add_u64,
-    shfl_idx_u64, warp_sum_u64,
+    atomic_add_u64, ballot, block_broadcast_u64, block_counter_add, block_exclusive_count,
+    flush_block_counters, global_thread_index, lane_id, lanemask_lt, opaque, red_add_f64,
+    red_add_u64, shared_address, shared_to_generic, shfl_idx_u64, sync_threads, sync_threads_or,
+    thread_index, warp_sum_u64, zero_block_counters,
 };
 
 /// Adds the warp's counters to the launch's totals (warp-collective: every lane calls it).
@@ -39,6 +41,36 @@ unsafe fn add_counters<P>(c: &PathCounters, lp: &LaunchParams<P>) {
         if lane0 && sum != 0 {
             // SAFETY: `counters` holds `launch::COUNTERS` values.
             unsafe { red_add_u64(totals.add(k), sum) };
+        }
+    }
+}
+
+/// Adds a finished path to the block's counters, in the order of `launch::COUNTERS`.
+#[inline(always)]
+fn record_in_block(path: &PathState) {
+    block_counter_add(0, 1);
+    block_counter_add(1, path.segments as u64);
+    block_counter_add(2, path.tracking_steps as u64);
+    if path.truncated != Truncation::None {
+        block_counter_add(3, 1);
+        if path.truncated == Truncation::TrackingSteps {
+            block_counter_add(4, 1);
+        }
+    }
+}
+
+/// Records a finished path: its counts, and its radiance added to its pixel's `f64` sums.
+///
+/// # Safety
+/// `film` must hold the `3 * pixels` sums and `pixel` be inside it.
+#[inline(always)]
+unsafe fn finish_path(path: &PathState, pixel: u32, film: *mut f64) {
+    record_in_block(path);
+    for c in 0..3 {
+        let value = path.radiance[c];
+        if value != 0.0 {
+            // SAFETY: the caller's contract.
+            unsafe { red_add_f64(film.add(3 * pixel as usize + c), value as f64) };
         }
     }
 }
@@ -71,6 +103,17 @@ pub unsafe fn naive_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     unsafe { add_counters(&counters, lp) };
 }
 
+/// Where regeneration waits before an idle lane takes a new path (the thesis's synchronisation
+/// levels of regenerationSK).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Refill {
+    /// Any idle lane refills at once; the warp's idle lanes share one atomic.
+    Thread,
+    /// The warp refills only when all its lanes are idle: one atomic per 32 paths, and a warp's
+    /// lanes start (and tend to end) together.
+    Warp,
+}
+
 /// regenerationSK: persistent threads step their paths and refill finished lanes from a global
 /// path counter. Path index `k` is sample `k / pixels` of pixel `k % pixels`, so the paths in flight
 /// at any time are spread over the image and the film's atomics rarely collide.
@@ -79,13 +122,31 @@ pub unsafe fn naive_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
 /// As [`naive_sk`]; and `lp.next_path` must be one zeroed `u64`, and the block size a multiple of 32.
 #[inline(always)]
 pub unsafe fn regeneration_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
+    // SAFETY: forwarded.
+    unsafe { regeneration(scene, lp, Refill::Thread) }
+}
+
+/// regenerationSK at warp level: see [`Refill::Warp`].
+///
+/// # Safety
+/// As [`regeneration_sk`].
+#[inline(always)]
+pub unsafe fn regeneration_warp_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
+    // SAFETY: forwarded.
+    unsafe { regeneration(scene, lp, Refill::Warp) }
+}
+
+/// # Safety
+/// As [`regeneration_sk`].
+#[inline(always)]
+unsafe fn regeneration<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, refill: Refill) {
     let width = scene.camera().width;
     let pixels = (width * scene.camera().height) as u64;
     let film = lp.film as *mut f64;
     let next_path = lp.next_path as *mut u64;
     let lane = lane_id();
     let below = lanemask_lt();
-    let mut counters = PathCounters::default();
+    zero_block_counters();
     // A placeholder until the first refill; `active` says whether `path` is a live path.
     let mut path = PathState::from_camera(scene, 0, 0, 0, lp.seed);
     let mut pixel = 0u32;
@@ -93,7 +154,11 @@ pub unsafe fn regeneration_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     let mut exhausted = false;
     loop {
         // Refill: the lanes without a path take consecutive indices with one atomic per warp.
-        let need = !active && !exhausted;
+        let ready = match refill {
+            Refill::Thread => true,
+            Refill::Warp => ballot(active) == 0,
+        };
+        let need = ready && !active && !exhausted;
         let wanting = ballot(need);
         if wanting != 0 {
             let leader = wanting.trailing_zeros();
@@ -122,18 +187,149 @@ pub unsafe fn regeneration_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
         if active {
             step(scene, &mut path);
             if !path.alive {
-                counters.record(&path);
-                for c in 0..3 {
-                    let value = path.radiance[c];
-                    if value != 0.0 {
-                        // SAFETY: `pixel` is inside the film.
-                        unsafe { red_add_f64(film.add(3 * pixel as usize + c), value as f64) };
-                    }
-                }
+                // SAFETY: `pixel` is inside the film.
+                unsafe { finish_path(&path, pixel, film) };
                 active = false;
             }
         }
     }
-    // SAFETY: forwarded.
-    unsafe { add_counters(&counters, lp) };
+    // SAFETY: `lp.counters` holds `COUNTERS` totals.
+    unsafe { flush_block_counters(lp.counters as *mut u64) };
+}
+
+/// regenerationSK at block level: after every step the block counts its idle lanes (a block-wide
+/// scan), takes that many path indices with one atomic, and hands them out in thread order.
+///
+/// # Safety
+/// As [`regeneration_sk`]; every thread of the block runs it.
+#[inline(always)]
+pub unsafe fn regeneration_block_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
+    let width = scene.camera().width;
+    let pixels = (width * scene.camera().height) as u64;
+    let film = lp.film as *mut f64;
+    let next_path = lp.next_path as *mut u64;
+    zero_block_counters();
+    let mut path = PathState::from_camera(scene, 0, 0, 0, lp.seed);
+    let mut pixel = 0u32;
+    let mut active = false;
+    let mut exhausted = false;
+    loop {
+        let need = opaque(!active && !exhausted);
+        let (rank, wanting) = block_exclusive_count(need);
+        if wanting > 0 {
+            // SAFETY: `next_path` is one `u64` (the caller's contract).
+            let base = block_broadcast_u64(|| unsafe { atomic_add_u64(next_path, wanting as u64) });
+            if need {
+                let index = base + rank as u64;
+                if index < lp.total_paths {
+                    let sample;
+                    (pixel, sample) = path_of(index, pixels, lp.first_sample);
+                    let (px, py) = pixel_xy(pixel, width);
+                    path = PathState::from_camera(scene, px, py, sample, lp.seed);
+                    active = true;
+                } else {
+                    exhausted = true;
+                }
+            }
+        }
+        if !sync_threads_or(opaque(active)) {
+            break;
+        }
+        if active {
+            step(scene, &mut path);
+            if !path.alive {
+                // SAFETY: `pixel` is inside the film.
+                unsafe { finish_path(&path, pixel, film) };
+                active = false;
+            }
+        }
+    }
+    // SAFETY: `lp.counters` holds `COUNTERS` totals.
+    unsafe { flush_block_counters(lp.counters as *mut u64) };
+}
+
+/// A path parked in shared memory while the block compacts: its state and its pixel.
+#[derive(Clone, Copy)]
+#[repr(C)]
+struct Slot {
+    path: PathState,
+    pixel: u32,
+}
+
+// One slot per thread of the block, for streamingSK's compaction.
+core::arch::global_asm!(
+    ".shared .align 16 .b8 volpt_stream_slots[{n}];",
+    n = const core::mem::size_of::<Slot>() * BLOCK_SIZE as usize,
+);
+
+/// streamingSK (the thesis's algorithm 5, with compaction in the block): persistent blocks; after
+/// every step the block compacts its live paths to its first threads (a block-wide exclusive scan
+/// gives each live path its slot in shared memory) and the idle tail takes new paths with one
+/// atomic per block. Live paths stay dense in the first warps, so the idle lanes are whole warps at
+/// the end of the block, which refill together.
+///
+/// # Safety
+/// As [`regeneration_sk`]; every thread of the block runs it.
+#[inline(always)]
+pub unsafe fn streaming_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
+    let width = scene.camera().width;
+    let pixels = (width * scene.camera().height) as u64;
+    let film = lp.film as *mut f64;
+    let next_path = lp.next_path as *mut u64;
+    let slots = shared_to_generic(shared_address!("volpt_stream_slots")) as *mut Slot;
+    let thread = thread_index();
+    zero_block_counters();
+    let mut slot = Slot {
+        path: PathState::from_camera(scene, 0, 0, 0, lp.seed),
+        pixel: 0,
+    };
+    let mut active = false;
+    let mut exhausted = false;
+    loop {
+        if active {
+            step(scene, &mut slot.path);
+            if !slot.path.alive {
+                // SAFETY: `pixel` is inside the film.
+                unsafe { finish_path(&slot.path, slot.pixel, film) };
+                active = false;
+            }
+        }
+        // Compaction: live path `rank` moves to thread `rank`.
+        let (rank, live) = block_exclusive_count(opaque(active));
+        if active {
+            // SAFETY: `rank < BLOCK_SIZE` slots.
+            unsafe { slots.add(rank as usize).write(slot) };
+        }
+        sync_threads();
+        active = thread < live;
+        if active {
+            // SAFETY: written before the barrier by the thread of that rank.
+            slot = unsafe { slots.add(thread as usize).read() };
+        }
+        // The slots are read before the next compaction writes them: the barrier in
+        // `block_exclusive_count` below orders them.
+        let need = opaque(!active && !exhausted);
+        let (rank, wanting) = block_exclusive_count(need);
+        if wanting > 0 {
+            // SAFETY: `next_path` is one `u64` (the caller's contract).
+            let base = block_broadcast_u64(|| unsafe { atomic_add_u64(next_path, wanting as u64) });
+            if need {
+                let index = base + rank as u64;
+                if index < lp.total_paths {
+                    let sample;
+                    (slot.pixel, sample) = path_of(index, pixels, lp.first_sample);
+                    let (px, py) = pixel_xy(slot.pixel, width);
+                    slot.path = PathState::from_camera(scene, px, py, sample, lp.seed);
+                    active = true;
+                } else {
+                    exhausted = true;
+                }
+            }
+        }
+        if !sync_threads_or(opaque(active)) {
+            break;
+        }
+    }
+    // SAFETY: `lp.counters` holds `COUNTERS` totals.
+    unsafe { flush_block_counters(lp.counters as *mut u64) };
 }

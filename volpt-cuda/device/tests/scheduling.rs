@@ -23,7 +23,7 @@ fn coverage(strategy: Strategy, pixels: u64, spp: u32) -> Vec<u32> {
                 }
             }
             // Persistent threads take path indices 0 .. total_paths from the global counter.
-            Strategy::RegenerationSk => {
+            _ => {
                 for index in 0..pixels * samples as u64 {
                     let (pixel, sample) = path_of(index, pixels, first);
                     assert!((pixel as u64) < pixels && sample < spp);
