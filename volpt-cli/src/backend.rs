@@ -8,6 +8,8 @@ use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressStyle};
 use volpt_core::PathSettings;
 use volpt_cuda::{CudaRenderer, Math, Schedule, Strategy};
+
+use crate::auto::{self, AutoCache, Choice};
 use volpt_render::{
     render_samples, with_scene_as, Effects, Film, Image, RenderOptions, RenderScene, RenderStats,
     SceneVisitor,
@@ -22,12 +24,47 @@ pub enum BackendKind {
     Cuda,
 }
 
+/// `--strategy`: `auto` (chosen by measurement, see `auto`) or one of the GPU's strategies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StrategyArg {
+    Auto,
+    Fixed(Strategy),
+}
+
+impl ValueEnum for StrategyArg {
+    fn value_variants<'a>() -> &'a [Self] {
+        static VARIANTS: std::sync::LazyLock<Vec<StrategyArg>> = std::sync::LazyLock::new(|| {
+            std::iter::once(StrategyArg::Auto)
+                .chain(Strategy::ALL.iter().map(|&s| StrategyArg::Fixed(s)))
+                .collect()
+        });
+        &VARIANTS
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(match self {
+            StrategyArg::Auto => clap::builder::PossibleValue::new("auto"),
+            StrategyArg::Fixed(s) => clap::builder::PossibleValue::new(s.name()),
+        })
+    }
+}
+
+impl std::fmt::Display for StrategyArg {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            StrategyArg::Auto => f.write_str("auto"),
+            StrategyArg::Fixed(s) => write!(f, "{s}"),
+        }
+    }
+}
+
 /// The flags that only the GPU backend takes: how it schedules and computes.
 #[derive(Clone, Copy, Debug, Default, clap::Args)]
 pub struct GpuArgs {
-    /// GPU scheduling strategy (default: regeneration-sk).
+    /// GPU scheduling strategy (default: auto, the fastest for the scene by a short calibration,
+    /// cached per scene and GPU).
     #[arg(long, value_enum)]
-    pub strategy: Option<Strategy>,
+    pub strategy: Option<StrategyArg>,
     /// GPU arithmetic: `exact` is bit-identical to the CPU (default), `fast` uses the GPU's
     /// approximate instructions.
     #[arg(long, value_enum)]
@@ -53,8 +90,10 @@ pub enum Backend {
     Cpu,
     Cuda {
         renderer: CudaRenderer,
-        schedule: Schedule,
+        /// A fixed schedule, or `None` for `auto`.
+        schedule: Option<Schedule>,
         math: Math,
+        auto: AutoCache,
     },
 }
 
@@ -85,13 +124,26 @@ impl Backend {
             }
             BackendKind::Cuda => {
                 let math = gpu.math.unwrap_or_default();
+                let schedule = match gpu.strategy.unwrap_or(StrategyArg::Auto) {
+                    StrategyArg::Auto => {
+                        if let Some(n) = gpu.max_registers {
+                            anyhow::bail!(
+                                "--max-registers {n} with --strategy auto: auto chooses the \
+                                 register cap too (name a strategy to set it)"
+                            );
+                        }
+                        None
+                    }
+                    StrategyArg::Fixed(strategy) => Some(Schedule {
+                        strategy,
+                        max_registers: gpu.max_registers,
+                    }),
+                };
                 Ok(Backend::Cuda {
                     renderer: CudaRenderer::new(0, math)?,
-                    schedule: Schedule {
-                        strategy: gpu.strategy.unwrap_or(Strategy::RegenerationSk),
-                        max_registers: gpu.max_registers,
-                    },
+                    schedule,
                     math,
+                    auto: AutoCache::open(),
                 })
             }
         }
@@ -108,10 +160,13 @@ impl Backend {
         }
     }
 
-    pub fn strategy(&self) -> Option<Strategy> {
+    /// The strategy flag's value (`auto` or a strategy's name); `None` on the CPU.
+    pub fn strategy(&self) -> Option<StrategyArg> {
         match self {
             Backend::Cpu => None,
-            Backend::Cuda { schedule, .. } => Some(schedule.strategy),
+            Backend::Cuda { schedule, .. } => {
+                Some(schedule.map_or(StrategyArg::Auto, |s| StrategyArg::Fixed(s.strategy)))
+            }
         }
     }
 
@@ -137,6 +192,7 @@ impl Backend {
     ) -> Result<RenderStats> {
         let visitor = Render {
             backend: self,
+            auto_key: self.auto_key(job),
             options: job.options,
             film,
             samples,
@@ -146,8 +202,21 @@ impl Backend {
     }
 }
 
+impl Backend {
+    /// The key of `job`'s `auto` choice: the GPU, the math and the scene as rendered.
+    fn auto_key(&self, job: &RenderJob) -> String {
+        format!(
+            "{}|{}|{:016x}",
+            self.device_name(),
+            self.math().map_or("-", |m| m.name()),
+            crate::checkpoint::fingerprint(job)
+        )
+    }
+}
+
 struct Render<'a> {
     backend: &'a Backend,
+    auto_key: String,
     options: RenderOptions,
     film: &'a mut Film,
     samples: Range<u32>,
@@ -167,12 +236,44 @@ impl SceneVisitor for Render<'_> {
         let stats = match self.backend {
             Backend::Cpu => render_samples(scene, film, samples, options, &report)?,
             Backend::Cuda {
-                renderer, schedule, ..
-            } => renderer.render_samples(scene, *schedule, film, samples, options, &report)?,
+                renderer,
+                schedule,
+                auto,
+                ..
+            } => {
+                let schedule = match schedule {
+                    Some(schedule) => *schedule,
+                    None => auto_schedule(renderer, auto, &self.auto_key, scene, options)?,
+                };
+                renderer.render_samples(scene, schedule, film, samples, options, &report)?
+            }
         };
         bar.finish_and_clear();
         Ok(stats)
     }
+}
+
+/// The cached `auto` choice for `key`, or a new calibration (printed and cached).
+fn auto_schedule<S: RenderScene>(
+    renderer: &CudaRenderer,
+    cache: &AutoCache,
+    key: &str,
+    scene: &S,
+    options: &RenderOptions,
+) -> Result<Schedule> {
+    if let Some(schedule) = cache.get(key).as_ref().and_then(Choice::schedule) {
+        tracing::info!(strategy = %schedule.strategy, max_registers = ?schedule.max_registers,
+            "auto: cached choice for this scene and GPU");
+        return Ok(schedule);
+    }
+    eprintln!("auto: calibrating the GPU strategies on this scene (cached afterwards)");
+    let choice = auto::calibrate(renderer, scene, options)?;
+    eprint!("{}", choice.report());
+    let schedule = choice
+        .schedule()
+        .expect("calibration chooses among the strategies");
+    cache.insert(key.to_owned(), choice);
+    Ok(schedule)
 }
 
 fn progress_bar(show: bool) -> ProgressBar {

@@ -1,5 +1,6 @@
 //! `volpt`: render solid participating media from Mitsuba scene files.
 
+mod auto;
 mod backend;
 mod bench;
 mod checkpoint;
@@ -51,6 +52,9 @@ enum Command {
     Compare(compare::CompareArgs),
     /// Error against time for each setting: progressive renders, CSV, SVG plots, a table.
     Converge(converge::ConvergeArgs),
+    /// Test the GPU strategies' collective building blocks (block scan, warp and block index
+    /// takers) on the GPU against plain CPU implementations.
+    Selftest,
 }
 
 #[derive(Subcommand)]
@@ -259,6 +263,7 @@ fn main() -> Result<()> {
         }
         Command::Compare(args) => compare::run(&args),
         Command::Converge(args) => converge::run(&args),
+        Command::Selftest => selftest(),
     }
 }
 
@@ -460,7 +465,7 @@ fn bench_command(args: BenchArgs) -> Result<()> {
     let report = bench::BenchReport {
         scene: args.scene.scene.display().to_string(),
         backend: format!("{:?}", args.sampling.backend).to_lowercase(),
-        strategy: backend.strategy().map(|s| s.name().to_owned()),
+        strategy: backend.strategy().map(|s| s.to_string()),
         math: backend.math().map(|m| m.name().to_owned()),
         device: backend.device_name(),
         variant: Parts::of(&desc, job.effects).variant().to_string(),
@@ -486,5 +491,28 @@ fn bench_command(args: BenchArgs) -> Result<()> {
     } else {
         println!("{}", report.table_row());
     }
+    Ok(())
+}
+
+fn selftest() -> Result<()> {
+    let renderer = volpt_cuda::CudaRenderer::new(0, volpt_cuda::Math::Exact)?;
+    let mut failed = 0;
+    for test in renderer.selftest()? {
+        if test.failures.is_empty() {
+            println!("PASS {} ({} threads)", test.name, test.threads);
+        } else {
+            failed += 1;
+            println!(
+                "FAIL {}: {} differences, first: {:?}",
+                test.name,
+                test.failures.len(),
+                &test.failures[..test.failures.len().min(5)]
+            );
+        }
+    }
+    if failed > 0 {
+        bail!("{failed} selftests failed on {}", renderer.device_name());
+    }
+    println!("all selftests passed on {}", renderer.device_name());
     Ok(())
 }

@@ -5,6 +5,7 @@
 //! - [`entry`]: the kernel entry point of a scene type, derived from its parts' names.
 //! - [`Strategy`]: the GPU scheduling strategies, selectable at run time (`volpt_device`), and
 //!   [`Math`]: exact or fast kernels.
+//! - [`selftest`]: the strategies' collective building blocks on the GPU against the CPU.
 //! - [`error`]: what can go wrong, from "no GPU here" to a failed launch.
 //!
 //! The CUDA driver is loaded at run time, so a binary with this crate builds and runs on machines
@@ -13,6 +14,7 @@
 pub mod entry;
 pub mod error;
 pub mod renderer;
+pub mod selftest;
 
 pub use error::CudaError;
 pub use renderer::{CudaRenderer, Schedule};

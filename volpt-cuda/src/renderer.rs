@@ -96,7 +96,11 @@ impl CudaRenderer {
 
     /// The kernel `entry` under the register cap `max_registers`, compiled on first use: the
     /// driver JIT-compiles only that kernel (and caches the result on disk).
-    fn kernel(&self, entry: &str, max_registers: Option<u32>) -> Result<CudaFunction, CudaError> {
+    pub(crate) fn kernel(
+        &self,
+        entry: &str,
+        max_registers: Option<u32>,
+    ) -> Result<CudaFunction, CudaError> {
         let key = (entry.to_owned(), max_registers);
         let mut modules = self.modules.lock().unwrap_or_else(|e| e.into_inner());
         let module = match modules.get(&key) {
@@ -117,6 +121,10 @@ impl CudaRenderer {
         module
             .load_function(entry)
             .map_err(|_| CudaError::MissingKernel(entry.to_owned()))
+    }
+
+    pub(crate) fn stream(&self) -> &Arc<CudaStream> {
+        &self.stream
     }
 
     pub fn device_name(&self) -> &str {

@@ -8,6 +8,7 @@
 //! - [`export_kernels!`]: exports the kernels of every strategy for one scene type. The workspace's
 //!   kernels crate invokes it for every variant of the registry; a library user invokes it for a
 //!   scene of their own parts (see `docs/extending.md`).
+//! - [`selftest`]: kernels that test the strategies' collective building blocks against the CPU.
 //! - on nvptx64 only: [`strategy`] (the strategies' kernel bodies) and the PTX intrinsics they use.
 #![no_std]
 #![cfg_attr(
@@ -21,6 +22,7 @@ extern crate std;
 
 pub mod launch;
 mod math;
+pub mod selftest;
 mod strategies;
 
 #[cfg(target_arch = "nvptx64")]

@@ -103,6 +103,46 @@ pub unsafe fn naive_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     unsafe { add_counters(&counters, lp) };
 }
 
+/// The lanes of the warp with `need` take consecutive indices from the counter `next`, in lane
+/// order, with one atomic per warp (warp-collective). `None` if no lane of the warp needs one;
+/// otherwise `Some` index, which is this lane's if it has `need`.
+///
+/// # Safety
+/// `next` must be the device address of one `u64`.
+#[inline(always)]
+pub unsafe fn warp_take_indices(need: bool, next: *mut u64) -> Option<u64> {
+    let wanting = ballot(need);
+    if wanting == 0 {
+        return None;
+    }
+    let leader = wanting.trailing_zeros();
+    let mut base = 0;
+    if lane_id() == leader {
+        // SAFETY: the caller's contract.
+        base = unsafe { atomic_add_u64(next, wanting.count_ones() as u64) };
+    }
+    let base = shfl_idx_u64(base, leader);
+    Some(base + (wanting & lanemask_lt()).count_ones() as u64)
+}
+
+/// The threads of the block with `need` take consecutive indices from the counter `next`, in
+/// thread order, with one atomic per block (block-collective: a block-wide exclusive scan and a
+/// broadcast). `None` if no thread of the block needs one; otherwise `Some` index, which is this
+/// thread's if it has `need`.
+///
+/// # Safety
+/// `next` must be the device address of one `u64`.
+#[inline(always)]
+pub unsafe fn block_take_indices(need: bool, next: *mut u64) -> Option<u64> {
+    let (rank, wanting) = block_exclusive_count(need);
+    if wanting == 0 {
+        return None;
+    }
+    // SAFETY: the caller's contract.
+    let base = block_broadcast_u64(|| unsafe { atomic_add_u64(next, wanting as u64) });
+    Some(base + rank as u64)
+}
+
 /// Where regeneration waits before an idle lane takes a new path (the thesis's synchronisation
 /// levels of regenerationSK).
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -144,8 +184,6 @@ unsafe fn regeneration<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, refill: Ref
     let pixels = (width * scene.camera().height) as u64;
     let film = lp.film as *mut f64;
     let next_path = lp.next_path as *mut u64;
-    let lane = lane_id();
-    let below = lanemask_lt();
     zero_block_counters();
     // A placeholder until the first refill; `active` says whether `path` is a live path.
     let mut path = PathState::from_camera(scene, 0, 0, 0, lp.seed);
@@ -159,17 +197,9 @@ unsafe fn regeneration<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, refill: Ref
             Refill::Warp => ballot(active) == 0,
         };
         let need = ready && !active && !exhausted;
-        let wanting = ballot(need);
-        if wanting != 0 {
-            let leader = wanting.trailing_zeros();
-            let mut base = 0;
-            if lane == leader {
-                // SAFETY: `next_path` is one `u64` (the caller's contract).
-                base = unsafe { atomic_add_u64(next_path, wanting.count_ones() as u64) };
-            }
-            let base = shfl_idx_u64(base, leader);
+        // SAFETY: `next_path` is one `u64` (the caller's contract).
+        if let Some(index) = unsafe { warp_take_indices(need, next_path) } {
             if need {
-                let index = base + (wanting & below).count_ones() as u64;
                 if index < lp.total_paths {
                     let sample;
                     (pixel, sample) = path_of(index, pixels, lp.first_sample);
@@ -215,12 +245,9 @@ pub unsafe fn regeneration_block_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>
     let mut exhausted = false;
     loop {
         let need = opaque(!active && !exhausted);
-        let (rank, wanting) = block_exclusive_count(need);
-        if wanting > 0 {
-            // SAFETY: `next_path` is one `u64` (the caller's contract).
-            let base = block_broadcast_u64(|| unsafe { atomic_add_u64(next_path, wanting as u64) });
+        // SAFETY: `next_path` is one `u64` (the caller's contract).
+        if let Some(index) = unsafe { block_take_indices(need, next_path) } {
             if need {
-                let index = base + rank as u64;
                 if index < lp.total_paths {
                     let sample;
                     (pixel, sample) = path_of(index, pixels, lp.first_sample);
@@ -309,12 +336,9 @@ pub unsafe fn streaming_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
         // The slots are read before the next compaction writes them: the barrier in
         // `block_exclusive_count` below orders them.
         let need = opaque(!active && !exhausted);
-        let (rank, wanting) = block_exclusive_count(need);
-        if wanting > 0 {
-            // SAFETY: `next_path` is one `u64` (the caller's contract).
-            let base = block_broadcast_u64(|| unsafe { atomic_add_u64(next_path, wanting as u64) });
+        // SAFETY: `next_path` is one `u64` (the caller's contract).
+        if let Some(index) = unsafe { block_take_indices(need, next_path) } {
             if need {
-                let index = base + rank as u64;
                 if index < lp.total_paths {
                     let sample;
                     (slot.pixel, sample) = path_of(index, pixels, lp.first_sample);

@@ -21,3 +21,6 @@ macro_rules! export_registry {
 
 #[cfg(target_arch = "nvptx64")]
 volpt_core::variants!('static => export_registry {});
+
+#[cfg(target_arch = "nvptx64")]
+volpt_device::export_selftests!();

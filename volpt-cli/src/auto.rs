@@ -1,0 +1,274 @@
+//! `--strategy auto`: the best GPU schedule for this scene on this GPU, chosen by measurement.
+//!
+//! The thesis's central finding is that the best strategy depends on the scene; so instead of a
+//! rule, short calibration renders of the actual scene time every candidate (each strategy but
+//! naive-sk, each with the compiler's registers and two register caps) and the fastest wins. The
+//! choice and the measurements behind it are printed, and cached per scene, GPU and math in
+//! `$XDG_CACHE_HOME/volpt/auto.json` (or `~/.cache/volpt/`; `VOLPT_CACHE_DIR` overrides), so only
+//! the first render of a scene pays for the calibration (a few seconds, most of it JIT compilation).
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::sync::Mutex;
+use std::time::Duration;
+
+use anyhow::Result;
+use serde::{Deserialize, Serialize};
+use volpt_core::abi::SceneAbi;
+use volpt_cuda::{CudaRenderer, Schedule, Strategy};
+use volpt_render::{Film, RenderOptions};
+
+/// Register caps tried for every strategy (`None`: the compiler's choice).
+const CAPS: [Option<u32>; 3] = [None, Some(96), Some(64)];
+
+/// Paths per calibration render: long enough that launch overheads are small against it.
+const CALIBRATION_PATHS: u64 = 1 << 22;
+
+/// Timed renders per candidate; the fastest counts (the first also warms the kernel up).
+const TRIALS: usize = 2;
+
+/// One candidate's calibration time.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Measurement {
+    pub strategy: String,
+    pub max_registers: Option<u32>,
+    /// Seconds per million paths (the fastest trial).
+    pub seconds_per_mpath: f64,
+}
+
+/// A choice and why.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Choice {
+    pub strategy: String,
+    pub max_registers: Option<u32>,
+    pub measurements: Vec<Measurement>,
+}
+
+impl Choice {
+    pub fn schedule(&self) -> Option<Schedule> {
+        let strategy = Strategy::ALL
+            .iter()
+            .copied()
+            .find(|s| s.name() == self.strategy)?;
+        Some(Schedule {
+            strategy,
+            max_registers: self.max_registers,
+        })
+    }
+
+    /// The measurements as a table, fastest first, and the choice.
+    pub fn report(&self) -> String {
+        let mut rows = self.measurements.clone();
+        rows.sort_by(|a, b| a.seconds_per_mpath.total_cmp(&b.seconds_per_mpath));
+        let best = rows.first().map_or(f64::NAN, |m| m.seconds_per_mpath);
+        let mut out = format!(
+            "auto: {} with {} (calibration, ms per million paths):\n",
+            self.strategy,
+            registers(self.max_registers)
+        );
+        for m in &rows {
+            out.push_str(&format!(
+                "  {:<24} {:<16} {:>9.3} ms  {:>6.2}x\n",
+                m.strategy,
+                registers(m.max_registers),
+                1e3 * m.seconds_per_mpath,
+                m.seconds_per_mpath / best
+            ));
+        }
+        out
+    }
+}
+
+fn registers(cap: Option<u32>) -> String {
+    cap.map_or_else(
+        || "compiler's registers".to_owned(),
+        |n| format!("<= {n} registers"),
+    )
+}
+
+/// Times every candidate on `scene` and returns the fastest.
+pub fn calibrate<S: SceneAbi>(
+    renderer: &CudaRenderer,
+    scene: &S,
+    options: &RenderOptions,
+) -> Result<Choice> {
+    let (width, height) = (scene.camera().width, scene.camera().height);
+    let pixels = width as u64 * height as u64;
+    let spp = CALIBRATION_PATHS.div_ceil(pixels.max(1)).clamp(1, 64) as u32;
+    let mut measurements = Vec::new();
+    for &strategy in Strategy::ALL {
+        if strategy == Strategy::NaiveSk {
+            continue;
+        }
+        for max_registers in CAPS {
+            let schedule = Schedule {
+                strategy,
+                max_registers,
+            };
+            let mut best = Duration::MAX;
+            for _ in 0..TRIALS {
+                let mut film = Film::new(width, height);
+                let stats = renderer.render_samples(
+                    scene,
+                    schedule,
+                    &mut film,
+                    0..spp,
+                    options,
+                    &|_, _| {},
+                )?;
+                best = best.min(stats.elapsed);
+            }
+            measurements.push(Measurement {
+                strategy: strategy.name().to_owned(),
+                max_registers,
+                seconds_per_mpath: best.as_secs_f64() / (pixels * spp as u64) as f64 * 1e6,
+            });
+        }
+    }
+    let fastest = measurements
+        .iter()
+        .min_by(|a, b| a.seconds_per_mpath.total_cmp(&b.seconds_per_mpath))
+        .expect("at least one candidate");
+    Ok(Choice {
+        strategy: fastest.strategy.clone(),
+        max_registers: fastest.max_registers,
+        measurements,
+    })
+}
+
+/// Choices by key (scene fingerprint, GPU and math), kept in memory and in a JSON file.
+pub struct AutoCache {
+    path: Option<PathBuf>,
+    entries: Mutex<BTreeMap<String, Choice>>,
+}
+
+impl AutoCache {
+    /// The user's cache file, read if it exists; an unreadable cache is ignored with a warning
+    /// (it only saves calibration time).
+    pub fn open() -> Self {
+        Self::at(cache_dir().map(|d| d.join("auto.json")))
+    }
+
+    /// The cache in file `path` (none: in memory only).
+    fn at(path: Option<PathBuf>) -> Self {
+        let entries = path
+            .as_ref()
+            .filter(|p| p.exists())
+            .and_then(|p| match std::fs::read(p) {
+                Ok(bytes) => serde_json::from_slice(&bytes)
+                    .map_err(|e| tracing::warn!("ignoring the auto cache {}: {e}", p.display()))
+                    .ok(),
+                Err(e) => {
+                    tracing::warn!("ignoring the auto cache {}: {e}", p.display());
+                    None
+                }
+            })
+            .unwrap_or_default();
+        Self {
+            path,
+            entries: Mutex::new(entries),
+        }
+    }
+
+    pub fn get(&self, key: &str) -> Option<Choice> {
+        self.lock().get(key).cloned()
+    }
+
+    /// Records `choice` and writes the cache file (a failure to write only warns).
+    pub fn insert(&self, key: String, choice: Choice) {
+        let mut entries = self.lock();
+        entries.insert(key, choice);
+        let Some(path) = &self.path else { return };
+        let written = path
+            .parent()
+            .map_or(Ok(()), std::fs::create_dir_all)
+            .and_then(|()| {
+                let json = serde_json::to_vec_pretty(&*entries).map_err(std::io::Error::other)?;
+                // Written beside and renamed, so that a concurrent reader never sees half a file.
+                let tmp = path.with_extension(format!("json.{}", std::process::id()));
+                std::fs::write(&tmp, json)?;
+                std::fs::rename(&tmp, path)
+            });
+        if let Err(e) = written {
+            tracing::warn!("could not write the auto cache {}: {e}", path.display());
+        }
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, BTreeMap<String, Choice>> {
+        self.entries.lock().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+fn cache_dir() -> Option<PathBuf> {
+    if let Some(dir) = std::env::var_os("VOLPT_CACHE_DIR") {
+        return Some(dir.into());
+    }
+    std::env::var_os("XDG_CACHE_HOME")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))
+        .map(|d| d.join("volpt"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn choice() -> Choice {
+        Choice {
+            strategy: "regeneration-sk".to_owned(),
+            max_registers: Some(96),
+            measurements: vec![
+                Measurement {
+                    strategy: "regeneration-sk".to_owned(),
+                    max_registers: Some(96),
+                    seconds_per_mpath: 0.001,
+                },
+                Measurement {
+                    strategy: "streaming-sk".to_owned(),
+                    max_registers: None,
+                    seconds_per_mpath: 0.003,
+                },
+            ],
+        }
+    }
+
+    #[test]
+    fn a_choice_names_a_schedule_and_reports_its_measurements() {
+        let c = choice();
+        assert_eq!(
+            c.schedule(),
+            Some(Schedule {
+                strategy: Strategy::RegenerationSk,
+                max_registers: Some(96)
+            })
+        );
+        let report = c.report();
+        assert!(
+            report.contains("auto: regeneration-sk with <= 96 registers"),
+            "{report}"
+        );
+        assert!(report.contains("3.00x"), "{report}");
+        let unknown = Choice {
+            strategy: "warp-drive".to_owned(),
+            ..c
+        };
+        assert_eq!(unknown.schedule(), None);
+    }
+
+    #[test]
+    fn the_cache_survives_a_restart_and_ignores_a_broken_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("auto.json");
+        let cache = AutoCache::at(Some(path.clone()));
+        cache.insert("gpu|exact|1234".to_owned(), choice());
+        let again: BTreeMap<String, Choice> =
+            serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+        assert_eq!(again.get("gpu|exact|1234"), Some(&choice()));
+        assert_eq!(
+            AutoCache::at(Some(path.clone())).get("gpu|exact|1234"),
+            Some(choice())
+        );
+        std::fs::write(&path, b"{ not json").unwrap();
+        assert_eq!(AutoCache::at(Some(path)).get("gpu|exact|1234"), None);
+    }
+}

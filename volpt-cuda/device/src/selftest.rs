@@ -1,0 +1,103 @@
+//! Kernels that test the strategies' collective building blocks against plain CPU code
+//! (`volpt selftest --backend cuda`, `volpt_cuda::selftest`): the block-wide exclusive count of
+//! streaming's compaction, and the warp and block index takers of regeneration. Each thread reads
+//! its input, runs the building block, and writes what it got.
+
+/// The selftest kernels' entry points, as [`export_selftests!`](crate::export_selftests) exports
+/// them.
+pub const ENTRIES: [&str; 3] = [
+    "selftest__block_exclusive_count",
+    "selftest__warp_take_indices",
+    "selftest__block_take_indices",
+];
+
+/// Exports the selftest kernels (the workspace's kernels crate invokes it once).
+#[macro_export]
+macro_rules! export_selftests {
+    () => {
+        const _: () = {
+            /// # Safety
+            /// As [`volpt_device::selftest::block_exclusive_count`].
+            #[export_name = "selftest__block_exclusive_count"]
+            pub unsafe extern "ptx-kernel" fn block_exclusive_count(
+                preds: *const u32,
+                out: *mut u32,
+            ) {
+                // SAFETY: forwarded.
+                unsafe { $crate::selftest::block_exclusive_count(preds, out) }
+            }
+            /// # Safety
+            /// As [`volpt_device::selftest::warp_take_indices`].
+            #[export_name = "selftest__warp_take_indices"]
+            pub unsafe extern "ptx-kernel" fn warp_take_indices(
+                needs: *const u32,
+                next: *mut u64,
+                out: *mut u64,
+            ) {
+                // SAFETY: forwarded.
+                unsafe { $crate::selftest::take_indices(needs, next, out, false) }
+            }
+            /// # Safety
+            /// As [`volpt_device::selftest::warp_take_indices`].
+            #[export_name = "selftest__block_take_indices"]
+            pub unsafe extern "ptx-kernel" fn block_take_indices(
+                needs: *const u32,
+                next: *mut u64,
+                out: *mut u64,
+            ) {
+                // SAFETY: forwarded.
+                unsafe { $crate::selftest::take_indices(needs, next, out, true) }
+            }
+        };
+    };
+}
+
+/// Thread `i` writes `block_exclusive_count(preds[i] != 0)` as `out[2i], out[2i + 1]`.
+///
+/// # Safety
+/// `preds` and `out` must hold one and two `u32` per thread of the launch, whose blocks are
+/// `BLOCK_SIZE` threads.
+#[cfg(target_arch = "nvptx64")]
+#[inline(always)]
+pub unsafe fn block_exclusive_count(preds: *const u32, out: *mut u32) {
+    use crate::nvptx::{block_exclusive_count, global_thread_index, opaque};
+    let i = global_thread_index() as usize;
+    // SAFETY: the caller's contract.
+    let pred = unsafe { *preds.add(i) } != 0;
+    let (rank, total) = block_exclusive_count(opaque(pred));
+    // SAFETY: the caller's contract.
+    unsafe {
+        *out.add(2 * i) = rank;
+        *out.add(2 * i + 1) = total;
+    }
+}
+
+/// Thread `i` with `needs[i] != 0` takes an index from `*next` (with the warp's index taker, or
+/// the block's if `block`) and writes it to `out[i]`; the others write `u64::MAX`.
+///
+/// # Safety
+/// `needs` and `out` must hold one value per thread of the launch, whose blocks are `BLOCK_SIZE`
+/// threads, and `next` one `u64`.
+#[cfg(target_arch = "nvptx64")]
+#[inline(always)]
+pub unsafe fn take_indices(needs: *const u32, next: *mut u64, out: *mut u64, block: bool) {
+    use crate::nvptx::{global_thread_index, opaque};
+    use crate::strategy::{block_take_indices, warp_take_indices};
+    let i = global_thread_index() as usize;
+    // SAFETY: the caller's contract.
+    let need = opaque(unsafe { *needs.add(i) } != 0);
+    // SAFETY: the caller's contract.
+    let taken = unsafe {
+        if block {
+            block_take_indices(need, next)
+        } else {
+            warp_take_indices(need, next)
+        }
+    };
+    let index = match taken {
+        Some(index) if need => index,
+        _ => u64::MAX,
+    };
+    // SAFETY: the caller's contract.
+    unsafe { *out.add(i) = index };
+}

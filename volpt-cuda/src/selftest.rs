@@ -1,0 +1,213 @@
+//! The strategies' collective building blocks on the GPU against plain CPU implementations, on
+//! random inputs with the corner cases (every, no, one and only the last thread of a block
+//! active): the block-wide exclusive count of streaming's compaction and the warp and block index
+//! takers of regeneration (`volpt_device::selftest`).
+
+use cudarc::driver::{CudaSlice, LaunchConfig, PushKernelArg};
+use volpt_device::launch::BLOCK_SIZE;
+
+use crate::error::{CudaError, Doing};
+use crate::CudaRenderer;
+
+/// Blocks per test launch.
+const BLOCKS: usize = 96;
+
+/// One building block's result: how many inputs, and what differed from the CPU.
+#[derive(Debug)]
+pub struct SelfTest {
+    pub name: &'static str,
+    pub threads: usize,
+    pub failures: Vec<String>,
+}
+
+/// One flag per thread: block `b` is all set, none, one at random, only the last thread, or random
+/// at a density that varies with `b`.
+pub fn patterns(seed: u64) -> Vec<bool> {
+    let mut state = seed;
+    let mut next = move || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 33) as u32
+    };
+    let n = BLOCK_SIZE as usize;
+    let mut flags = Vec::with_capacity(BLOCKS * n);
+    for b in 0..BLOCKS {
+        let one = next() as usize % n;
+        let density = (b % 7) as u32;
+        flags.extend((0..n).map(|t| match b % 8 {
+            0 => true,
+            1 => false,
+            2 => t == one,
+            3 => t == n - 1,
+            _ => next() % 7 < density,
+        }));
+    }
+    flags
+}
+
+/// What the block-wide exclusive count must give thread `i`: the set flags before it in its block,
+/// and the block's total.
+pub fn expected_counts(flags: &[bool]) -> Vec<(u32, u32)> {
+    flags
+        .chunks(BLOCK_SIZE as usize)
+        .flat_map(|block| {
+            let total = block.iter().filter(|&&f| f).count() as u32;
+            let mut before = 0;
+            block.iter().map(move |&f| {
+                let r = (before, total);
+                before += f as u32;
+                r
+            })
+        })
+        .collect()
+}
+
+/// Whether `taken` (an index per flagged thread, `u64::MAX` elsewhere) is what an index taker
+/// over groups of `group` threads must hand out: within a group, consecutive indices in thread
+/// order; over all groups, each of `0..flagged` exactly once.
+pub fn check_taken(flags: &[bool], taken: &[u64], group: usize) -> Vec<String> {
+    let mut failures = Vec::new();
+    let mut seen = vec![false; flags.iter().filter(|&&f| f).count()];
+    for (g, (fs, ts)) in flags.chunks(group).zip(taken.chunks(group)).enumerate() {
+        let mut expect = None;
+        for (t, (&f, &index)) in fs.iter().zip(ts).enumerate() {
+            if !f {
+                if index != u64::MAX {
+                    failures.push(format!("group {g} thread {t}: took {index} without need"));
+                }
+                continue;
+            }
+            if let Some(e) = expect {
+                if index != e {
+                    failures.push(format!("group {g} thread {t}: took {index}, expected {e}"));
+                }
+            }
+            expect = Some(index.wrapping_add(1));
+            match seen.get_mut(index as usize) {
+                Some(s) if !*s => *s = true,
+                Some(_) => failures.push(format!("index {index} taken twice")),
+                None => failures.push(format!("group {g} thread {t}: index {index} out of range")),
+            }
+        }
+    }
+    failures
+}
+
+impl CudaRenderer {
+    /// Runs every building block on the GPU and compares with the CPU.
+    pub fn selftest(&self) -> Result<Vec<SelfTest>, CudaError> {
+        let stream = self.stream();
+        let threads = BLOCKS * BLOCK_SIZE as usize;
+        let config = LaunchConfig {
+            grid_dim: (BLOCKS as u32, 1, 1),
+            block_dim: (BLOCK_SIZE, 1, 1),
+            shared_mem_bytes: 0,
+        };
+        let mut results = Vec::new();
+        for seed in 1..=4u64 {
+            let flags = patterns(seed);
+            let input: Vec<u32> = flags.iter().map(|&f| f as u32).collect();
+            let input = stream.clone_htod(&input).doing("copying test input")?;
+
+            let kernel = self.kernel("selftest__block_exclusive_count", None)?;
+            let mut out: CudaSlice<u32> = stream
+                .alloc_zeros(2 * threads)
+                .doing("allocating test output")?;
+            // SAFETY: one flag and two outputs per thread of the launch.
+            unsafe {
+                stream
+                    .launch_builder(&kernel)
+                    .arg(&input)
+                    .arg(&mut out)
+                    .launch(config)
+            }
+            .doing("launching a selftest")?;
+            let got = stream.clone_dtoh(&out).doing("reading test output")?;
+            let failures = got
+                .chunks(2)
+                .zip(expected_counts(&flags))
+                .enumerate()
+                .filter(|(_, (g, e))| (g[0], g[1]) != *e)
+                .map(|(i, (g, e))| format!("thread {i}: ({}, {}), expected {e:?}", g[0], g[1]))
+                .collect();
+            results.push(SelfTest {
+                name: "block exclusive count",
+                threads,
+                failures,
+            });
+
+            for (name, entry, group) in [
+                ("warp index taker", "selftest__warp_take_indices", 32),
+                (
+                    "block index taker",
+                    "selftest__block_take_indices",
+                    BLOCK_SIZE as usize,
+                ),
+            ] {
+                let kernel = self.kernel(entry, None)?;
+                let mut next: CudaSlice<u64> =
+                    stream.alloc_zeros(1).doing("allocating a counter")?;
+                let mut out: CudaSlice<u64> = stream
+                    .alloc_zeros(threads)
+                    .doing("allocating test output")?;
+                // SAFETY: one flag and one output per thread of the launch, one counter.
+                unsafe {
+                    stream
+                        .launch_builder(&kernel)
+                        .arg(&input)
+                        .arg(&mut next)
+                        .arg(&mut out)
+                        .launch(config)
+                }
+                .doing("launching a selftest")?;
+                let taken = stream.clone_dtoh(&out).doing("reading test output")?;
+                let counter = stream.clone_dtoh(&next).doing("reading the counter")?;
+                let mut failures = check_taken(&flags, &taken, group);
+                let flagged = flags.iter().filter(|&&f| f).count() as u64;
+                if counter[0] != flagged {
+                    failures.push(format!("counter {}, expected {flagged}", counter[0]));
+                }
+                results.push(SelfTest {
+                    name,
+                    threads,
+                    failures,
+                });
+            }
+        }
+        Ok(results)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_patterns_hold_the_corner_cases() {
+        let flags = patterns(1);
+        let n = BLOCK_SIZE as usize;
+        let count = |b: usize| flags[b * n..(b + 1) * n].iter().filter(|&&f| f).count();
+        assert_eq!((count(0), count(1), count(2), count(3)), (n, 0, 1, 1));
+        assert!(flags[4 * n - 1]);
+    }
+
+    #[test]
+    fn the_reference_count_is_an_exclusive_scan_per_block() {
+        let flags = [true, false, true, true].repeat(BLOCK_SIZE as usize / 4);
+        let counts = expected_counts(&flags);
+        assert_eq!(&counts[..5], &[(0, 96), (1, 96), (1, 96), (2, 96), (3, 96)]);
+    }
+
+    #[test]
+    fn the_taken_check_catches_gaps_repeats_and_order() {
+        let flags = [true, false, true, true];
+        assert!(check_taken(&flags, &[0, u64::MAX, 1, 2], 4).is_empty());
+        // Another group order is fine: the second group took first.
+        assert!(check_taken(&flags, &[2, u64::MAX, 0, 1], 2).is_empty());
+        assert!(!check_taken(&flags, &[0, u64::MAX, 2, 1], 4).is_empty());
+        assert!(!check_taken(&flags, &[0, u64::MAX, 1, 1], 4).is_empty());
+        assert!(!check_taken(&flags, &[0, 3, 1, 2], 4).is_empty());
+        assert!(!check_taken(&flags, &[0, u64::MAX, 1, 7], 4).is_empty());
+    }
+}
