@@ -1,0 +1,363 @@
+//! Safe owners of the CUDA driver's host-side memory kinds. Each checks every `CUresult`, frees
+//! what it allocated exactly once (on drop, with its context current), and hands out the address
+//! a kernel reads the values at.
+//!
+//! Drop never panics: a failure to free is logged (the process goes on; at worst it keeps the
+//! memory).
+
+use std::marker::PhantomData;
+use std::ptr::NonNull;
+use std::sync::Arc;
+
+use cudarc::driver::{sys, CudaContext, DriverError};
+
+use crate::error::ZeroCopyError;
+
+/// `CU_DEVICE_CPU` of `cuda.h` (not in cudarc's bindings): the host, as a `cuMemAdvise` target.
+const CU_DEVICE_CPU: sys::CUdevice = -1;
+
+fn bytes_of(len: usize) -> u64 {
+    len as u64 * std::mem::size_of::<f32>() as u64
+}
+
+/// Page-locked host memory mapped into the device's address space (`cuMemHostAlloc` with
+/// `CU_MEMHOSTALLOC_DEVICEMAP`): the CPU writes it as a slice, kernels read it at
+/// [`PinnedBuffer::device_address`] across the bus, without a copy.
+pub struct PinnedBuffer {
+    host: NonNull<f32>,
+    len: usize,
+    device: u64,
+    ctx: Arc<CudaContext>,
+}
+
+// SAFETY: the buffer owns its memory exclusively, like a `Box<[f32]>`; the driver calls on it are
+// thread-safe given a current context, which every method makes current first.
+unsafe impl Send for PinnedBuffer {}
+// SAFETY: shared access only reads.
+unsafe impl Sync for PinnedBuffer {}
+
+impl PinnedBuffer {
+    /// `len` zeroed `f32`s of page-locked, device-mapped host memory in `ctx`.
+    pub fn zeroed(ctx: &Arc<CudaContext>, len: usize) -> Result<Self, ZeroCopyError> {
+        let bytes = bytes_of(len);
+        let driver = |doing| {
+            move |source| ZeroCopyError::Driver {
+                doing,
+                bytes,
+                source,
+            }
+        };
+        ctx.bind_to_thread()
+            .map_err(driver("making the GPU's context current"))?;
+        // A zero-byte request is an error for the driver: allocate one value at least.
+        let size = len.max(1) * std::mem::size_of::<f32>();
+        let mut host: *mut std::ffi::c_void = std::ptr::null_mut();
+        let flags = sys::CU_MEMHOSTALLOC_DEVICEMAP | sys::CU_MEMHOSTALLOC_PORTABLE;
+        // SAFETY: `host` is a valid out-pointer; the driver writes it only on success.
+        unsafe { sys::cuMemHostAlloc(&mut host, size, flags) }
+            .result()
+            .map_err(|source| ZeroCopyError::OutOfPinnedMemory { bytes, source })?;
+        let Some(host) = NonNull::new(host.cast::<f32>()) else {
+            return Err(ZeroCopyError::Driver {
+                doing: "allocating pinned host memory (the driver returned null)",
+                bytes,
+                source: DriverError(sys::CUresult::CUDA_ERROR_UNKNOWN),
+            });
+        };
+        // From here on `Drop` frees the allocation, also on the error paths below.
+        let mut buffer = Self {
+            host,
+            len,
+            device: 0,
+            ctx: ctx.clone(),
+        };
+        let mut device: sys::CUdeviceptr = 0;
+        // SAFETY: `host` was returned by `cuMemHostAlloc` with DEVICEMAP in this context.
+        unsafe { sys::cuMemHostGetDevicePointer_v2(&mut device, host.as_ptr().cast(), 0) }
+            .result()
+            .map_err(driver("mapping pinned host memory into the GPU"))?;
+        buffer.device = device;
+        // SAFETY: `size` bytes at `host` are ours; zero is a valid `f32`.
+        unsafe { std::ptr::write_bytes(host.as_ptr().cast::<u8>(), 0, size) };
+        Ok(buffer)
+    }
+
+    pub fn as_slice(&self) -> &[f32] {
+        // SAFETY: `len` initialised (zeroed, then written as `f32`) values, owned by `self`.
+        unsafe { std::slice::from_raw_parts(self.host.as_ptr(), self.len) }
+    }
+
+    pub fn as_mut_slice(&mut self) -> &mut [f32] {
+        // SAFETY: as `as_slice`, and `&mut self` is exclusive.
+        unsafe { std::slice::from_raw_parts_mut(self.host.as_ptr(), self.len) }
+    }
+
+    /// Where kernels read the values.
+    pub fn device_address(&self) -> u64 {
+        self.device
+    }
+
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+}
+
+impl Drop for PinnedBuffer {
+    fn drop(&mut self) {
+        if let Err(e) = self.ctx.bind_to_thread() {
+            tracing::error!(%e, "cannot make the GPU's context current to free pinned memory");
+            return;
+        }
+        // SAFETY: allocated by `cuMemHostAlloc`, freed once, no slice of it outlives `self`.
+        if let Err(e) = unsafe { sys::cuMemFreeHost(self.host.as_ptr().cast()) }.result() {
+            tracing::error!(%e, bytes = bytes_of(self.len), "cuMemFreeHost failed");
+        }
+    }
+}
+
+/// A caller's host memory page-locked and mapped into the device in place (`cuMemHostRegister`
+/// with `CU_MEMHOSTREGISTER_DEVICEMAP`): a loaded volume becomes readable by kernels without a
+/// second copy. Unregistered on drop; the values must not move or be freed before that, which the
+/// borrow `'a` guarantees.
+pub struct HostRegistration<'a> {
+    host: NonNull<f32>,
+    len: usize,
+    device: u64,
+    ctx: Arc<CudaContext>,
+    _values: PhantomData<&'a [f32]>,
+}
+
+// SAFETY: it only refers to memory it borrows immutably for `'a`.
+unsafe impl Send for HostRegistration<'_> {}
+// SAFETY: as above.
+unsafe impl Sync for HostRegistration<'_> {}
+
+impl<'a> HostRegistration<'a> {
+    /// Page-locks and maps `values`. Fails with `CUDA_ERROR_HOST_MEMORY_ALREADY_REGISTERED` when
+    /// a page of `values` is registered already (small allocations can share a page), which
+    /// [`HostRegistration::already_registered`] recognises.
+    pub fn new(ctx: &Arc<CudaContext>, values: &'a [f32]) -> Result<Self, ZeroCopyError> {
+        let bytes = bytes_of(values.len());
+        let driver = |doing| {
+            move |source| ZeroCopyError::Driver {
+                doing,
+                bytes,
+                source,
+            }
+        };
+        if values.is_empty() {
+            return Err(ZeroCopyError::Driver {
+                doing: "page-locking an empty volume",
+                bytes,
+                source: DriverError(sys::CUresult::CUDA_ERROR_INVALID_VALUE),
+            });
+        }
+        ctx.bind_to_thread()
+            .map_err(driver("making the GPU's context current"))?;
+        let host = NonNull::from(values).cast::<f32>();
+        let flags = sys::CU_MEMHOSTREGISTER_DEVICEMAP | sys::CU_MEMHOSTREGISTER_PORTABLE;
+        // SAFETY: `values` is live host memory of `bytes` bytes for `'a`; registration only
+        // page-locks it. The driver rounds the range out to whole pages.
+        unsafe {
+            sys::cuMemHostRegister_v2(host.as_ptr().cast(), std::mem::size_of_val(values), flags)
+        }
+        .result()
+        .map_err(|source| match source.0 {
+            sys::CUresult::CUDA_ERROR_OUT_OF_MEMORY => {
+                ZeroCopyError::OutOfPinnedMemory { bytes, source }
+            }
+            _ => driver("page-locking a volume in host memory")(source),
+        })?;
+        let mut registration = Self {
+            host,
+            len: values.len(),
+            device: 0,
+            ctx: ctx.clone(),
+            _values: PhantomData,
+        };
+        let mut device: sys::CUdeviceptr = 0;
+        // SAFETY: `host` is the start of a range registered with DEVICEMAP in this context.
+        unsafe { sys::cuMemHostGetDevicePointer_v2(&mut device, host.as_ptr().cast(), 0) }
+            .result()
+            .map_err(driver("mapping a page-locked volume into the GPU"))?;
+        registration.device = device;
+        Ok(registration)
+    }
+
+    /// Whether `error` (from [`HostRegistration::new`]) says the memory was registered already.
+    pub fn already_registered(error: &ZeroCopyError) -> bool {
+        matches!(
+            error,
+            ZeroCopyError::Driver { source, .. }
+                if source.0 == sys::CUresult::CUDA_ERROR_HOST_MEMORY_ALREADY_REGISTERED
+        )
+    }
+
+    /// Where kernels read the values.
+    pub fn device_address(&self) -> u64 {
+        self.device
+    }
+
+    /// The registration with its borrow forgotten.
+    ///
+    /// # Safety
+    /// The registered values must stay live and unmoved until the result is dropped.
+    pub unsafe fn into_static(self) -> HostRegistration<'static> {
+        let this = std::mem::ManuallyDrop::new(self);
+        HostRegistration {
+            host: this.host,
+            len: this.len,
+            device: this.device,
+            // SAFETY: read once from a value that is never dropped.
+            ctx: unsafe { std::ptr::read(&this.ctx) },
+            _values: PhantomData,
+        }
+    }
+}
+
+impl Drop for HostRegistration<'_> {
+    fn drop(&mut self) {
+        if let Err(e) = self.ctx.bind_to_thread() {
+            tracing::error!(%e, "cannot make the GPU's context current to unregister a volume");
+            return;
+        }
+        // SAFETY: registered by `new` at this address, unregistered once.
+        if let Err(e) = unsafe { sys::cuMemHostUnregister(self.host.as_ptr().cast()) }.result() {
+            tracing::error!(%e, bytes = bytes_of(self.len), "cuMemHostUnregister failed");
+        }
+    }
+}
+
+/// Managed memory (`cuMemAllocManaged`): one address for the CPU and the device; the driver
+/// migrates or maps pages as the advice says ([`ManagedBuffer::place`]).
+pub struct ManagedBuffer {
+    address: sys::CUdeviceptr,
+    len: usize,
+    ctx: Arc<CudaContext>,
+}
+
+// SAFETY: owns its memory exclusively, like a `Box<[f32]>`.
+unsafe impl Send for ManagedBuffer {}
+// SAFETY: shared access only reads.
+unsafe impl Sync for ManagedBuffer {}
+
+impl ManagedBuffer {
+    /// `len` zeroed `f32`s of managed memory, attached globally (any stream may read it).
+    pub fn zeroed(ctx: &Arc<CudaContext>, len: usize) -> Result<Self, ZeroCopyError> {
+        let bytes = bytes_of(len);
+        ctx.bind_to_thread()
+            .map_err(|source| ZeroCopyError::Driver {
+                doing: "making the GPU's context current",
+                bytes,
+                source,
+            })?;
+        let size = len.max(1) * std::mem::size_of::<f32>();
+        let mut address: sys::CUdeviceptr = 0;
+        // SAFETY: `address` is a valid out-pointer.
+        unsafe {
+            sys::cuMemAllocManaged(
+                &mut address,
+                size,
+                sys::CUmemAttach_flags::CU_MEM_ATTACH_GLOBAL as u32,
+            )
+        }
+        .result()
+        .map_err(|source| ZeroCopyError::OutOfManagedMemory { bytes, source })?;
+        let buffer = Self {
+            address,
+            len,
+            ctx: ctx.clone(),
+        };
+        // SAFETY: `size` bytes of managed memory, host-accessible; no kernel runs on it yet.
+        unsafe { std::ptr::write_bytes(address as *mut u8, 0, size) };
+        Ok(buffer)
+    }
+
+    pub fn as_mut_slice(&mut self) -> &mut [f32] {
+        // SAFETY: `len` initialised values, host-accessible, exclusive through `&mut self`; no
+        // kernel reads them while the CPU holds this borrow (kernels run after `place`).
+        unsafe { std::slice::from_raw_parts_mut(self.address as *mut f32, self.len) }
+    }
+
+    /// Where kernels (and the CPU) read the values.
+    pub fn device_address(&self) -> u64 {
+        self.address
+    }
+
+    /// Advises the driver where the values live: the first `device_bytes` (a multiple of
+    /// [`crate::policy::MANAGED_GRANULE`], at most the buffer) preferred on `device` and
+    /// prefetched there on `stream`, the rest preferred in host memory and mapped for `device`,
+    /// so that the device reads it remotely instead of migrating (and evicting) pages.
+    pub fn place(
+        &self,
+        device: sys::CUdevice,
+        device_bytes: u64,
+        stream: sys::CUstream,
+    ) -> Result<(), ZeroCopyError> {
+        let total = bytes_of(self.len);
+        let device_bytes = device_bytes.min(total);
+        let driver = |doing| {
+            move |source| ZeroCopyError::Driver {
+                doing,
+                bytes: total,
+                source,
+            }
+        };
+        self.ctx
+            .bind_to_thread()
+            .map_err(driver("making the GPU's context current"))?;
+        let advise = |offset: u64, count: u64, advice, target| {
+            if count == 0 {
+                return Ok(());
+            }
+            // SAFETY: `[offset, offset + count)` lies inside this allocation.
+            unsafe {
+                sys::cuMemAdvise(self.address + offset, count as usize, advice, target).result()
+            }
+        };
+        use sys::CUmem_advise::{
+            CU_MEM_ADVISE_SET_ACCESSED_BY, CU_MEM_ADVISE_SET_PREFERRED_LOCATION,
+        };
+        advise(
+            0,
+            device_bytes,
+            CU_MEM_ADVISE_SET_PREFERRED_LOCATION,
+            device,
+        )
+        .map_err(driver("advising managed memory to live on the GPU"))?;
+        let rest = total - device_bytes;
+        advise(
+            device_bytes,
+            rest,
+            CU_MEM_ADVISE_SET_PREFERRED_LOCATION,
+            CU_DEVICE_CPU,
+        )
+        .map_err(driver("advising managed memory to live in host memory"))?;
+        advise(device_bytes, rest, CU_MEM_ADVISE_SET_ACCESSED_BY, device)
+            .map_err(driver("mapping host-resident managed memory for the GPU"))?;
+        if device_bytes > 0 {
+            // SAFETY: the range lies inside this allocation; `stream` belongs to its context.
+            unsafe { sys::cuMemPrefetchAsync(self.address, device_bytes as usize, device, stream) }
+                .result()
+                .map_err(driver("prefetching managed memory to the GPU"))?;
+        }
+        Ok(())
+    }
+}
+
+impl Drop for ManagedBuffer {
+    fn drop(&mut self) {
+        if let Err(e) = self.ctx.bind_to_thread() {
+            tracing::error!(%e, "cannot make the GPU's context current to free managed memory");
+            return;
+        }
+        // SAFETY: allocated by `cuMemAllocManaged`, freed once, no slice of it outlives `self`.
+        if let Err(e) = unsafe { sys::cuMemFree_v2(self.address) }.result() {
+            tracing::error!(%e, bytes = bytes_of(self.len), "cuMemFree of managed memory failed");
+        }
+    }
+}
