@@ -14,6 +14,8 @@ use volpt_render::{
 };
 use volpt_scene::SceneDescription;
 
+use crate::volume::VolumeArgs;
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum BackendKind {
     /// Every CPU core, through rayon.
@@ -58,6 +60,17 @@ impl Backend {
                 renderer: CudaRenderer::new(0)?,
                 strategy: strategy.unwrap_or(Strategy::RegenerationSk),
             }),
+        }
+    }
+
+    /// Where the GPU reads the scene's grids from (`--volume-memory` and its companions).
+    pub fn place_volumes(&mut self, volumes: &VolumeArgs) -> Result<()> {
+        match self {
+            Backend::Cpu => volumes.check_cpu(),
+            Backend::Cuda { renderer, .. } => {
+                renderer.set_volume_policy(volumes.policy());
+                Ok(())
+            }
         }
     }
 

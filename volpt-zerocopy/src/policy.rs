@@ -40,6 +40,20 @@ impl VolumeMemory {
     }
 }
 
+impl std::str::FromStr for VolumeMemory {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| {
+                let names: Vec<_> = Self::ALL.iter().map(|m| m.name()).collect();
+                format!("expected one of {}, found {s:?}", names.join(", "))
+            })
+    }
+}
+
 impl std::fmt::Display for VolumeMemory {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())
@@ -241,6 +255,11 @@ mod tests {
     fn names_are_the_flags_values() {
         let names: Vec<_> = VolumeMemory::ALL.iter().map(|m| m.name()).collect();
         assert_eq!(names, ["device", "zerocopy", "managed", "auto"]);
+        for m in VolumeMemory::ALL {
+            assert_eq!(m.name().parse::<VolumeMemory>(), Ok(m));
+        }
+        let err = "pinned".parse::<VolumeMemory>().unwrap_err();
+        assert!(err.contains("device, zerocopy, managed, auto"), "{err}");
         assert_eq!(VolumePolicy::default().memory, VolumeMemory::Device);
     }
 }
