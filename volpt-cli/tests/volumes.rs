@@ -14,7 +14,15 @@ fn volume_flags_on_the_cpu_are_a_clear_error() {
         &["--device-memory-budget", "2GiB"],
         &["--bricked"],
     ] {
-        let mut args = vec!["render", "--spp", "1", "--resolution", "4x4", "-o", "/dev/null"];
+        let mut args = vec![
+            "render",
+            "--spp",
+            "1",
+            "--resolution",
+            "4x4",
+            "-o",
+            "/dev/null",
+        ];
         let scene = example_arg();
         args.push(&scene);
         args.extend(flags);
