@@ -17,7 +17,8 @@
 # Files under $OUT: summary.txt (everything, PASS/FAIL lines), throughput.txt (the ratio tables),
 # big.txt (the 8 GiB renders), device.txt, logs.tar.gz (every command's output), bench.tar.gz (JSON).
 # WORK (default ./ooc-work) holds the generated volumes (8.5 GiB) and images; deleted at the end
-# unless KEEP=1. QUICK=1 skips the 8 GiB volume; MID_RES=N makes the throughput volume N^3.
+# unless KEEP=1. QUICK=1 skips the 8 GiB volume; MID_RES=N makes the throughput volume N^3 and
+# BIG_DIMS="X Y Z" the large one X x Y x Z (both for trying the script out on a CPU stand-in).
 set -uo pipefail
 cd "$(dirname "$0")"
 OUT=${OUT:-$PWD/out-ooc}
@@ -64,24 +65,27 @@ run generate "$VOLPT" scene generate scenes || fail "volpt scene generate: $(tai
 # ---------------------------------------------------------------------------------------------
 # 1. Identical images.
 log "1. identical images (naive-sk, seed 7, 4 spp, 200x200)"
-# name:flags (an empty budget is the device's free memory)
+# name:flags. PARTIAL is a budget that prefetches part of the scene's grids: cgg-logo's density
+# (4 MB) whole and 2 MiB of its albedo (12 MB); bucky's grids (0.5 MB) are below the 2 MiB unit
+# of managed prefetch, so there it leaves everything in host memory.
 PLACEMENTS=(
     "zerocopy:--volume-memory zerocopy"
     "managed:--volume-memory managed"
-    "managed-partial:--volume-memory managed --device-memory-budget 6M"
-    "auto-over-budget:--volume-memory auto --device-memory-budget 1M"
+    "managed-partial:--volume-memory managed --device-memory-budget PARTIAL"
+    "auto-over-budget:--volume-memory auto --device-memory-budget 1K"
     "device-bricked:--volume-memory device --bricked"
     "zerocopy-bricked:--volume-memory zerocopy --bricked"
-    "managed-bricked-partial:--volume-memory managed --bricked --device-memory-budget 6M"
+    "managed-bricked-partial:--volume-memory managed --bricked --device-memory-budget PARTIAL"
 )
+# name:file:partial budget:parameters
 SCENES=(
-    "cgg-logo:scenes/cgg-logo/scene.xml:"
-    "bucky:scenes/bucky/scene.toml:-Ddata=$DATA"
+    "cgg-logo:scenes/cgg-logo/scene.xml:6M:"
+    "bucky:scenes/bucky/scene.toml:1K:-Ddata=$DATA"
 )
 COMMON=(--spp 4 --seed 7 --resolution 200x200)
 GPU=(--backend cuda --strategy naive-sk)
 for entry in "${SCENES[@]}"; do
-    IFS=: read -r scene file params <<<"$entry"
+    IFS=: read -r scene file partial params <<<"$entry"
     [ -f "$file" ] || { log "SKIP $scene: $file not in this bundle"; continue; }
     # shellcheck disable=SC2086
     run "$scene-cpu" "$VOLPT" render "$file" $params "${COMMON[@]}" -o "$WORK/$scene-cpu.exr" \
@@ -96,6 +100,7 @@ for entry in "${SCENES[@]}"; do
     else fail "$scene cpu vs device: $(tail_of "$scene-cpu-vs-device" 2)"; fi
     for p in "${PLACEMENTS[@]}"; do
         IFS=: read -r name flags <<<"$p"
+        flags=${flags//PARTIAL/$partial}
         # shellcheck disable=SC2086
         if run "$scene-$name" "$VOLPT" render "$file" $params "${COMMON[@]}" "${GPU[@]}" $flags \
             -o "$WORK/$scene-$name.exr"; then
@@ -168,10 +173,10 @@ g = 0.3
 bsdf = "null"
 
 [camera]
-origin = [2.2, 1.6, 3.4]
+origin = [1.5, 1.0, 2.3]
 target = [0.0, 0.0, 0.0]
 up = [0.0, 1.0, 0.0]
-fov = 38.0
+fov = 45.0
 
 [film]
 width = 256
@@ -194,11 +199,13 @@ if [ "${QUICK:-0}" = 1 ]; then
 else
     log "2. a generated 8 GiB volume (2048x1024x1024 f32) under --device-memory-budget 2G"
     BIG=$WORK/big.raw
-    if [ "$(stat -c %s "$BIG" 2>/dev/null)" != "$((2048 * 1024 * 1024 * 4))" ]; then
-        run generate-big python3 "$WORK/generate.py" "$BIG" 2048 1024 1024 || fail "generating the 8 GiB volume: $(tail_of generate-big)"
+    read -r bx by bz <<<"${BIG_DIMS:-2048 1024 1024}"
+    if [ "$(stat -c %s "$BIG" 2>/dev/null)" != "$((bx * by * bz * 4))" ]; then
+        run generate-big python3 "$WORK/generate.py" "$BIG" "$bx" "$by" "$bz" \
+            || fail "generating the 8 GiB volume: $(tail_of generate-big)"
     fi
     log "   $(tail -n 2 "$WORK/logs/generate-big.log" 2>/dev/null | head -n 1)"
-    scene_toml "$WORK/big.toml" "$BIG" 2048 1024 1024 60
+    scene_toml "$WORK/big.toml" "$BIG" "$bx" "$by" "$bz" 60
     BIGRUN=(--spp 4 --seed 7 --resolution 256x256 --backend cuda --strategy naive-sk --memory-limit 16G)
     : >"$OUT/big.txt"
     for p in "device:--volume-memory device" \
