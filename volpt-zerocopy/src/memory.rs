@@ -119,12 +119,33 @@ impl Drop for PinnedBuffer {
     }
 }
 
+/// The host's page size: registrations cover the whole pages that hold the values (page-locking
+/// works on pages, and older drivers refuse unaligned ranges); a larger alignment could reach into
+/// unmapped memory below an allocation.
+pub fn page_size() -> usize {
+    // SAFETY: sysconf only reads a system constant.
+    let size = unsafe { libc::sysconf(libc::_SC_PAGESIZE) };
+    usize::try_from(size)
+        .ok()
+        .filter(|s| s.is_power_of_two())
+        .unwrap_or(4096)
+}
+
+/// The page-aligned range `(start, bytes)` that [`HostRegistration`] registers for `bytes` bytes
+/// at `address`, with pages of `page` bytes (a power of two).
+pub fn register_range(address: usize, bytes: usize, page: usize) -> (usize, usize) {
+    let start = address & !(page - 1);
+    let end = (address + bytes).next_multiple_of(page);
+    (start, end - start)
+}
+
 /// A caller's host memory page-locked and mapped into the device in place (`cuMemHostRegister`
 /// with `CU_MEMHOSTREGISTER_DEVICEMAP`): a loaded volume becomes readable by kernels without a
 /// second copy. Unregistered on drop; the values must not move or be freed before that, which the
 /// borrow `'a` guarantees.
 pub struct HostRegistration<'a> {
-    host: NonNull<f32>,
+    /// The start of the registered (aligned) range.
+    base: NonNull<u8>,
     len: usize,
     device: u64,
     ctx: Arc<CudaContext>,
@@ -137,9 +158,9 @@ unsafe impl Send for HostRegistration<'_> {}
 unsafe impl Sync for HostRegistration<'_> {}
 
 impl<'a> HostRegistration<'a> {
-    /// Page-locks and maps `values`. Fails with `CUDA_ERROR_HOST_MEMORY_ALREADY_REGISTERED` when
-    /// a page of `values` is registered already (small allocations can share a page), which
-    /// [`HostRegistration::already_registered`] recognises.
+    /// Page-locks and maps `values` (the pages that hold them, [`register_range`]). Fails
+    /// with `CUDA_ERROR_HOST_MEMORY_ALREADY_REGISTERED` when a page is registered already (small
+    /// allocations can share one), which [`HostRegistration::already_registered`] recognises.
     pub fn new(ctx: &Arc<CudaContext>, values: &'a [f32]) -> Result<Self, ZeroCopyError> {
         let bytes = bytes_of(values.len());
         let driver = |doing| {
@@ -158,33 +179,37 @@ impl<'a> HostRegistration<'a> {
         }
         ctx.bind_to_thread()
             .map_err(driver("making the GPU's context current"))?;
-        let host = NonNull::from(values).cast::<f32>();
+        let address = values.as_ptr() as usize;
+        let (start, size) = register_range(address, std::mem::size_of_val(values), page_size());
+        let Some(base) = NonNull::new(start as *mut u8) else {
+            return Err(driver("page-locking a volume at the first page of memory")(
+                DriverError(sys::CUresult::CUDA_ERROR_INVALID_VALUE),
+            ));
+        };
         let flags = sys::CU_MEMHOSTREGISTER_DEVICEMAP | sys::CU_MEMHOSTREGISTER_PORTABLE;
-        // SAFETY: `values` is live host memory of `bytes` bytes for `'a`; registration only
-        // page-locks it. The driver rounds the range out to whole pages.
-        unsafe {
-            sys::cuMemHostRegister_v2(host.as_ptr().cast(), std::mem::size_of_val(values), flags)
-        }
-        .result()
-        .map_err(|source| match source.0 {
-            sys::CUresult::CUDA_ERROR_OUT_OF_MEMORY => {
-                ZeroCopyError::OutOfPinnedMemory { bytes, source }
-            }
-            _ => driver("page-locking a volume in host memory")(source),
-        })?;
+        // SAFETY: the range is exactly the pages that hold `values` (mapped whole), live for
+        // `'a`; registration only page-locks and maps them.
+        unsafe { sys::cuMemHostRegister_v2(base.as_ptr().cast(), size, flags) }
+            .result()
+            .map_err(|source| match source.0 {
+                sys::CUresult::CUDA_ERROR_OUT_OF_MEMORY => {
+                    ZeroCopyError::OutOfPinnedMemory { bytes, source }
+                }
+                _ => driver("page-locking a volume in host memory")(source),
+            })?;
         let mut registration = Self {
-            host,
+            base,
             len: values.len(),
             device: 0,
             ctx: ctx.clone(),
             _values: PhantomData,
         };
         let mut device: sys::CUdeviceptr = 0;
-        // SAFETY: `host` is the start of a range registered with DEVICEMAP in this context.
-        unsafe { sys::cuMemHostGetDevicePointer_v2(&mut device, host.as_ptr().cast(), 0) }
+        // SAFETY: `base` is the start of a range registered with DEVICEMAP in this context.
+        unsafe { sys::cuMemHostGetDevicePointer_v2(&mut device, base.as_ptr().cast(), 0) }
             .result()
             .map_err(driver("mapping a page-locked volume into the GPU"))?;
-        registration.device = device;
+        registration.device = device + (address - start) as u64;
         Ok(registration)
     }
 
@@ -209,7 +234,7 @@ impl<'a> HostRegistration<'a> {
     pub unsafe fn into_static(self) -> HostRegistration<'static> {
         let this = std::mem::ManuallyDrop::new(self);
         HostRegistration {
-            host: this.host,
+            base: this.base,
             len: this.len,
             device: this.device,
             // SAFETY: read once from a value that is never dropped.
@@ -226,7 +251,7 @@ impl Drop for HostRegistration<'_> {
             return;
         }
         // SAFETY: registered by `new` at this address, unregistered once.
-        if let Err(e) = unsafe { sys::cuMemHostUnregister(self.host.as_ptr().cast()) }.result() {
+        if let Err(e) = unsafe { sys::cuMemHostUnregister(self.base.as_ptr().cast()) }.result() {
             tracing::error!(%e, bytes = bytes_of(self.len), "cuMemHostUnregister failed");
         }
     }
@@ -359,5 +384,36 @@ impl Drop for ManagedBuffer {
         if let Err(e) = unsafe { sys::cuMemFree_v2(self.address) }.result() {
             tracing::error!(%e, bytes = bytes_of(self.len), "cuMemFree of managed memory failed");
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn registrations_cover_the_pages_that_hold_the_values() {
+        let a = 4096;
+        assert_eq!(register_range(a, a, a), (a, a));
+        assert_eq!(register_range(a + 16, 8, a), (a, a));
+        // A grid from malloc's mmap: 16 bytes into a page, 8 GiB long.
+        let (start, size) = register_range(7 * a + 16, 8 << 30, a);
+        assert_eq!((start, size), (7 * a, (8 << 30) + a));
+        for page in [4096, 16384, 65536] {
+            for (address, bytes) in [
+                (1, 1),
+                (page - 1, 2),
+                (3 * page + 5, 10 * page),
+                (12345, 678),
+            ] {
+                let (start, size) = register_range(address, bytes, page);
+                assert_eq!(start % page, 0);
+                assert_eq!(size % page, 0);
+                assert!(start <= address && address + bytes <= start + size);
+                // Never a page that holds no value.
+                assert!(address - start < page && start + size - (address + bytes) < page);
+            }
+        }
+        assert!(page_size().is_power_of_two() && page_size() >= 4096);
     }
 }

@@ -218,7 +218,10 @@ impl VolumePlacer {
                 }
                 // A small grid sharing a page with one registered before: copy it instead.
                 Err(e) if HostRegistration::already_registered(&e) => {}
-                Err(e) => return Err(e),
+                Err(e @ ZeroCopyError::OutOfPinnedMemory { .. }) => return Err(e),
+                // Registration is not supported everywhere (some virtualised or older systems):
+                // pinned memory of our own still maps the grid, at the cost of a copy.
+                Err(e) => tracing::warn!(%e, "cannot page-lock the volume in place: copying it"),
             }
         }
         let mut buffer = PinnedBuffer::zeroed(&self.ctx, grid.len)?;
