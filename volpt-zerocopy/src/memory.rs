@@ -9,7 +9,7 @@ use std::marker::PhantomData;
 use std::ptr::NonNull;
 use std::sync::Arc;
 
-use cudarc::driver::{sys, CudaContext, DriverError};
+use cudarc::driver::{sys, CudaContext, CudaStream, DriverError};
 
 use crate::error::ZeroCopyError;
 
@@ -314,15 +314,11 @@ impl ManagedBuffer {
     }
 
     /// Advises the driver where the values live: the first `device_bytes` (a multiple of
-    /// [`crate::policy::MANAGED_GRANULE`], at most the buffer) preferred on `device` and
-    /// prefetched there on `stream`, the rest preferred in host memory and mapped for `device`,
+    /// [`crate::policy::MANAGED_GRANULE`], at most the buffer) preferred on the buffer's device and
+    /// prefetched there on `stream`, the rest preferred in host memory and mapped for the device,
     /// so that the device reads it remotely instead of migrating (and evicting) pages.
-    pub fn place(
-        &self,
-        device: sys::CUdevice,
-        device_bytes: u64,
-        stream: sys::CUstream,
-    ) -> Result<(), ZeroCopyError> {
+    pub fn place(&self, device_bytes: u64, stream: &CudaStream) -> Result<(), ZeroCopyError> {
+        let device = self.ctx.cu_device();
         let total = bytes_of(self.len);
         let device_bytes = device_bytes.min(total);
         let driver = |doing| {
@@ -365,7 +361,8 @@ impl ManagedBuffer {
         advise(device_bytes, rest, CU_MEM_ADVISE_SET_ACCESSED_BY, device)
             .map_err(driver("mapping host-resident managed memory for the GPU"))?;
         if device_bytes > 0 {
-            // SAFETY: the range lies inside this allocation; `stream` belongs to its context.
+            let stream = stream.cu_stream();
+            // SAFETY: the range lies inside this allocation; `stream` is a live stream.
             unsafe { sys::cuMemPrefetchAsync(self.address, device_bytes as usize, device, stream) }
                 .result()
                 .map_err(driver("prefetching managed memory to the GPU"))?;

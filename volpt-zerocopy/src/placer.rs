@@ -153,7 +153,7 @@ impl VolumePlacer {
                     budget,
                 })
             }
-            Placement::Device => match self.to_device(&grid) {
+            Placement::Device => match self.copy_to_device(&grid) {
                 Ok(address) => {
                     self.used += bytes;
                     (address, PlacedIn::Device)
@@ -190,7 +190,7 @@ impl VolumePlacer {
         })
     }
 
-    fn to_device(&mut self, grid: &Grid<'_>) -> Result<u64, ZeroCopyError> {
+    fn copy_to_device(&mut self, grid: &Grid<'_>) -> Result<u64, ZeroCopyError> {
         let bytes = grid.len as u64 * 4;
         let copied = match grid.layout {
             GridLayout::Dense => self.stream.clone_htod(grid.values),
@@ -234,7 +234,7 @@ impl VolumePlacer {
     fn managed(&mut self, grid: &Grid<'_>, device_bytes: u64) -> Result<u64, ZeroCopyError> {
         let mut buffer = ManagedBuffer::zeroed(&self.ctx, grid.len)?;
         grid.write_into(buffer.as_mut_slice());
-        buffer.place(self.ctx.cu_device(), device_bytes, self.stream.cu_stream())?;
+        buffer.place(device_bytes, &self.stream)?;
         let address = buffer.device_address();
         self.held.push(Box::new(buffer));
         Ok(address)
