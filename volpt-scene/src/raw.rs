@@ -166,7 +166,7 @@ pub struct RawLayout {
 impl RawLayout {
     /// The number of values and of data bytes, checked against overflow and [`MAX_VALUES`];
     /// `path` names the file in the error.
-    pub(crate) fn checked_size(&self, path: &Path) -> Result<(usize, u64), SceneError> {
+    pub fn checked_size(&self, path: &Path) -> Result<(usize, u64), SceneError> {
         if self.resolution.contains(&0) || self.channels == 0 {
             let [x, y, z] = self.resolution;
             return Err(grid_error(

@@ -50,6 +50,8 @@ pub enum ZeroCopyError {
         crate::policy::human_bytes(*.bytes)
     )]
     OutOfHostMemory { bytes: u64 },
+    #[error(transparent)]
+    Load(#[from] volpt_scene::SceneError),
     #[error("CUDA driver call failed while {doing} ({} volume): {source}", crate::policy::human_bytes(*.bytes))]
     Driver {
         doing: &'static str,

@@ -5,8 +5,9 @@
 //! - [`layout`]: the host side of the bricked grid layout ([`volpt_core::GridLayout::Bricked`]):
 //!   dense samples rewritten brick by brick.
 //! - [`memory`]: safe owners of the CUDA driver's host memory kinds: page-locked, device-mapped host
-//!   memory ([`PinnedBuffer`], `cuMemHostAlloc`), a caller's own host memory page-locked and mapped
-//!   in place ([`HostRegistration`], `cuMemHostRegister`), and managed memory ([`ManagedBuffer`],
+//!   memory ([`PinnedBuffer`], `cuMemHostAlloc`; [`PinnedBuffer::read_raw`] streams a raw grid
+//!   file straight into it), a caller's own host memory page-locked and mapped in place
+//!   ([`HostRegistration`], `cuMemHostRegister`), and managed memory ([`ManagedBuffer`],
 //!   `cuMemAllocManaged` with advice and prefetch).
 //! - [`placer`]: the [`volpt_core::abi::Uploader`] the CUDA backend hands to a scene's `to_params`:
 //!   it places each grid as the policy decides and owns the memory for the render.

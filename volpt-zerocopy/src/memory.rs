@@ -82,6 +82,20 @@ impl PinnedBuffer {
         Ok(buffer)
     }
 
+    /// A raw grid file streamed straight into new pinned memory (`volpt_scene::read_raw_into`):
+    /// the file's values are never held anywhere else. Kernels read them at
+    /// [`PinnedBuffer::device_address`]; the CPU through [`PinnedBuffer::as_slice`].
+    pub fn read_raw(
+        ctx: &Arc<CudaContext>,
+        path: &std::path::Path,
+        layout: &volpt_scene::RawLayout,
+    ) -> Result<Self, ZeroCopyError> {
+        let (count, _) = layout.checked_size(path)?;
+        let mut buffer = Self::zeroed(ctx, count)?;
+        volpt_scene::read_raw_into(path, layout, buffer.as_mut_slice())?;
+        Ok(buffer)
+    }
+
     pub fn as_slice(&self) -> &[f32] {
         // SAFETY: `len` initialised (zeroed, then written as `f32`) values, owned by `self`.
         unsafe { std::slice::from_raw_parts(self.host.as_ptr(), self.len) }
