@@ -8,6 +8,8 @@
 
 use std::collections::BTreeSet;
 
+use volpt_core::abi::{PlacedGrid, Uploader};
+use volpt_core::GridLayout;
 use volpt_render::{render, with_scene, Image, RenderOptions, RenderScene, SceneVisitor, Variant};
 use volpt_scene::description::*;
 use volpt_tests::cube_scene;
@@ -102,15 +104,54 @@ fn descriptions() -> Vec<SceneDescription> {
     descs
 }
 
-/// Renders the scene, and the scene rebuilt from its launch parameters.
-struct RoundTrip;
+/// "Uploads" to the host itself: values stay where they are, grids in the bricked layout are
+/// rewritten into buffers it keeps, as the CUDA backend's placer does in pinned memory.
+struct HostUploader {
+    layout: GridLayout,
+    bricked: Vec<Vec<f32>>,
+}
+
+impl Uploader for HostUploader {
+    fn values(&mut self, values: &[f32]) -> u64 {
+        values.as_ptr() as u64
+    }
+
+    fn grid(&mut self, values: &[f32], res: [u32; 3], channels: u32) -> PlacedGrid {
+        if self.layout == GridLayout::Dense {
+            return PlacedGrid {
+                address: self.values(values),
+                len: values.len() as u64,
+                layout: GridLayout::Dense,
+            };
+        }
+        let bricked = volpt_zerocopy::layout::bricked(values, res, channels).expect("memory");
+        let placed = PlacedGrid {
+            address: bricked.as_ptr() as u64,
+            len: bricked.len() as u64,
+            layout: GridLayout::Bricked,
+        };
+        // The vector's heap buffer does not move when the vector does.
+        self.bricked.push(bricked);
+        placed
+    }
+}
+
+/// Renders the scene, and the scene rebuilt from its launch parameters with grids in `layout`.
+struct RoundTrip {
+    layout: GridLayout,
+}
 
 impl SceneVisitor for RoundTrip {
     type Output = (Image, Image);
 
     fn visit<S: RenderScene>(self, scene: &S) -> Self::Output {
-        let params = scene.to_params(&mut |values| values.as_ptr() as u64);
-        // SAFETY: every address is a slice of the description, alive for this whole visit.
+        let mut uploader = HostUploader {
+            layout: self.layout,
+            bricked: Vec::new(),
+        };
+        let params = scene.to_params(&mut uploader);
+        // SAFETY: every address is a slice of the description or of `uploader`, alive for this
+        // whole visit.
         let rebuilt = unsafe { S::from_params(&params) };
         let options = RenderOptions {
             spp: 4,
@@ -125,11 +166,23 @@ impl SceneVisitor for RoundTrip {
 
 #[test]
 fn every_variant_survives_the_device_abi_bit_for_bit() {
+    round_trips(GridLayout::Dense);
+}
+
+/// Grids rewritten in 8^3 bricks (padding included: the test grids are 4x3x2) are read by the
+/// device code exactly as the dense grids they came from.
+#[test]
+fn every_variant_with_bricked_grids_renders_bit_for_bit() {
+    round_trips(GridLayout::Bricked);
+}
+
+fn round_trips(layout: GridLayout) {
     let descs = descriptions();
     let variants: BTreeSet<String> = descs.iter().map(|d| Variant::of(d).to_string()).collect();
     assert_eq!(variants.len(), 36, "the descriptions cover every variant");
     for desc in &descs {
-        let (original, decoded) = with_scene(desc, volpt_render::path_settings(desc), RoundTrip);
+        let trip = RoundTrip { layout };
+        let (original, decoded) = with_scene(desc, volpt_render::path_settings(desc), trip);
         assert!(
             original.pixels.iter().flatten().any(|&v| v > 0.0),
             "{}: a black image proves nothing",

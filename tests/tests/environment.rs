@@ -295,7 +295,7 @@ fn launch_parameters_carry_the_map() {
         1.5,
     );
     let mut uploads = 0;
-    let params = env.to_params(&mut |values| {
+    let params = env.to_params(&mut |values: &[f32]| {
         uploads += 1;
         values.as_ptr() as u64
     });

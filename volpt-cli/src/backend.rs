@@ -16,6 +16,8 @@ use volpt_render::{
 };
 use volpt_scene::SceneDescription;
 
+use crate::volume::VolumeArgs;
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum BackendKind {
     /// Every CPU core, through rayon.
@@ -145,6 +147,17 @@ impl Backend {
                     math,
                     auto: AutoCache::open(),
                 })
+            }
+        }
+    }
+
+    /// Where the GPU reads the scene's grids from (`--volume-memory` and its companions).
+    pub fn place_volumes(&mut self, volumes: &VolumeArgs) -> Result<()> {
+        match self {
+            Backend::Cpu => volumes.check_cpu(),
+            Backend::Cuda { renderer, .. } => {
+                renderer.set_volume_policy(volumes.policy());
+                Ok(())
             }
         }
     }

@@ -293,7 +293,8 @@ fn render_once(
 pub fn run(args: &ConvergeArgs) -> Result<()> {
     let desc = load(&args.scene)?;
     let base = options(&desc, &args.sampling)?;
-    let backend = Backend::open(args.sampling.backend, args.sampling.gpu)?;
+    let mut backend = Backend::open(args.sampling.backend, args.sampling.gpu)?;
+    backend.place_volumes(&args.sampling.volumes)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let reference = reference(args, &desc, &backend, base)?;

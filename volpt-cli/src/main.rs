@@ -8,6 +8,7 @@ mod compare;
 mod converge;
 mod info;
 mod plot;
+mod volume;
 
 use std::path::{Path, PathBuf};
 
@@ -140,6 +141,8 @@ struct SamplingArgs {
     backend: BackendKind,
     #[command(flatten)]
     gpu: GpuArgs,
+    #[command(flatten)]
+    volumes: volume::VolumeArgs,
 }
 
 #[derive(Args)]
@@ -182,8 +185,10 @@ struct BenchArgs {
 /// The most `bench --trials`: more is a typo, not a benchmark.
 const MAX_TRIALS: i64 = 10_000;
 
-/// `1234`, `512K`, `64M`, `8G` (powers of 1024) as bytes.
+/// `1234`, `512K`, `64M`, `8G` (powers of 1024; `8GiB` too) as bytes.
 fn parse_bytes(s: &str) -> Result<u64, String> {
+    let original = s;
+    let s = s.strip_suffix("iB").unwrap_or(s);
     let (digits, unit) = match s.char_indices().last() {
         Some((i, c)) if c.is_ascii_alphabetic() => (&s[..i], c.to_ascii_uppercase()),
         _ => (s, 'B'),
@@ -196,7 +201,7 @@ fn parse_bytes(s: &str) -> Result<u64, String> {
         'T' => 40,
         _ => {
             return Err(format!(
-                "expected bytes with an optional K, M, G or T, found {s:?}"
+                "expected bytes with an optional K, M, G or T, found {original:?}"
             ))
         }
     };
@@ -205,7 +210,9 @@ fn parse_bytes(s: &str) -> Result<u64, String> {
         .ok()
         .and_then(|n| n.checked_mul(1 << shift))
         .filter(|&n| n > 0)
-        .ok_or_else(|| format!("expected a positive number of bytes such as 8G, found {s:?}"))
+        .ok_or_else(|| {
+            format!("expected a positive number of bytes such as 8G, found {original:?}")
+        })
 }
 
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
@@ -319,7 +326,8 @@ fn render_command(args: RenderArgs) -> Result<()> {
         effects: args.scene.effects(),
         show_progress: true,
     };
-    let backend = Backend::open(args.sampling.backend, args.sampling.gpu)?;
+    let mut backend = Backend::open(args.sampling.backend, args.sampling.gpu)?;
+    backend.place_volumes(&args.sampling.volumes)?;
     let variant = Parts::of(&desc, job.effects).variant();
     tracing::info!(
         scene = %args.scene.scene.display(),
@@ -442,7 +450,8 @@ fn bench_command(args: BenchArgs) -> Result<()> {
         effects: args.scene.effects(),
         show_progress: false,
     };
-    let backend = Backend::open(args.sampling.backend, args.sampling.gpu)?;
+    let mut backend = Backend::open(args.sampling.backend, args.sampling.gpu)?;
+    backend.place_volumes(&args.sampling.volumes)?;
     let mut trials = Vec::new();
     let mut last = None;
     for trial in 0..=args.trials {

@@ -18,14 +18,47 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::camera::PerspectiveCamera;
-use crate::grid::{Grid, GridMapping};
+use crate::grid::{Grid, GridLayout, GridMapping};
 use crate::path::PathSettings;
 use crate::scene::{Scene, VolumeScene};
 use crate::{Aabb, Vec2, Vec3};
 
-/// Copies grid or map values to device memory and returns their device address; the caller keeps
-/// that memory alive for as long as the parameters are used.
-pub type Upload<'u> = dyn FnMut(&[f32]) -> u64 + 'u;
+/// Places grid or map values in memory a device can read and returns their device address; the
+/// caller keeps that memory alive for as long as the parameters are used. Any
+/// `FnMut(&[f32]) -> u64` (a copy to device memory) is one.
+pub trait Uploader {
+    /// Places `values`, in their order, and returns their device address.
+    fn values(&mut self, values: &[f32]) -> u64;
+
+    /// Places the samples of a dense grid of `res` samples of `channels` channels, in a layout of
+    /// the uploader's choice (by default dense, through [`Uploader::values`]).
+    fn grid(&mut self, values: &[f32], res: [u32; 3], channels: u32) -> PlacedGrid {
+        let _ = (res, channels);
+        PlacedGrid {
+            address: self.values(values),
+            len: values.len() as u64,
+            layout: GridLayout::Dense,
+        }
+    }
+}
+
+impl<F: FnMut(&[f32]) -> u64> Uploader for F {
+    fn values(&mut self, values: &[f32]) -> u64 {
+        self(values)
+    }
+}
+
+/// Where an [`Uploader`] put a grid: `len` `f32` values at device address `address`, ordered as
+/// `layout` says.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PlacedGrid {
+    pub address: u64,
+    pub len: u64,
+    pub layout: GridLayout,
+}
+
+/// What the components' `to_params` receive.
+pub type Upload<'u> = dyn Uploader + 'u;
 
 /// A scene part that can travel to a GPU kernel.
 pub trait Component {
@@ -122,8 +155,8 @@ impl From<&SettingsParams> for PathSettings {
     }
 }
 
-/// A dense grid in device memory: `len` `f32` values at address `data`, laid out as [`Grid`] says,
-/// and its world-to-index mapping as the host computed it.
+/// A grid in device memory: `len` `f32` values at address `data`, ordered as `layout`
+/// ([`GridLayout::to_u32`]) says, and its world-to-index mapping as the host computed it.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GridParams {
@@ -136,14 +169,21 @@ pub struct GridParams {
     pub bounds_max: [f32; 3],
     pub scale: [f32; 3],
     pub offset: [f32; 3],
+    pub layout: u32,
+    pub padding: u32,
 }
 
 impl GridParams {
     /// The parameters of `grid`, whose values `upload` copies to the device.
+    /// `grid` must be dense (the host's grids are; the uploader picks the device's layout).
     pub fn new<const C: usize>(grid: &Grid<'_, C>, upload: &mut Upload<'_>) -> Self {
+        debug_assert_eq!(grid.layout, GridLayout::Dense);
+        let placed = upload.grid(grid.data, grid.res, C as u32);
         Self {
-            data: upload(grid.data),
-            len: grid.data.len() as u64,
+            data: placed.address,
+            len: placed.len,
+            layout: placed.layout.to_u32(),
+            padding: 0,
             res: grid.res,
             channels: C as u32,
             bounds_min: grid.mapping.bounds.min.to_array(),
@@ -157,7 +197,7 @@ impl GridParams {
     ///
     /// # Safety
     /// `data` must point to `len` initialised `f32` values that stay valid and unchanged for `'a`,
-    /// and `len` must equal `res_x * res_y * res_z * C`.
+    /// and `len` must equal `GridLayout::values(res, C)` of the layout.
     #[inline]
     pub unsafe fn grid<'a, const C: usize>(&self) -> Grid<'a, C> {
         let bounds = Aabb::new(
@@ -175,6 +215,7 @@ impl GridParams {
                 Vec3::from_array(self.scale),
                 Vec3::from_array(self.offset),
             ),
+            layout: GridLayout::from_u32(self.layout),
         }
     }
 }

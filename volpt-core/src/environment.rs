@@ -166,7 +166,7 @@ impl Component for LatLongEnvironment<'_> {
 
     fn to_params(&self, upload: &mut Upload<'_>) -> LatLongParams {
         LatLongParams {
-            texels: upload(self.rgb),
+            texels: upload.values(self.rgb),
             len: self.rgb.len() as u64,
             world_to_map: self.world_to_map.map(|row| row.to_array()),
             scale: self.scale,

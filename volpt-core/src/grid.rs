@@ -60,41 +60,143 @@ impl GridMapping {
     }
 }
 
-/// A grid of `C`-channel samples, x fastest: `data[((z * res_y + y) * res_x + x) * C + c]`.
+/// How a grid's samples are ordered in memory.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum GridLayout {
+    /// x fastest: sample `(x, y, z)` at `((z * res_y + y) * res_x + x) * C`.
+    #[default]
+    Dense,
+    /// Bricks of [`BRICK`]^3 samples, each stored contiguously (x fastest inside a brick), the
+    /// bricks themselves x fastest. The 8 corners of a lookup lie in one brick (rarely 2 to 8),
+    /// i.e. in a few 2 KiB blocks instead of 4 rows of planes `res_x * res_y` apart: a GPU reading
+    /// the grid over PCIe (zero-copy, managed memory) fetches fewer, fuller lines.
+    /// Axes that are not a multiple of [`BRICK`] are padded; padding is never read.
+    Bricked,
+}
+
+/// Samples along each edge of a brick of [`GridLayout::Bricked`].
+pub const BRICK: u32 = 8;
+const BRICK_SHIFT: u32 = BRICK.trailing_zeros();
+
+impl GridLayout {
+    /// Values a grid of `res` samples of `channels` channels takes in this layout (with its
+    /// padding), or `None` if that does not fit in `u64`.
+    pub fn values(self, res: [u32; 3], channels: u32) -> Option<u64> {
+        let samples = match self {
+            GridLayout::Dense => res.map(u64::from),
+            GridLayout::Bricked => res.map(|r| u64::from(r.div_ceil(BRICK)) * u64::from(BRICK)),
+        };
+        samples
+            .iter()
+            .try_fold(u64::from(channels), |acc, &r| acc.checked_mul(r))
+    }
+
+    /// The sample index (before multiplying by the channel count) of `(x, y, z)` in a grid of
+    /// `res` samples. Arithmetic is `u32`, as the lookup's: a grid's padded sample count must be
+    /// below 2^32 ([`GridLayout::values`]).
+    #[inline]
+    pub fn index(self, res: [u32; 3], x: u32, y: u32, z: u32) -> u32 {
+        match self {
+            GridLayout::Dense => dense_index(res, x, y, z),
+            GridLayout::Bricked => bricked_index(res, x, y, z),
+        }
+    }
+
+    /// The layout's number in [`crate::abi::GridParams`] (any unknown number reads as dense).
+    pub fn to_u32(self) -> u32 {
+        match self {
+            GridLayout::Dense => 0,
+            GridLayout::Bricked => 1,
+        }
+    }
+
+    pub fn from_u32(n: u32) -> Self {
+        match n {
+            1 => GridLayout::Bricked,
+            _ => GridLayout::Dense,
+        }
+    }
+}
+
+#[inline]
+fn dense_index(res: [u32; 3], x: u32, y: u32, z: u32) -> u32 {
+    (z * res[1] + y) * res[0] + x
+}
+
+#[inline]
+fn bricked_index(res: [u32; 3], x: u32, y: u32, z: u32) -> u32 {
+    let bricks_x = (res[0] + BRICK - 1) >> BRICK_SHIFT;
+    let bricks_y = (res[1] + BRICK - 1) >> BRICK_SHIFT;
+    let brick =
+        ((z >> BRICK_SHIFT) * bricks_y + (y >> BRICK_SHIFT)) * bricks_x + (x >> BRICK_SHIFT);
+    let mask = BRICK - 1;
+    let inner = (((z & mask) << BRICK_SHIFT) + (y & mask)) << BRICK_SHIFT | (x & mask);
+    (brick << (3 * BRICK_SHIFT)) | inner
+}
+
+/// A grid of `C`-channel samples, ordered as its [`GridLayout`] says (dense: x fastest,
+/// `data[((z * res_y + y) * res_x + x) * C + c]`).
 /// Borrowed, so that the same type wraps host memory and device memory.
 #[derive(Clone, Copy, Debug)]
 pub struct Grid<'a, const C: usize> {
     pub data: &'a [f32],
     pub res: [u32; 3],
     pub mapping: GridMapping,
+    pub layout: GridLayout,
 }
 
 impl<'a, const C: usize> Grid<'a, C> {
-    /// `data.len()` must be `res_x * res_y * res_z * C`; lookups index within that.
+    /// A dense grid: `data.len()` must be `res_x * res_y * res_z * C`; lookups index within that.
     pub fn new(data: &'a [f32], res: [u32; 3], mapping: GridMapping) -> Self {
-        assert_eq!(
-            data.len(),
-            res[0] as usize * res[1] as usize * res[2] as usize * C,
-            "grid data does not match its resolution"
-        );
-        Self { data, res, mapping }
+        Self::with_layout(data, res, mapping, GridLayout::Dense)
     }
 
-    #[inline]
-    fn at(&self, x: u32, y: u32, z: u32) -> [f32; C] {
-        let i = (((z * self.res[1] + y) * self.res[0] + x) as usize) * C;
-        let mut v = [0.0; C];
-        v.copy_from_slice(&self.data[i..i + C]);
-        v
+    /// A grid in `layout`: `data.len()` must be `layout.values(res, C)`.
+    pub fn with_layout(
+        data: &'a [f32],
+        res: [u32; 3],
+        mapping: GridMapping,
+        layout: GridLayout,
+    ) -> Self {
+        assert_eq!(
+            Some(data.len() as u64),
+            layout.values(res, C as u32),
+            "grid data does not match its resolution"
+        );
+        Self {
+            data,
+            res,
+            mapping,
+            layout,
+        }
     }
 
     /// Trilinear interpolation of the samples around `p`; zero outside the grid's box, and the edge
     /// samples held constant between the outermost sample and the box's faces.
     #[inline]
     pub fn lookup(&self, p: Vec3) -> [f32; C] {
+        // One branch per lookup, not per corner: each layout gets its own copy of the
+        // interpolation, and the dense copy is exactly the code of a grid without layouts.
+        match self.layout {
+            GridLayout::Dense => self.interpolate(p, dense_index),
+            GridLayout::Bricked => self.interpolate(p, bricked_index),
+        }
+    }
+
+    #[inline(always)]
+    fn interpolate<I>(&self, p: Vec3, index: I) -> [f32; C]
+    where
+        I: Fn([u32; 3], u32, u32, u32) -> u32,
+    {
         if !self.mapping.bounds.contains(p) {
             return [0.0; C];
         }
+        let at = |x: u32, y: u32, z: u32| {
+            let i = index(self.res, x, y, z) as usize * C;
+            let mut v = [0.0; C];
+            v.copy_from_slice(&self.data[i..i + C]);
+            v
+        };
         let max_index = Vec3::new(
             (self.res[0] - 1) as f32,
             (self.res[1] - 1) as f32,
@@ -120,10 +222,135 @@ impl<'a, const C: usize> Grid<'a, C> {
             }
             r
         };
-        let c00 = lerp_c(self.at(x0, y0, z0), self.at(x1, y0, z0), f.x);
-        let c10 = lerp_c(self.at(x0, y1, z0), self.at(x1, y1, z0), f.x);
-        let c01 = lerp_c(self.at(x0, y0, z1), self.at(x1, y0, z1), f.x);
-        let c11 = lerp_c(self.at(x0, y1, z1), self.at(x1, y1, z1), f.x);
+        let c00 = lerp_c(at(x0, y0, z0), at(x1, y0, z0), f.x);
+        let c10 = lerp_c(at(x0, y1, z0), at(x1, y1, z0), f.x);
+        let c01 = lerp_c(at(x0, y0, z1), at(x1, y0, z1), f.x);
+        let c11 = lerp_c(at(x0, y1, z1), at(x1, y1, z1), f.x);
         lerp_c(lerp_c(c00, c10, f.y), lerp_c(c01, c11, f.y), f.z)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use std::vec;
+    use std::vec::Vec;
+
+    use super::*;
+
+    /// The bricked form of dense samples, written with the layout's own index: what a host
+    /// uploader does (volpt-zerocopy), here only to test the lookup.
+    fn brick<const C: usize>(dense: &[f32], res: [u32; 3]) -> Vec<f32> {
+        let len = GridLayout::Bricked.values(res, C as u32).unwrap() as usize;
+        let mut out = vec![0.0; len];
+        for z in 0..res[2] {
+            for y in 0..res[1] {
+                for x in 0..res[0] {
+                    let from = GridLayout::Dense.index(res, x, y, z) as usize * C;
+                    let to = GridLayout::Bricked.index(res, x, y, z) as usize * C;
+                    out[to..to + C].copy_from_slice(&dense[from..from + C]);
+                }
+            }
+        }
+        out
+    }
+
+    /// A small counter-based generator, so that the test needs no dependency.
+    fn hash(i: u32) -> f32 {
+        let mut h = i.wrapping_mul(0x9E37_79B9) ^ 0x85EB_CA6B;
+        h ^= h >> 15;
+        h = h.wrapping_mul(0x2C1B_3C6D);
+        h ^= h >> 12;
+        (h >> 8) as f32 / (1 << 24) as f32
+    }
+
+    const SHAPES: [[u32; 3]; 7] = [
+        [1, 1, 1],
+        [8, 8, 8],
+        [9, 8, 17],
+        [13, 7, 5],
+        [2048, 1, 1],
+        [3, 16, 24],
+        [17, 17, 17],
+    ];
+
+    #[test]
+    fn bricked_indices_are_a_permutation_into_the_padded_grid() {
+        for res in SHAPES {
+            let len = GridLayout::Bricked.values(res, 1).unwrap() as usize;
+            let mut seen = vec![false; len];
+            for z in 0..res[2] {
+                for y in 0..res[1] {
+                    for x in 0..res[0] {
+                        let i = GridLayout::Bricked.index(res, x, y, z) as usize;
+                        assert!(!seen[i], "{res:?}: ({x}, {y}, {z}) collides at {i}");
+                        seen[i] = true;
+                    }
+                }
+            }
+            let padded: u64 = res.iter().map(|&r| u64::from(r.div_ceil(8) * 8)).product();
+            assert_eq!(len as u64, padded);
+        }
+    }
+
+    #[test]
+    fn a_brick_is_contiguous_and_x_fastest() {
+        let res = [20, 12, 9];
+        // The second brick along x starts right after the first brick's 512 samples.
+        assert_eq!(GridLayout::Bricked.index(res, 8, 0, 0), 512);
+        assert_eq!(GridLayout::Bricked.index(res, 1, 0, 0), 1);
+        assert_eq!(GridLayout::Bricked.index(res, 0, 1, 0), 8);
+        assert_eq!(GridLayout::Bricked.index(res, 0, 0, 1), 64);
+        // 3 bricks along x, 2 along y: brick (0, 0, 1) is the 6th.
+        assert_eq!(GridLayout::Bricked.index(res, 0, 0, 8), 6 * 512);
+        assert_eq!(GridLayout::Dense.index(res, 3, 2, 1), (12 + 2) * 20 + 3);
+    }
+
+    fn lookups_match<const C: usize>(res: [u32; 3], mapping: GridMapping) {
+        let n = res.iter().product::<u32>() as usize * C;
+        let dense: Vec<f32> = (0..n as u32).map(hash).collect();
+        let bricked = brick::<C>(&dense, res);
+        let a = Grid::<C>::new(&dense, res, mapping);
+        let b = Grid::<C>::with_layout(&bricked, res, mapping, GridLayout::Bricked);
+        let (min, extent) = (mapping.bounds.min, mapping.bounds.extent());
+        for i in 0..4000u32 {
+            // Points inside, on and slightly outside the box.
+            let u = Vec3::new(hash(3 * i), hash(3 * i + 1), hash(3 * i + 2)) * 1.1 - 0.05;
+            let p = min + u * extent;
+            let (x, y) = (a.lookup(p), b.lookup(p));
+            for c in 0..C {
+                assert_eq!(x[c].to_bits(), y[c].to_bits(), "{res:?} at {p:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn bricked_lookups_are_bit_identical_to_dense() {
+        let bounds = Aabb::new(Vec3::new(-1.0, 0.5, 2.0), Vec3::new(3.0, 1.5, 2.25));
+        for res in SHAPES {
+            lookups_match::<1>(res, GridMapping::vertex_centred(bounds, res));
+            lookups_match::<1>(res, GridMapping::cell_centred(bounds, res));
+            lookups_match::<3>(res, GridMapping::cell_centred(bounds, res));
+        }
+    }
+
+    #[test]
+    fn layout_sizes_overflow_cleanly() {
+        assert_eq!(GridLayout::Dense.values([2, 3, 4], 3), Some(72));
+        assert_eq!(GridLayout::Bricked.values([2, 3, 4], 3), Some(512 * 3));
+        assert_eq!(GridLayout::Bricked.values([u32::MAX; 3], u32::MAX), None);
+        assert_eq!(
+            GridLayout::from_u32(GridLayout::Bricked.to_u32()),
+            GridLayout::Bricked
+        );
+        assert_eq!(GridLayout::from_u32(7), GridLayout::Dense);
+    }
+
+    #[test]
+    #[should_panic(expected = "does not match its resolution")]
+    fn a_bricked_grid_must_hold_its_padding() {
+        let data = [0.0; 8];
+        let mapping = GridMapping::cell_centred(Aabb::new(Vec3::ZERO, Vec3::ONE), [2, 2, 2]);
+        Grid::<1>::with_layout(&data, [2, 2, 2], mapping, GridLayout::Bricked);
     }
 }

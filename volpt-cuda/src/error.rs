@@ -25,6 +25,8 @@ pub enum CudaError {
     MissingKernel(String),
     #[error(transparent)]
     Empty(#[from] volpt_film::NothingToRender),
+    #[error(transparent)]
+    Volume(#[from] volpt_zerocopy::ZeroCopyError),
     #[error("CUDA driver call failed while {doing}: {source}")]
     Driver {
         doing: &'static str,

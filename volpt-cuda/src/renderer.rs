@@ -19,6 +19,7 @@ use volpt_core::path::PathCounters;
 use volpt_device::launch::{BLOCK_SIZE, COUNTERS};
 use volpt_device::{LaunchParams, Math, Strategy};
 use volpt_film::{Film, Image, RenderOptions, RenderStats};
+use volpt_zerocopy::{VolumePlacer, VolumePolicy};
 
 use crate::entry::{entry_name, single_kernel_ptx};
 use crate::error::{CudaError, Doing};
@@ -52,6 +53,7 @@ pub struct CudaRenderer {
     modules: Mutex<HashMap<KernelKey, Arc<CudaModule>>>,
     device_name: String,
     multiprocessors: u32,
+    volumes: VolumePolicy,
 }
 
 impl CudaRenderer {
@@ -91,6 +93,7 @@ impl CudaRenderer {
             modules: Mutex::default(),
             device_name,
             multiprocessors,
+            volumes: VolumePolicy::default(),
         })
     }
 
@@ -125,6 +128,11 @@ impl CudaRenderer {
 
     pub(crate) fn stream(&self) -> &Arc<CudaStream> {
         &self.stream
+    }
+
+    /// Where renders place their grids from now on (`--volume-memory`, docs/out-of-core.md).
+    pub fn set_volume_policy(&mut self, policy: VolumePolicy) {
+        self.volumes = policy;
     }
 
     pub fn device_name(&self) -> &str {
@@ -166,23 +174,12 @@ impl CudaRenderer {
         let kernel = self.kernel(&name, schedule.max_registers)?;
         let stream = &self.stream;
 
-        // The scene: grids to the device, everything else by value.
-        let mut grids: Vec<CudaSlice<f32>> = Vec::new();
-        let mut upload_error = None;
-        let scene_params = scene.to_params(&mut |values| match stream.clone_htod(values) {
-            Ok(slice) => {
-                let (address, _) = slice.device_ptr(stream);
-                grids.push(slice);
-                address
-            }
-            Err(e) => {
-                upload_error.get_or_insert(e);
-                0
-            }
-        });
-        if let Some(e) = upload_error {
-            return Err(e).doing("copying the volume to the GPU");
-        }
+        // The scene: grids where the volume policy puts them, everything else by value.
+        // SAFETY: the grids are `scene`'s, borrowed for this whole call; `volumes` is dropped
+        // before it returns.
+        let mut volumes = unsafe { VolumePlacer::new(stream.clone(), self.volumes) }?;
+        let scene_params = scene.to_params(&mut volumes);
+        volumes.check()?;
 
         let pixels = width as u64 * height as u64;
         let mut device_film: CudaSlice<f64> = stream
@@ -249,7 +246,7 @@ impl CudaRenderer {
 
         let sums = stream.clone_dtoh(&device_film).doing("reading the film")?;
         let totals = stream.clone_dtoh(&counters).doing("reading the counters")?;
-        drop(grids);
+        drop(volumes);
         film.sums = sums.chunks_exact(3).map(|s| [s[0], s[1], s[2]]).collect();
         let counters = PathCounters {
             paths: totals[0],

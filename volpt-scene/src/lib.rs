@@ -43,7 +43,7 @@ pub use description::*;
 pub use error::{GridProblem, SceneError, VolProblem};
 pub use metaimage::{read_metaimage, write_metaimage, MetaImageOptions};
 pub use normalise::normalise;
-pub use raw::{read_raw, write_raw, ByteOrder, RawLayout, ScalarType};
+pub use raw::{read_raw, read_raw_into, write_raw, ByteOrder, RawLayout, ScalarType};
 pub use transfer::TransferFunction;
 pub use vol::{read_vol, write_vol, VolGrid};
 pub use vtk::{read_vtk, write_vtk};

@@ -166,7 +166,7 @@ pub struct RawLayout {
 impl RawLayout {
     /// The number of values and of data bytes, checked against overflow and [`MAX_VALUES`];
     /// `path` names the file in the error.
-    pub(crate) fn checked_size(&self, path: &Path) -> Result<(usize, u64), SceneError> {
+    pub fn checked_size(&self, path: &Path) -> Result<(usize, u64), SceneError> {
         if self.resolution.contains(&0) || self.channels == 0 {
             let [x, y, z] = self.resolution;
             return Err(grid_error(
@@ -209,6 +209,46 @@ impl RawLayout {
 /// The file must hold exactly `header_bytes` plus the data, and every value must be finite and
 /// non-negative.
 pub fn read_raw(path: &Path, layout: &RawLayout, bounds: Bounds) -> Result<GridDesc, SceneError> {
+    let (mut file, data_bytes) = open_raw(path, layout)?;
+    let what = format!("voxel data in {}", path.display());
+    let data = read_values(&mut file, layout, data_bytes, path, path, &what)?;
+    Ok(GridDesc {
+        resolution: layout.resolution,
+        channels: layout.channels,
+        bounds,
+        convention: GridConvention::Cell,
+        data,
+    })
+}
+
+/// [`read_raw`]'s values, streamed straight into the caller's `out` (for instance page-locked
+/// memory a GPU reads), which must hold exactly the layout's number of values: no second copy of
+/// the grid is ever made. The same checks and errors as [`read_raw`]; after an error `out` holds
+/// the values read so far.
+pub fn read_raw_into(path: &Path, layout: &RawLayout, out: &mut [f32]) -> Result<(), SceneError> {
+    let (count, _) = layout.checked_size(path)?;
+    if out.len() != count {
+        let [x, y, z] = layout.resolution;
+        return Err(grid_error(
+            path,
+            GridProblem::BadField {
+                line: None,
+                field: "the caller's buffer".into(),
+                expected: format!("{count} values ({x} x {y} x {z} x {})", layout.channels),
+                found: format!("{} values", out.len()),
+            },
+        ));
+    }
+    let (mut file, data_bytes) = open_raw(path, layout)?;
+    let what = format!("voxel data in {}", path.display());
+    stream_values(&mut file, layout, data_bytes, path, path, &what, |i, v| {
+        out[i] = v;
+    })
+}
+
+/// Opens a raw file, checks that it holds exactly the header and the layout's data, and leaves it
+/// at the data; returns it with the data's length in bytes.
+fn open_raw(path: &Path, layout: &RawLayout) -> Result<(File, u64), SceneError> {
     let (_, data_bytes) = layout.checked_size(path)?;
     let io = |error| SceneError::Io {
         path: path.to_path_buf(),
@@ -248,15 +288,7 @@ pub fn read_raw(path: &Path, layout: &RawLayout, bounds: Bounds) -> Result<GridD
     }
     file.seek(SeekFrom::Start(layout.header_bytes))
         .map_err(io)?;
-    let what = format!("voxel data in {}", path.display());
-    let data = read_values(&mut file, layout, data_bytes, path, path, &what)?;
-    Ok(GridDesc {
-        resolution: layout.resolution,
-        channels: layout.channels,
-        bounds,
-        convention: GridConvention::Cell,
-        data,
-    })
+    Ok((file, data_bytes))
 }
 
 /// Writes a grid's values (no header) in the given type and byte order. Integer types must hold
@@ -283,6 +315,34 @@ pub(crate) fn read_values(
     source: &Path,
     what: &str,
 ) -> Result<Vec<f32>, SceneError> {
+    let count = (data_bytes / layout.scalar.bytes() as u64) as usize; // checked_size made it fit
+    let mut data = Vec::new();
+    if data.try_reserve_exact(count).is_err() {
+        return Err(grid_error(
+            path,
+            GridProblem::TooLarge {
+                resolution: layout.resolution,
+                channels: layout.channels,
+                limit: MAX_VALUES,
+            },
+        ));
+    }
+    stream_values(reader, layout, data_bytes, path, source, what, |_, v| {
+        data.push(v)
+    })?;
+    Ok(data)
+}
+
+/// [`read_values`] into `sink(index, value)`, value by value, each checked.
+fn stream_values(
+    reader: &mut impl Read,
+    layout: &RawLayout,
+    data_bytes: u64,
+    path: &Path,
+    source: &Path,
+    what: &str,
+    mut sink: impl FnMut(usize, f32),
+) -> Result<(), SceneError> {
     const CHUNK: usize = 1 << 16; // a multiple of every value size
     let decode_error = |error: std::io::Error, path: &Path, what: &str| match error.kind() {
         // What a corrupt zlib stream reports.
@@ -299,18 +359,7 @@ pub(crate) fn read_values(
         },
     };
     let size = layout.scalar.bytes();
-    let count = (data_bytes / size as u64) as usize; // checked_size made it fit
-    let mut data = Vec::new();
-    if data.try_reserve_exact(count).is_err() {
-        return Err(grid_error(
-            path,
-            GridProblem::TooLarge {
-                resolution: layout.resolution,
-                channels: layout.channels,
-                limit: MAX_VALUES,
-            },
-        ));
-    }
+    let mut index = 0;
     let mut buffer = vec![0u8; CHUNK];
     let mut done = 0u64;
     while done < data_bytes {
@@ -328,7 +377,8 @@ pub(crate) fn read_values(
         }
         for bytes in buffer[..n].chunks_exact(size) {
             let value = layout.scalar.decode(bytes, layout.byte_order);
-            data.push(checked_value(path, layout, data.len(), value)?);
+            sink(index, checked_value(path, layout, index, value)?);
+            index += 1;
         }
         done += n as u64;
     }
@@ -341,7 +391,7 @@ pub(crate) fn read_values(
             },
         ));
     }
-    Ok(data)
+    Ok(())
 }
 
 /// A decoded value as `f32`, or the error naming its voxel: volpt's grids are densities and

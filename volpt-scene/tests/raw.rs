@@ -4,8 +4,8 @@ use std::path::{Path, PathBuf};
 
 use tempfile::TempDir;
 use volpt_scene::{
-    normalise, read_raw, write_raw, Bounds, ByteOrder, GridConvention, GridDesc, GridProblem,
-    RawLayout, ScalarType, SceneError,
+    normalise, read_raw, read_raw_into, write_raw, Bounds, ByteOrder, GridConvention, GridDesc,
+    GridProblem, RawLayout, ScalarType, SceneError,
 };
 
 fn unit() -> Bounds {
@@ -280,4 +280,52 @@ fn bucky_reads_and_normalises() {
     for (d, v) in density.data.iter().zip(&grid.data) {
         assert!((d - v * 40.0 / max).abs() <= 1e-5 * 40.0);
     }
+}
+
+/// Streaming into a caller's buffer (page-locked memory for a GPU, say) reads exactly what
+/// `read_raw` reads, with the same checks, and refuses a buffer of the wrong size before reading.
+#[test]
+fn streaming_into_a_callers_buffer_reads_what_read_raw_reads() {
+    let dir = TempDir::new().unwrap();
+    let data: Vec<f32> = (0..3 * 70_000).map(|i| (i % 977) as f32).collect();
+    let original = grid([70, 50, 20], 3, data);
+    for scalar in [ScalarType::F32, ScalarType::U16, ScalarType::F64] {
+        let path = dir.path().join(format!("{scalar:?}.raw"));
+        write_raw(&path, &original, scalar, ByteOrder::Big).unwrap();
+        let layout = RawLayout {
+            byte_order: ByteOrder::Big,
+            ..layout([70, 50, 20], 3, scalar)
+        };
+        let mut out = vec![f32::NAN; original.data.len()];
+        read_raw_into(&path, &layout, &mut out).unwrap();
+        assert_eq!(out, read_raw(&path, &layout, unit()).unwrap().data);
+        assert_eq!(out, original.data, "{scalar:?}");
+
+        let mut short = vec![0.0; original.data.len() - 1];
+        let err = read_raw_into(&path, &layout, &mut short).unwrap_err();
+        let message = err.to_string();
+        assert!(message.contains("210000 values"), "{message}");
+        assert!(message.contains("209999 values"), "{message}");
+        assert!(short.iter().all(|&v| v == 0.0), "nothing was read");
+    }
+
+    let mut bytes = Vec::new();
+    for v in [1.0f32, 2.0, -3.0, 4.0] {
+        bytes.extend_from_slice(&v.to_le_bytes());
+    }
+    let (_dir, path) = file(&bytes);
+    let layout = layout([2, 2, 1], 1, ScalarType::F32);
+    let streamed = read_raw_into(&path, &layout, &mut [0.0; 4]).map(|()| grid([1; 3], 1, vec![]));
+    assert_eq!(
+        problem(streamed, &path),
+        problem(read_raw(&path, &layout, unit()), &path)
+    );
+    let (_dir, path) = file(&bytes[..12]);
+    assert!(matches!(
+        problem(
+            read_raw_into(&path, &layout, &mut [0.0; 4]).map(|()| grid([1; 3], 1, vec![])),
+            &path
+        ),
+        GridProblem::SizeMismatch { .. }
+    ));
 }

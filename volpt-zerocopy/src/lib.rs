@@ -1,3 +1,26 @@
-//! Volumes in pinned, device-mapped host memory, for volumes larger than the GPU.
+//! Volumes larger than the GPU: where a render's grids live while its kernels read them.
 //!
-//! Empty until the zero-copy issue: it builds on the CUDA backend's device volumes.
+//! - [`policy`]: `--volume-memory device|zerocopy|managed|auto` and the device memory budget, as a
+//!   pure decision per grid ([`policy::decide`]), testable without a GPU.
+//! - [`layout`]: the host side of the bricked grid layout ([`volpt_core::GridLayout::Bricked`]):
+//!   dense samples rewritten brick by brick.
+//! - [`memory`]: safe owners of the CUDA driver's host memory kinds: page-locked, device-mapped host
+//!   memory ([`PinnedBuffer`], `cuMemHostAlloc`; [`PinnedBuffer::read_raw`] streams a raw grid
+//!   file straight into it), a caller's own host memory page-locked and mapped in place
+//!   ([`HostRegistration`], `cuMemHostRegister`), and managed memory ([`ManagedBuffer`],
+//!   `cuMemAllocManaged` with advice and prefetch).
+//! - [`placer`]: the [`volpt_core::abi::Uploader`] the CUDA backend hands to a scene's `to_params`:
+//!   it places each grid as the policy decides and owns the memory for the render.
+//!
+//! `docs/out-of-core.md` describes the design and the measurements.
+
+pub mod error;
+pub mod layout;
+pub mod memory;
+pub mod placer;
+pub mod policy;
+
+pub use error::ZeroCopyError;
+pub use memory::{HostRegistration, ManagedBuffer, PinnedBuffer};
+pub use placer::{Placed, VolumePlacer};
+pub use policy::{Placement, VolumeMemory, VolumePolicy};

@@ -1,0 +1,69 @@
+use cudarc::driver::DriverError;
+use thiserror::Error;
+
+/// What can go wrong placing a volume; every out-of-memory case says how much was asked for and
+/// what to try instead.
+#[derive(Debug, Error)]
+pub enum ZeroCopyError {
+    #[error(
+        "the GPU has no room for a volume of {} (--volume-memory device): use \
+         --volume-memory auto, zerocopy or managed to read it from host memory",
+        crate::policy::human_bytes(*.bytes)
+    )]
+    OutOfDeviceMemory {
+        bytes: u64,
+        #[source]
+        source: DriverError,
+    },
+    #[error(
+        "a volume of {} does not fit the device memory budget ({} left of \
+         --device-memory-budget {}) with --volume-memory device: use --volume-memory auto, \
+         zerocopy or managed, or a larger budget",
+        crate::policy::human_bytes(*.bytes),
+        crate::policy::human_bytes(*.left),
+        crate::policy::human_bytes(*.budget)
+    )]
+    OverBudget { bytes: u64, left: u64, budget: u64 },
+    #[error(
+        "cannot page-lock {} of host memory for a volume read by the GPU (the system's \
+         pinned memory, `ulimit -l` or RAM is exhausted): free memory, or use \
+         --volume-memory managed",
+        crate::policy::human_bytes(*.bytes)
+    )]
+    OutOfPinnedMemory {
+        bytes: u64,
+        #[source]
+        source: DriverError,
+    },
+    #[error(
+        "cannot allocate {} of managed memory for a volume: free host memory, or use \
+         --volume-memory zerocopy",
+        crate::policy::human_bytes(*.bytes)
+    )]
+    OutOfManagedMemory {
+        bytes: u64,
+        #[source]
+        source: DriverError,
+    },
+    #[error(
+        "cannot allocate {} of host memory to rearrange a volume into bricks",
+        crate::policy::human_bytes(*.bytes)
+    )]
+    OutOfHostMemory { bytes: u64 },
+    #[error(transparent)]
+    Load(#[from] volpt_scene::SceneError),
+    #[error("CUDA driver call failed while {doing} ({} volume): {source}", crate::policy::human_bytes(*.bytes))]
+    Driver {
+        doing: &'static str,
+        bytes: u64,
+        #[source]
+        source: DriverError,
+    },
+}
+
+impl ZeroCopyError {
+    /// Whether the driver said it ran out of memory (device or host).
+    pub(crate) fn is_out_of_memory(source: &DriverError) -> bool {
+        source.0 == cudarc::driver::sys::CUresult::CUDA_ERROR_OUT_OF_MEMORY
+    }
+}

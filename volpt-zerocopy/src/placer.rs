@@ -1,0 +1,327 @@
+//! The [`Uploader`] of the CUDA backend: places each grid of a scene where the [`VolumePolicy`]
+//! decides, and owns that memory for the render.
+
+use std::fmt;
+use std::sync::Arc;
+
+use cudarc::driver::{CudaContext, CudaStream, DevicePtr, DriverError};
+use rayon::prelude::*;
+use volpt_core::abi::{PlacedGrid, Uploader};
+use volpt_core::GridLayout;
+
+use crate::error::ZeroCopyError;
+use crate::layout::{brick_into, bricked, values_in};
+use crate::memory::{HostRegistration, ManagedBuffer, PinnedBuffer};
+use crate::policy::{decide, human_bytes, Placement, VolumeMemory, VolumePolicy};
+
+/// Memory a render's scene is read from, kept only to be freed when the render ends.
+type Held = Box<dyn Send>;
+
+/// Where a grid went, for the log and the render's report.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Placed {
+    pub bytes: u64,
+    pub layout: GridLayout,
+    pub memory: PlacedIn,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PlacedIn {
+    Device,
+    /// Page-locked in place (the loader's own memory, no copy).
+    ZeroCopyInPlace,
+    /// Copied (or bricked) into page-locked memory.
+    ZeroCopy,
+    Managed {
+        device_bytes: u64,
+    },
+}
+
+impl fmt::Display for Placed {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let layout = match self.layout {
+            GridLayout::Dense => "dense",
+            GridLayout::Bricked => "bricked",
+        };
+        write!(f, "{} {layout} grid in ", human_bytes(self.bytes))?;
+        match self.memory {
+            PlacedIn::Device => write!(f, "device memory"),
+            PlacedIn::ZeroCopyInPlace => write!(f, "host memory page-locked in place (zero-copy)"),
+            PlacedIn::ZeroCopy => write!(f, "pinned host memory (zero-copy)"),
+            PlacedIn::Managed { device_bytes } => write!(
+                f,
+                "managed memory, {} of it prefetched to the device",
+                human_bytes(device_bytes)
+            ),
+        }
+    }
+}
+
+/// Places a scene's grids (and copies its other values, such as environment maps, to the device)
+/// for one render; dropping it frees everything.
+pub struct VolumePlacer {
+    ctx: Arc<CudaContext>,
+    stream: Arc<CudaStream>,
+    policy: VolumePolicy,
+    free_device: u64,
+    /// Device bytes taken by this render's grids so far.
+    used: u64,
+    held: Vec<Held>,
+    placed: Vec<Placed>,
+    error: Option<ZeroCopyError>,
+}
+
+impl VolumePlacer {
+    /// A placer on `stream`'s device; asks the driver how much device memory is free now.
+    ///
+    /// # Safety
+    /// Every slice given to [`Uploader::grid`] must stay live and unmoved until the placer is
+    /// dropped: zero-copy grids are the caller's own memory, page-locked in place.
+    pub unsafe fn new(
+        stream: Arc<CudaStream>,
+        policy: VolumePolicy,
+    ) -> Result<Self, ZeroCopyError> {
+        let ctx = stream.context().clone();
+        let (free, total) = ctx.mem_get_info().map_err(|source| ZeroCopyError::Driver {
+            doing: "asking how much device memory is free",
+            bytes: 0,
+            source,
+        })?;
+        tracing::debug!(
+            free = %human_bytes(free as u64),
+            total = %human_bytes(total as u64),
+            budget = %human_bytes(policy.effective_budget(free as u64)),
+            memory = %policy.memory,
+            "placing volumes"
+        );
+        Ok(Self {
+            ctx,
+            stream,
+            policy,
+            free_device: free as u64,
+            used: 0,
+            held: Vec::new(),
+            placed: Vec::new(),
+            error: None,
+        })
+    }
+
+    /// The first error of any placement; the parameters built with this placer are only valid
+    /// if this is `Ok`.
+    pub fn check(&mut self) -> Result<(), ZeroCopyError> {
+        self.error.take().map_or(Ok(()), Err)
+    }
+
+    /// Where each grid went, in the order the scene placed them.
+    pub fn placed(&self) -> &[Placed] {
+        &self.placed
+    }
+
+    fn place(
+        &mut self,
+        values: &[f32],
+        res: [u32; 3],
+        channels: u32,
+    ) -> Result<PlacedGrid, ZeroCopyError> {
+        let layout = match self.policy.layout {
+            GridLayout::Bricked if values_in(GridLayout::Bricked, res, channels).is_none() => {
+                tracing::warn!(
+                    ?res,
+                    "a grid padded to whole bricks would have 2^32 samples or more: it stays dense"
+                );
+                GridLayout::Dense
+            }
+            layout => layout,
+        };
+        let len = match layout {
+            GridLayout::Dense => values.len(),
+            GridLayout::Bricked => values_in(layout, res, channels).unwrap_or(0) as usize,
+        };
+        let bytes = len as u64 * 4;
+        let grid = Grid {
+            values,
+            res,
+            channels,
+            layout,
+            len,
+        };
+        let (address, memory) = match decide(&self.policy, bytes, self.used, self.free_device) {
+            Placement::OverBudget { left, budget } => {
+                return Err(ZeroCopyError::OverBudget {
+                    bytes,
+                    left,
+                    budget,
+                })
+            }
+            Placement::Device => match self.copy_to_device(&grid) {
+                Ok(address) => {
+                    self.used += bytes;
+                    (address, PlacedIn::Device)
+                }
+                Err(ZeroCopyError::OutOfDeviceMemory { .. })
+                    if self.policy.memory == VolumeMemory::Auto =>
+                {
+                    tracing::warn!(
+                        bytes = %human_bytes(bytes),
+                        "the device has no room for the volume: reading it from host memory"
+                    );
+                    self.zero_copy(&grid)?
+                }
+                Err(e) => return Err(e),
+            },
+            Placement::ZeroCopy => self.zero_copy(&grid)?,
+            Placement::Managed { device_bytes } => {
+                let address = self.managed(&grid, device_bytes)?;
+                self.used += device_bytes;
+                (address, PlacedIn::Managed { device_bytes })
+            }
+        };
+        let placed = Placed {
+            bytes,
+            layout,
+            memory,
+        };
+        tracing::info!("volume: {placed}");
+        self.placed.push(placed);
+        Ok(PlacedGrid {
+            address,
+            len: len as u64,
+            layout,
+        })
+    }
+
+    fn copy_to_device(&mut self, grid: &Grid<'_>) -> Result<u64, ZeroCopyError> {
+        let bytes = grid.len as u64 * 4;
+        let copied = match grid.layout {
+            GridLayout::Dense => self.stream.clone_htod(grid.values),
+            GridLayout::Bricked => {
+                let host = bricked(grid.values, grid.res, grid.channels)
+                    .ok_or(ZeroCopyError::OutOfHostMemory { bytes })?;
+                self.stream.clone_htod(&host)
+            }
+        };
+        let slice = copied.map_err(|source| device_error(bytes, source))?;
+        let (address, _) = slice.device_ptr(&self.stream);
+        self.held.push(Box::new(slice));
+        Ok(address)
+    }
+
+    fn zero_copy(&mut self, grid: &Grid<'_>) -> Result<(u64, PlacedIn), ZeroCopyError> {
+        if grid.layout == GridLayout::Dense {
+            match HostRegistration::new(&self.ctx, grid.values) {
+                Ok(registration) => {
+                    let address = registration.device_address();
+                    // SAFETY: `new`'s contract: the values outlive the placer.
+                    let registration = unsafe { registration.into_static() };
+                    self.held.push(Box::new(registration));
+                    return Ok((address, PlacedIn::ZeroCopyInPlace));
+                }
+                // A small grid sharing a page with one registered before: copy it instead.
+                Err(e) if HostRegistration::already_registered(&e) => {}
+                Err(e @ ZeroCopyError::OutOfPinnedMemory { .. }) => return Err(e),
+                // Registration is not supported everywhere (some virtualised or older systems):
+                // pinned memory of our own still maps the grid, at the cost of a copy.
+                Err(e) => tracing::warn!(%e, "cannot page-lock the volume in place: copying it"),
+            }
+        }
+        let mut buffer = PinnedBuffer::zeroed(&self.ctx, grid.len)?;
+        grid.write_into(buffer.as_mut_slice());
+        let address = buffer.device_address();
+        self.held.push(Box::new(buffer));
+        Ok((address, PlacedIn::ZeroCopy))
+    }
+
+    fn managed(&mut self, grid: &Grid<'_>, device_bytes: u64) -> Result<u64, ZeroCopyError> {
+        let mut buffer = ManagedBuffer::zeroed(&self.ctx, grid.len)?;
+        grid.write_into(buffer.as_mut_slice());
+        buffer.place(device_bytes, &self.stream)?;
+        let address = buffer.device_address();
+        self.held.push(Box::new(buffer));
+        Ok(address)
+    }
+}
+
+/// A grid being placed: its dense host values and the layout and length it takes on the device.
+struct Grid<'v> {
+    values: &'v [f32],
+    res: [u32; 3],
+    channels: u32,
+    layout: GridLayout,
+    len: usize,
+}
+
+impl Grid<'_> {
+    /// Writes the grid in its layout into `out` (of `len` values).
+    fn write_into(&self, out: &mut [f32]) {
+        match self.layout {
+            GridLayout::Dense => {
+                const CHUNK: usize = 1 << 20;
+                out.par_chunks_mut(CHUNK)
+                    .zip(self.values.par_chunks(CHUNK))
+                    .for_each(|(to, from)| to.copy_from_slice(from));
+            }
+            GridLayout::Bricked => brick_into(self.values, self.res, self.channels, out),
+        }
+    }
+}
+
+fn device_error(bytes: u64, source: DriverError) -> ZeroCopyError {
+    if ZeroCopyError::is_out_of_memory(&source) {
+        ZeroCopyError::OutOfDeviceMemory { bytes, source }
+    } else {
+        ZeroCopyError::Driver {
+            doing: "copying a volume to the GPU",
+            bytes,
+            source,
+        }
+    }
+}
+
+impl Uploader for VolumePlacer {
+    /// Environment maps and other values: always copied to device memory (they are small).
+    fn values(&mut self, values: &[f32]) -> u64 {
+        if self.error.is_some() {
+            return 0;
+        }
+        match self.stream.clone_htod(values) {
+            Ok(slice) => {
+                let (address, _) = slice.device_ptr(&self.stream);
+                self.held.push(Box::new(slice));
+                address
+            }
+            Err(source) => {
+                self.error = Some(device_error(values.len() as u64 * 4, source));
+                0
+            }
+        }
+    }
+
+    fn grid(&mut self, values: &[f32], res: [u32; 3], channels: u32) -> PlacedGrid {
+        let failed = PlacedGrid {
+            address: 0,
+            len: 0,
+            layout: GridLayout::Dense,
+        };
+        if self.error.is_some() {
+            return failed;
+        }
+        match self.place(values, res, channels) {
+            Ok(placed) => placed,
+            Err(e) => {
+                self.error = Some(e);
+                failed
+            }
+        }
+    }
+}
+
+impl Drop for VolumePlacer {
+    fn drop(&mut self) {
+        // Kernels may still read the memory after an error elsewhere: wait for them before
+        // freeing it (a failed synchronisation leaves nothing better to do than to free).
+        if let Err(e) = self.stream.synchronize() {
+            tracing::error!(%e, "synchronising before freeing the volumes");
+        }
+        self.held.clear();
+    }
+}
