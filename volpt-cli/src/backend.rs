@@ -87,7 +87,9 @@ pub struct RenderJob<'a> {
     pub show_progress: bool,
 }
 
-/// An opened backend, reused across renders (a GPU's kernels are loaded once).
+/// An opened backend, reused across renders (a GPU's kernels are compiled once).
+// One backend per process: the size of the GPU variant costs nothing worth a box.
+#[allow(clippy::large_enum_variant)]
 pub enum Backend {
     Cpu,
     Cuda {
