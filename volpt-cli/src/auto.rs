@@ -1,8 +1,10 @@
 //! `--strategy auto`: the best GPU schedule for this scene on this GPU, chosen by measurement.
 //!
 //! The thesis's central finding is that the best strategy depends on the scene; so instead of a
-//! rule, short calibration renders of the actual scene time every candidate (each strategy but
-//! naive-sk, each with the compiler's registers and two register caps) and the fastest wins. The
+//! rule, short calibration renders of the actual scene time the candidates and the fastest wins:
+//! every strategy but naive-sk with the compiler's registers, then the fastest of them under two
+//! register caps (the caps' effect hardly depends on the strategy, and each candidate costs a JIT
+//! compilation). The
 //! choice and the measurements behind it are printed, and cached per scene, GPU and math in
 //! `$XDG_CACHE_HOME/volpt/auto.json` (or `~/.cache/volpt/`; `VOLPT_CACHE_DIR` overrides), so only
 //! the first render of a scene pays for the calibration (a few seconds, most of it JIT compilation).
@@ -18,11 +20,11 @@ use volpt_core::abi::SceneAbi;
 use volpt_cuda::{CudaRenderer, Schedule, Strategy};
 use volpt_render::{Film, RenderOptions};
 
-/// Register caps tried for every strategy (`None`: the compiler's choice).
-const CAPS: [Option<u32>; 3] = [None, Some(96), Some(64)];
+/// Register caps tried on the fastest strategy.
+const CAPS: [u32; 2] = [96, 64];
 
 /// Paths per calibration render: long enough that launch overheads are small against it.
-const CALIBRATION_PATHS: u64 = 1 << 22;
+const CALIBRATION_PATHS: u64 = 1 << 21;
 
 /// Timed renders per candidate; the fastest counts (the first also warms the kernel up).
 const TRIALS: usize = 2;
@@ -95,45 +97,51 @@ pub fn calibrate<S: SceneAbi>(
     let (width, height) = (scene.camera().width, scene.camera().height);
     let pixels = width as u64 * height as u64;
     let spp = CALIBRATION_PATHS.div_ceil(pixels.max(1)).clamp(1, 64) as u32;
+    let time = |schedule: Schedule| -> Result<Measurement> {
+        let mut best = Duration::MAX;
+        for _ in 0..TRIALS {
+            let mut film = Film::new(width, height);
+            let stats =
+                renderer.render_samples(scene, schedule, &mut film, 0..spp, options, &|_, _| {})?;
+            best = best.min(stats.elapsed);
+        }
+        Ok(Measurement {
+            strategy: schedule.strategy.name().to_owned(),
+            max_registers: schedule.max_registers,
+            seconds_per_mpath: best.as_secs_f64() / (pixels * spp as u64) as f64 * 1e6,
+        })
+    };
     let mut measurements = Vec::new();
     for &strategy in Strategy::ALL {
-        if strategy == Strategy::NaiveSk {
-            continue;
-        }
-        for max_registers in CAPS {
-            let schedule = Schedule {
-                strategy,
-                max_registers,
-            };
-            let mut best = Duration::MAX;
-            for _ in 0..TRIALS {
-                let mut film = Film::new(width, height);
-                let stats = renderer.render_samples(
-                    scene,
-                    schedule,
-                    &mut film,
-                    0..spp,
-                    options,
-                    &|_, _| {},
-                )?;
-                best = best.min(stats.elapsed);
-            }
-            measurements.push(Measurement {
-                strategy: strategy.name().to_owned(),
-                max_registers,
-                seconds_per_mpath: best.as_secs_f64() / (pixels * spp as u64) as f64 * 1e6,
-            });
+        if strategy != Strategy::NaiveSk {
+            measurements.push(time(strategy.into())?);
         }
     }
-    let fastest = measurements
+    let winner = fastest(&measurements).strategy.clone();
+    let strategy = Strategy::ALL
         .iter()
-        .min_by(|a, b| a.seconds_per_mpath.total_cmp(&b.seconds_per_mpath))
-        .expect("at least one candidate");
+        .copied()
+        .find(|s| s.name() == winner)
+        .expect("measured strategies are strategies");
+    for cap in CAPS {
+        measurements.push(time(Schedule {
+            strategy,
+            max_registers: Some(cap),
+        })?);
+    }
+    let best = fastest(&measurements);
     Ok(Choice {
-        strategy: fastest.strategy.clone(),
-        max_registers: fastest.max_registers,
+        strategy: best.strategy.clone(),
+        max_registers: best.max_registers,
         measurements,
     })
+}
+
+fn fastest(measurements: &[Measurement]) -> &Measurement {
+    measurements
+        .iter()
+        .min_by(|a, b| a.seconds_per_mpath.total_cmp(&b.seconds_per_mpath))
+        .expect("at least one candidate")
 }
 
 /// Choices by key (scene fingerprint, GPU and math), kept in memory and in a JSON file.
