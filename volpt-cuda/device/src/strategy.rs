@@ -18,10 +18,9 @@ use volpt_core::Scene;
 
 use crate::launch::{path_of, pixel_xy, LaunchParams, BLOCK_SIZE};
 use crate::nvptx::{
-    atomic_add_u64, ballot, block_broadcast_u64, block_counter_add, block_exclusive_count,
-    flush_block_counters, global_thread_index, lane_id, lanemask_lt, opaque, red_add_f64,
-    red_add_u64, shared_address, shared_to_generic, shfl_idx_u64, sync_threads, sync_threads_or,
-    thread_index, warp_sum_u64, zero_block_counters,
+    atomic_add_u64, ballot, block_broadcast_u64, block_exclusive_count, global_thread_index,
+    lane_id, lanemask_lt, opaque, red_add_f64, red_add_u64, shared_address, shared_to_generic,
+    shfl_idx_u64, sync_threads, sync_threads_or, thread_index, warp_sum_u64,
 };
 
 /// Adds the warp's counters to the launch's totals (warp-collective: every lane calls it).
@@ -45,27 +44,83 @@ unsafe fn add_counters<P>(c: &PathCounters, lp: &LaunchParams<P>) {
     }
 }
 
-/// Adds a finished path to the block's counters, in the order of `launch::COUNTERS`.
-#[inline(always)]
-fn record_in_block(path: &PathState) {
-    block_counter_add(0, 1);
-    block_counter_add(1, path.segments as u64);
-    block_counter_add(2, path.tracking_steps as u64);
-    if path.truncated != Truncation::None {
-        block_counter_add(3, 1);
-        if path.truncated == Truncation::TrackingSteps {
-            block_counter_add(4, 1);
+/// A thread's counts of the paths it finished, in 32 bits: three registers across the path loop
+/// instead of five 64-bit totals (or contended 64-bit shared-memory atomics). A count that would
+/// overflow goes to the launch's totals at once; the rest goes there at the end ([`Self::flush`]);
+/// the rare truncated paths go there directly.
+#[derive(Default)]
+struct ThreadCounters {
+    paths: u32,
+    segments: u32,
+    tracking_steps: u32,
+}
+
+impl ThreadCounters {
+    /// # Safety
+    /// `totals` must be the launch's `launch::COUNTERS` totals.
+    #[inline(always)]
+    unsafe fn record(&mut self, path: &PathState, totals: *mut u64) {
+        // SAFETY: the caller's contract; the indices are those of `launch::COUNTERS`.
+        unsafe {
+            Self::add(&mut self.paths, 1, totals);
+            Self::add(&mut self.segments, path.segments, totals.add(1));
+            Self::add(&mut self.tracking_steps, path.tracking_steps, totals.add(2));
+            if path.truncated != Truncation::None {
+                red_add_u64(totals.add(3), 1);
+                if path.truncated == Truncation::TrackingSteps {
+                    red_add_u64(totals.add(4), 1);
+                }
+            }
         }
+    }
+
+    /// # Safety
+    /// `total` must be a valid global `u64`.
+    #[inline(always)]
+    unsafe fn add(count: &mut u32, v: u32, total: *mut u64) {
+        match count.checked_add(v) {
+            Some(sum) => *count = sum,
+            None => {
+                // SAFETY: the caller's contract.
+                unsafe { red_add_u64(total, *count as u64 + v as u64) };
+                *count = 0;
+            }
+        }
+    }
+
+    /// Adds the counts to the launch's totals (warp-collective: every lane calls it).
+    ///
+    /// # Safety
+    /// As [`add_counters`].
+    #[inline(always)]
+    unsafe fn flush<P>(self, lp: &LaunchParams<P>) {
+        let counters = PathCounters {
+            paths: self.paths as u64,
+            segments: self.segments as u64,
+            tracking_steps: self.tracking_steps as u64,
+            truncated: 0,
+            truncated_tracking: 0,
+        };
+        // SAFETY: forwarded.
+        unsafe { add_counters(&counters, lp) };
     }
 }
 
 /// Records a finished path: its counts, and its radiance added to its pixel's `f64` sums.
 ///
 /// # Safety
-/// `film` must hold the `3 * pixels` sums and `pixel` be inside it.
+/// `film` must hold the `3 * pixels` sums and `pixel` be inside it; `totals` must be the launch's
+/// `launch::COUNTERS` totals.
 #[inline(always)]
-unsafe fn finish_path(path: &PathState, pixel: u32, film: *mut f64) {
-    record_in_block(path);
+unsafe fn finish_path(
+    path: &PathState,
+    pixel: u32,
+    film: *mut f64,
+    counters: &mut ThreadCounters,
+    totals: *mut u64,
+) {
+    // SAFETY: the caller's contract.
+    unsafe { counters.record(path, totals) };
     for c in 0..3 {
         let value = path.radiance[c];
         if value != 0.0 {
@@ -184,7 +239,8 @@ unsafe fn regeneration<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, refill: Ref
     let pixels = (width * scene.camera().height) as u64;
     let film = lp.film as *mut f64;
     let next_path = lp.next_path as *mut u64;
-    zero_block_counters();
+    let mut counters = ThreadCounters::default();
+    let totals = lp.counters as *mut u64;
     // A placeholder until the first refill; `active` says whether `path` is a live path.
     let mut path = PathState::from_camera(scene, 0, 0, 0, lp.seed);
     let mut pixel = 0u32;
@@ -218,13 +274,13 @@ unsafe fn regeneration<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, refill: Ref
             step(scene, &mut path);
             if !path.alive {
                 // SAFETY: `pixel` is inside the film.
-                unsafe { finish_path(&path, pixel, film) };
+                unsafe { finish_path(&path, pixel, film, &mut counters, totals) };
                 active = false;
             }
         }
     }
     // SAFETY: `lp.counters` holds `COUNTERS` totals.
-    unsafe { flush_block_counters(lp.counters as *mut u64) };
+    unsafe { counters.flush(lp) };
 }
 
 /// regenerationSK at block level: after every step the block counts its idle lanes (a block-wide
@@ -238,7 +294,8 @@ pub unsafe fn regeneration_block_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>
     let pixels = (width * scene.camera().height) as u64;
     let film = lp.film as *mut f64;
     let next_path = lp.next_path as *mut u64;
-    zero_block_counters();
+    let mut counters = ThreadCounters::default();
+    let totals = lp.counters as *mut u64;
     let mut path = PathState::from_camera(scene, 0, 0, 0, lp.seed);
     let mut pixel = 0u32;
     let mut active = false;
@@ -266,13 +323,13 @@ pub unsafe fn regeneration_block_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>
             step(scene, &mut path);
             if !path.alive {
                 // SAFETY: `pixel` is inside the film.
-                unsafe { finish_path(&path, pixel, film) };
+                unsafe { finish_path(&path, pixel, film, &mut counters, totals) };
                 active = false;
             }
         }
     }
     // SAFETY: `lp.counters` holds `COUNTERS` totals.
-    unsafe { flush_block_counters(lp.counters as *mut u64) };
+    unsafe { counters.flush(lp) };
 }
 
 /// A path parked in shared memory while the block compacts: its state and its pixel.
@@ -305,7 +362,8 @@ pub unsafe fn streaming_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     let next_path = lp.next_path as *mut u64;
     let slots = shared_to_generic(shared_address!("volpt_stream_slots")) as *mut Slot;
     let thread = thread_index();
-    zero_block_counters();
+    let mut counters = ThreadCounters::default();
+    let totals = lp.counters as *mut u64;
     let mut slot = Slot {
         path: PathState::from_camera(scene, 0, 0, 0, lp.seed),
         pixel: 0,
@@ -317,7 +375,7 @@ pub unsafe fn streaming_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
             step(scene, &mut slot.path);
             if !slot.path.alive {
                 // SAFETY: `pixel` is inside the film.
-                unsafe { finish_path(&slot.path, slot.pixel, film) };
+                unsafe { finish_path(&slot.path, slot.pixel, film, &mut counters, totals) };
                 active = false;
             }
         }
@@ -355,5 +413,5 @@ pub unsafe fn streaming_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
         }
     }
     // SAFETY: `lp.counters` holds `COUNTERS` totals.
-    unsafe { flush_block_counters(lp.counters as *mut u64) };
+    unsafe { counters.flush(lp) };
 }
