@@ -187,7 +187,6 @@ impl<'a> LatLongEnvironment<'a> {
         f / total * (self.width as f32 * self.height as f32) / (2.0 * PI * PI * sin_theta)
     }
 
-
     #[inline]
     fn texel(&self, x: u32, y: u32) -> Spectrum {
         let i = 3 * (y as usize * self.width as usize + x as usize);
@@ -230,7 +229,11 @@ impl Environment for LatLongEnvironment<'_> {
         let x = u.y * total;
         let j = find_interval(marginal, h, x);
         let row = &rows[j * (w + 1)..(j + 1) * (w + 1)];
-        let dy = clamp((x - marginal[j]) / (marginal[j + 1] - marginal[j]), 0.0, 1.0);
+        let dy = clamp(
+            (x - marginal[j]) / (marginal[j + 1] - marginal[j]),
+            0.0,
+            1.0,
+        );
         let xr = u.x * row[w];
         let i = find_interval(row, w, xr);
         let f = row[i + 1] - row[i];

@@ -251,7 +251,9 @@ impl MajorantGridParams {
         }
         Some(MajorantGrid {
             // SAFETY: the caller guarantees the address range.
-            data: unsafe { core::slice::from_raw_parts(self.data as *const f32, self.len as usize) },
+            data: unsafe {
+                core::slice::from_raw_parts(self.data as *const f32, self.len as usize)
+            },
             res: self.res,
             bounds: Aabb::new(
                 Vec3::from_array(self.bounds_min),

@@ -110,9 +110,15 @@ pub fn delta_tracking<M: Medium>(
     steps: &mut u32,
     max_steps: u32,
 ) -> FreeFlight {
-    walk_majorants(medium, ray, t_max, rng, steps, max_steps, |rng, t, majorant| {
-        M::HOMOGENEOUS || rng.next_f32() * majorant < medium.sigma_t(ray.at(t))
-    })
+    walk_majorants(
+        medium,
+        ray,
+        t_max,
+        rng,
+        steps,
+        max_steps,
+        |rng, t, majorant| M::HOMOGENEOUS || rng.next_f32() * majorant < medium.sigma_t(ray.at(t)),
+    )
 }
 
 /// An unbiased estimate of the transmittance `exp(-int_0^t_max sigma_t)` along `ray`, or `None`
@@ -135,17 +141,25 @@ pub fn ratio_tracking<M: Medium>(
         return Some(exp(-medium.majorant() * t_max));
     }
     let mut transmittance = 1.0f32;
-    let flight = walk_majorants(medium, ray, t_max, rng, steps, max_steps, |rng, t, majorant| {
-        transmittance *= 1.0 - medium.sigma_t(ray.at(t)) / majorant;
-        if transmittance < 0.125 {
-            if rng.next_f32() < 0.5 {
-                transmittance *= 2.0;
-            } else {
-                transmittance = 0.0;
+    let flight = walk_majorants(
+        medium,
+        ray,
+        t_max,
+        rng,
+        steps,
+        max_steps,
+        |rng, t, majorant| {
+            transmittance *= 1.0 - medium.sigma_t(ray.at(t)) / majorant;
+            if transmittance < 0.125 {
+                if rng.next_f32() < 0.5 {
+                    transmittance *= 2.0;
+                } else {
+                    transmittance = 0.0;
+                }
             }
-        }
-        transmittance <= 0.0
-    });
+            transmittance <= 0.0
+        },
+    );
     match flight {
         FreeFlight::OutOfSteps => None,
         FreeFlight::Collision(_) => Some(0.0),

@@ -22,9 +22,9 @@ use std::fmt;
 use volpt_core::abi::SceneAbi;
 use volpt_core::grid::{Grid, GridMapping};
 use volpt_core::majorant::{build_majorants, MajorantGrid};
-use volpt_core::path::Estimator;
 use volpt_core::math::tan;
 use volpt_core::microfacet::Ggx;
+use volpt_core::path::Estimator;
 use volpt_core::{
     Aabb, ConstantAlbedo, ConstantEnvironment, GridAlbedo, GridMedium, HenyeyGreenstein,
     HomogeneousMedium, Isotropic, LatLongEnvironment, LatLongRows, NullBoundary, PathSettings,
@@ -316,14 +316,15 @@ impl Derived {
             MediumPart::GridDensity(m) => Some((m.density, m.scale)),
             MediumPart::GridDensityAlbedo(m) => Some((m.density, m.scale)),
         };
-        let majorants = density
-            .filter(|_| settings.majorant_resolution > 1)
-            .map(|(density, scale)| {
-                let res = MajorantGrid::resolution_for(bounds, settings.majorant_resolution);
-                let mut data = vec![0.0; res.iter().map(|&r| r as usize).product()];
-                build_majorants(&density, scale, bounds, res, &mut data);
-                (data, res)
-            });
+        let majorants =
+            density
+                .filter(|_| settings.majorant_resolution > 1)
+                .map(|(density, scale)| {
+                    let res = MajorantGrid::resolution_for(bounds, settings.majorant_resolution);
+                    let mut data = vec![0.0; res.iter().map(|&r| r as usize).product()];
+                    build_majorants(&density, scale, bounds, res, &mut data);
+                    (data, res)
+                });
         let distribution = match &parts.environment {
             EnvironmentPart::LatLong(map) if settings.estimator == Estimator::NextEvent => {
                 let mut data =
