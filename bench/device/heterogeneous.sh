@@ -3,7 +3,8 @@
 # device machine from the bundle (`cargo xtask device-bundle`), like run.sh:
 #
 #   bash bundle/heterogeneous.sh        # writes under $OUT (default: ./out)
-#   BACKEND=cpu bash heterogeneous.sh   # the same measurements on the CPU backend (for testing)
+#   ROOT=. BACKEND=cpu VOLPT=$PWD/target/release/volpt DATA=../shared/data SIZE=100x100 SPP=16 \
+#       bash bench/device/heterogeneous.sh   # the same on the CPU backend (docs/heterogeneous.md)
 #
 # 1. naive-sk vs CPU bit-identity (4 spp, 64x64) for the grid and the nee variants, and for today's
 #    algorithm (--tracking global --estimator pt);
@@ -11,7 +12,7 @@
 #    cgg-logo with global majorant vs majorant grids of 8, 16, 32, 64 cells (path tracing), and pt vs
 #    nee with the default grid; summary.csv has time, tracking steps and segments per path.
 set -uo pipefail
-cd "$(dirname "$0")"
+cd "${ROOT:-$(dirname "$0")}"
 OUT=${OUT:-$PWD/out}
 mkdir -p "$OUT"
 VOLPT=${VOLPT:-$PWD/bin/volpt}
@@ -20,6 +21,7 @@ TRIALS=${TRIALS:-3}
 BACKEND=${BACKEND:-cuda}
 RESOLUTIONS=${RESOLUTIONS:-8 16 32 64}
 SIZE=${SIZE:-400x400}
+SPP=${SPP:-100}          # bucky renders 3x this
 failures=0
 log() { echo "== $*" | tee -a "$OUT/summary.txt"; }
 if [ "$BACKEND" = cuda ]; then
@@ -93,8 +95,8 @@ PY
 for entry in "${SCENES[@]}"; do
     IFS=: read -r name file params <<<"$entry"
     [ -f "$file" ] || continue
-    spp=100
-    [ "$name" = bucky ] && spp=300
+    spp=$SPP
+    [ "$name" = bucky ] && spp=$((3 * SPP))
     bench "$name" global-pt "$file" "$params" --spp $spp --tracking global --estimator pt
     for r in $RESOLUTIONS; do
         bench "$name" "grid$r-pt" "$file" "$params" --spp $spp --majorant-resolution "$r" --estimator pt
