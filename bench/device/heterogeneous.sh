@@ -9,8 +9,10 @@
 # 1. naive-sk vs CPU bit-identity (4 spp, 64x64) for the grid and the nee variants, and for today's
 #    algorithm (--tracking global --estimator pt);
 # 2. `volpt bench --json` (regeneration-sk) at 400x400, 100 spp (bucky 300): smoke, bucky, ad and
-#    cgg-logo with global majorant vs majorant grids of 8, 16, 32, 64 cells (path tracing), and pt vs
-#    nee with the default grid; summary.csv has time, tracking steps and segments per path.
+#    cgg-logo with global majorant vs majorant grids of 8, 16, 32, 64 cells (path tracing), pt vs
+#    nee with the default grid, and pt vs nee on envmap-cube with an index-matched boundary;
+#    summary.csv has time, tracking steps and segments per path. Efficiency (1 / (MSE x time)) of
+#    nee vs pt: `volpt converge --backend cuda --setting estimator=pt,nee` (docs/heterogeneous.md).
 set -uo pipefail
 cd "${ROOT:-$(dirname "$0")}"
 OUT=${OUT:-$PWD/out}
@@ -50,7 +52,7 @@ VARIANTS=(
     "global-nee:--tracking global --estimator nee"
 )
 
-for entry in "${SCENES[@]}" "envmap-cube:scenes/envmap-cube/scene.xml:"; do
+for entry in "${SCENES[@]}" "envmap-cube:scenes/envmap-cube/index-matched.xml:"; do
     IFS=: read -r name file params <<<"$entry"
     [ -f "$file" ] || { log "SKIP $name: $file not in this bundle"; continue; }
     for v in "${VARIANTS[@]}"; do
@@ -103,6 +105,12 @@ for entry in "${SCENES[@]}"; do
     done
     bench "$name" grid-nee "$file" "$params" --spp $spp --estimator nee
 done
+# NEE where its default applies: envmap-cube's sun through an index-matched boundary.
+file=scenes/envmap-cube/index-matched.xml
+if [ -f "$file" ]; then
+    bench envmap-cube-index-matched pt "$file" "" --spp "$SPP" --estimator pt
+    bench envmap-cube-index-matched nee "$file" "" --spp "$SPP" --estimator nee
+fi
 
 log "failures $failures"
 tar -czf "$OUT/heterogeneous-json.tar.gz" -C "$OUT" $(cd "$OUT" && ls bench-*.json) 2>/dev/null && rm -f "$OUT"/bench-*.json

@@ -4,7 +4,9 @@ use std::fmt::Write;
 use std::path::Path;
 
 use volpt_core::{Estimator, PathSettings};
-use volpt_render::factory::{majorant_ratio, BoundaryKind, Derived, Effects, MediumKind, Parts};
+use volpt_render::factory::{
+    majorant_ratio, BoundaryKind, Derived, Effects, EnvironmentKind, MediumKind, Parts,
+};
 use volpt_scene::{
     AlbedoDesc, BsdfDesc, DensityDesc, EnvironmentDesc, GridDesc, PhaseDesc, SceneDescription,
 };
@@ -126,6 +128,9 @@ fn tracking(desc: &SceneDescription, parts: &Parts<'_>, settings: &PathSettings)
     );
     let how = match derived.majorant_resolution() {
         Some([x, y, z]) => format!("majorant grid {x}x{y}x{z}, DDA"),
+        None if settings.majorant_resolution > 1 => {
+            "one global majorant (every cell of a majorant grid would have it)".to_owned()
+        }
         None => "one global majorant".to_owned(),
     };
     match majorant_ratio(desc, *settings) {
@@ -136,16 +141,24 @@ fn tracking(desc: &SceneDescription, parts: &Parts<'_>, settings: &PathSettings)
     }
 }
 
-/// The estimator the paths use, and why where the requested one does not apply.
+/// The estimator the paths use, and why.
 fn estimator(parts: &Parts<'_>, settings: &PathSettings) -> &'static str {
-    match (settings.estimator, parts.boundary.kind()) {
-        (Estimator::PathTracing, _) => "path tracing",
-        (Estimator::NextEvent, BoundaryKind::IndexMatched) => {
-            "next-event estimation of the environment (ratio tracking, MIS with the phase function)"
-        }
-        (Estimator::NextEvent, _) => {
+    let index_matched = parts.boundary.kind() == BoundaryKind::IndexMatched;
+    match (settings.estimator, index_matched) {
+        (_, false) => {
             "path tracing: the dielectric boundary reflects and refracts, so no straight shadow ray \
              reaches the environment (next-event estimation needs an index-matched boundary)"
+        }
+        (Estimator::NextEvent, true) => {
+            "next-event estimation of the environment (ratio tracking, MIS with the phase function)"
+        }
+        (Estimator::PathTracing, true) => {
+            if parts.environment.kind() == EnvironmentKind::Constant {
+                "path tracing (next-event estimation of a constant environment costs more than its \
+                 lower variance saves; --estimator nee)"
+            } else {
+                "path tracing (--estimator nee samples the map)"
+            }
         }
     }
 }

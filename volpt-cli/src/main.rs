@@ -102,14 +102,14 @@ struct SceneArgs {
     /// map) instead of the one specialised to the scene's effects: what specialisation saves.
     #[arg(long)]
     general: bool,
-    /// Delta and ratio tracking under one global majorant or a majorant grid (default: grid).
+    /// Delta and ratio tracking under one global majorant or a majorant grid (default: a grid of 32 cells along the longest axis).
     #[arg(long, value_enum)]
     tracking: Option<Tracking>,
     /// Cells of the majorant grid along the box's longest axis (1 is the global majorant).
     #[arg(long, value_name = "CELLS", value_parser = clap::value_parser!(u32).range(1..=1024))]
     majorant_resolution: Option<u32>,
-    /// How paths gather the environment's light (default: nee behind an index-matched boundary,
-    /// where it applies; pt elsewhere).
+    /// How paths gather the environment's light (default: nee for a lat-long map behind an
+    /// index-matched boundary, pt elsewhere; nee needs an index-matched boundary).
     #[arg(long, value_enum)]
     estimator: Option<EstimatorArg>,
 }

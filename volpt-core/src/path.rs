@@ -60,7 +60,7 @@ pub struct PathSettings {
 impl PathSettings {
     pub const UNLIMITED: u32 = u32::MAX;
     /// Measured on the thesis scenes (`docs/heterogeneous.md`).
-    pub const DEFAULT_MAJORANT_RESOLUTION: u32 = 16;
+    pub const DEFAULT_MAJORANT_RESOLUTION: u32 = 32;
 }
 
 /// How a path gathers the environment's light.
@@ -85,7 +85,8 @@ impl Default for PathSettings {
             // scene whose majorant is not wasted (the thesis scenes use ~100 steps per path).
             max_tracking_steps: 1 << 26,
             majorant_resolution: Self::DEFAULT_MAJORANT_RESOLUTION,
-            estimator: Estimator::NextEvent,
+            // The render factory picks the estimator per scene (`default_estimator`).
+            estimator: Estimator::PathTracing,
         }
     }
 }

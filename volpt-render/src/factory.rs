@@ -316,15 +316,20 @@ impl Derived {
             MediumPart::GridDensity(m) => Some((m.density, m.scale)),
             MediumPart::GridDensityAlbedo(m) => Some((m.density, m.scale)),
         };
-        let majorants =
-            density
-                .filter(|_| settings.majorant_resolution > 1)
-                .map(|(density, scale)| {
-                    let res = MajorantGrid::resolution_for(bounds, settings.majorant_resolution);
-                    let mut data = vec![0.0; res.iter().map(|&r| r as usize).product()];
-                    build_majorants(&density, scale, bounds, res, &mut data);
-                    (data, res)
-                });
+        let majorants = density
+            .filter(|_| settings.majorant_resolution > 1)
+            .map(|(density, scale)| {
+                let res = MajorantGrid::resolution_for(bounds, settings.majorant_resolution);
+                let mut data = vec![0.0; res.iter().map(|&r| r as usize).product()];
+                build_majorants(&density, scale, bounds, res, &mut data);
+                (data, res)
+            })
+            // A grid whose every cell has the global bound (a uniform density, as ad's) saves no
+            // step and costs the walk: track with the global majorant.
+            .filter(|(data, _)| {
+                let global = data.iter().copied().fold(0.0, f32::max);
+                data.iter().any(|&m| m < global)
+            });
         let distribution = match &parts.environment {
             EnvironmentPart::LatLong(map) if settings.estimator == Estimator::NextEvent => {
                 let mut data =
@@ -585,12 +590,25 @@ pub fn camera(desc: &CameraDesc, film: &FilmDesc) -> PerspectiveCamera {
     }
 }
 
-/// The integrator settings a scene file asks for.
+/// The integrator settings a scene file asks for, with the estimator chosen for the scene.
 pub fn path_settings(desc: &SceneDescription) -> PathSettings {
     PathSettings {
         max_depth: desc.integrator.max_depth.unwrap_or(PathSettings::UNLIMITED),
         rr_depth: desc.integrator.rr_depth.unwrap_or(PathSettings::UNLIMITED),
+        estimator: default_estimator(desc),
         ..PathSettings::default()
+    }
+}
+
+/// Next-event estimation where it pays: a lat-long map behind an index-matched boundary (3x the
+/// efficiency of path tracing on envmap-cube with an index-matched boundary). Under a constant
+/// environment a path tracer's escaping path already sees the whole light, and NEE's shadow rays
+/// cost more than its lower variance saves (smoke: 0.6x); a dielectric boundary rules NEE out
+/// (`docs/heterogeneous.md`).
+pub fn default_estimator(desc: &SceneDescription) -> Estimator {
+    match (&desc.boundary.bsdf, &desc.environment) {
+        (BsdfDesc::Null, EnvironmentDesc::LatLong(_)) => Estimator::NextEvent,
+        _ => Estimator::PathTracing,
     }
 }
 
