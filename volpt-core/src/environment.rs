@@ -158,7 +158,7 @@ impl<'a> LatLongEnvironment<'a> {
 
     /// Map-space direction to its world direction (the rotation's transpose).
     #[inline]
-    fn to_world(&self, v: Vec3) -> Vec3 {
+    fn map_dir_to_world(&self, v: Vec3) -> Vec3 {
         self.world_to_map[0] * v.x + self.world_to_map[1] * v.y + self.world_to_map[2] * v.z
     }
 
@@ -223,7 +223,7 @@ impl Environment for LatLongEnvironment<'_> {
         }
         let (rows, marginal) = self.distribution.split_at(h * (w + 1));
         let total = marginal[h];
-        if !(total > 0.0) {
+        if total.is_nan() || total <= 0.0 {
             return None;
         }
         let x = u.y * total;
@@ -241,12 +241,12 @@ impl Environment for LatLongEnvironment<'_> {
         let (cu, cv) = ((i as f32 + dx) / w as f32, (j as f32 + dy) / h as f32);
         let (sin_theta, cos_theta) = sin_cos(PI * cv);
         let pdf = self.density(f, total, sin_theta);
-        if !(pdf > 0.0) || !pdf.is_finite() {
+        if !(pdf.is_finite() && pdf > 0.0) {
             return None;
         }
         let (sin_phi, cos_phi) = sin_cos_2pi(cu);
         let dir = self
-            .to_world(Vec3::new(
+            .map_dir_to_world(Vec3::new(
                 sin_theta * sin_phi,
                 cos_theta,
                 -sin_theta * cos_phi,

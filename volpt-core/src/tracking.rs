@@ -87,8 +87,8 @@ pub fn walk_majorants<M: Medium>(
                 }
             }
         }
-        // `!(end < t_max)` also ends a walk whose crossings are NaN.
-        if !(end < t_max) {
+        // Anything but `end < t_max` ends the walk, a NaN `end` or `t_max` included.
+        if end.partial_cmp(&t_max) != Some(core::cmp::Ordering::Less) {
             return FreeFlight::Escaped;
         }
         start = start.max(end);
