@@ -3,7 +3,7 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::abi::{Component, Upload};
-use crate::math::{clamp, sin_cos, sin_cos_2pi, INV_4PI, INV_PI, PI};
+use crate::math::{clamp, sin_cos_2pi, INV_4PI, INV_PI, PI};
 use crate::sampling::sample_uniform_sphere;
 use crate::{Spectrum, Vec2, Vec3};
 
@@ -239,7 +239,8 @@ impl Environment for LatLongEnvironment<'_> {
         let f = row[i + 1] - row[i];
         let dx = clamp((xr - row[i]) / f, 0.0, 1.0);
         let (cu, cv) = ((i as f32 + dx) / w as f32, (j as f32 + dy) / h as f32);
-        let (sin_theta, cos_theta) = sin_cos(PI * cv);
+        // `sin_cos_2pi` of half a turn per unit: no argument reduction (see `math::sin_cos_2pi`).
+        let (sin_theta, cos_theta) = sin_cos_2pi(0.5 * cv);
         let pdf = self.density(f, total, sin_theta);
         if !(pdf.is_finite() && pdf > 0.0) {
             return None;
@@ -270,7 +271,7 @@ impl Environment for LatLongEnvironment<'_> {
         let i = ((u * w as f32) as usize).min(w - 1);
         let j = ((v * h as f32) as usize).min(h - 1);
         let f = rows[j * (w + 1) + i + 1] - rows[j * (w + 1) + i];
-        self.density(f, marginal[h], sin_cos(PI * v).0)
+        self.density(f, marginal[h], sin_cos_2pi(0.5 * v).0)
     }
 }
 

@@ -145,12 +145,41 @@ pub fn build_majorants(
 }
 
 /// Where a ray is in the majorant grid: the current cell and, per axis, the distance along the ray
-/// to the next cell boundary and between boundaries.
+/// to the next cell boundary and between boundaries. Named scalars, not arrays: a GPU keeps them in
+/// registers, where an array indexed by a computed axis would go to local memory.
 #[derive(Clone, Copy, Debug)]
 pub struct Dda {
     cell: [i32; 3],
-    next_crossing: [f32; 3],
-    delta: [f32; 3],
+    next_crossing: Vec3,
+    delta: Vec3,
+}
+
+/// One axis of [`Dda::new`]: the cell of grid coordinate `origin` (clamped into `0..res`), the
+/// distance to its boundary along the direction `dir` (grid units per unit of `t`) and between
+/// boundaries; infinite along an axis the ray does not move on.
+#[inline(always)]
+fn start_axis(origin: f32, dir: f32, res: f32) -> (i32, f32, f32) {
+    let cell = libm::floorf(origin).clamp(0.0, res - 1.0);
+    if dir > 0.0 {
+        (cell as i32, (cell + 1.0 - origin) / dir, 1.0 / dir)
+    } else if dir < 0.0 {
+        (cell as i32, (cell - origin) / dir, -1.0 / dir)
+    } else {
+        (cell as i32, f32::INFINITY, f32::INFINITY)
+    }
+}
+
+/// Moves one axis of a [`Dda`] to its next cell; where that would leave the grid the ray stays in
+/// its cell for ever (the crossing becomes infinite).
+#[inline(always)]
+fn step_axis(cell: &mut i32, next_crossing: &mut f32, delta: f32, dir: f32, res: u32) {
+    let next = *cell + if dir > 0.0 { 1 } else { -1 };
+    if next < 0 || next >= res as i32 {
+        *next_crossing = f32::INFINITY;
+    } else {
+        *cell = next;
+        *next_crossing += delta;
+    }
 }
 
 impl Dda {
@@ -162,54 +191,56 @@ impl Dda {
         let to_grid = res / grid.bounds.extent();
         let origin = (ray.origin - grid.bounds.min) * to_grid;
         let dir = ray.dir * to_grid;
-        let mut dda = Self {
-            cell: [0; 3],
-            next_crossing: [f32::INFINITY; 3],
-            delta: [f32::INFINITY; 3],
-        };
-        for a in 0..3 {
-            let cell = libm::floorf(origin[a]).clamp(0.0, res[a] - 1.0);
-            dda.cell[a] = cell as i32;
-            if dir[a] > 0.0 {
-                dda.next_crossing[a] = (cell + 1.0 - origin[a]) / dir[a];
-                dda.delta[a] = 1.0 / dir[a];
-            } else if dir[a] < 0.0 {
-                dda.next_crossing[a] = (cell - origin[a]) / dir[a];
-                dda.delta[a] = -1.0 / dir[a];
-            }
+        let (cx, nx, dx) = start_axis(origin.x, dir.x, res.x);
+        let (cy, ny, dy) = start_axis(origin.y, dir.y, res.y);
+        let (cz, nz, dz) = start_axis(origin.z, dir.z, res.z);
+        Self {
+            cell: [cx, cy, cz],
+            next_crossing: Vec3::new(nx, ny, nz),
+            delta: Vec3::new(dx, dy, dz),
         }
-        dda
     }
 
     /// The majorant of the current cell and the distance at which the ray leaves it (infinite in
     /// the last cell the ray reaches: the caller's own end, the box's exit, ends the walk there).
     #[inline]
     pub fn segment(&self, grid: &MajorantGrid<'_>) -> (f32, f32) {
-        let end = self.next_crossing[0]
-            .min(self.next_crossing[1])
-            .min(self.next_crossing[2]);
         let [x, y, z] = self.cell;
-        (grid.at(x as u32, y as u32, z as u32), end)
+        (
+            grid.at(x as u32, y as u32, z as u32),
+            self.next_crossing.min_element(),
+        )
     }
 
-    /// Moves into the next cell along the ray. Where that would leave the grid, the ray stays in
-    /// its cell for ever: points rounding puts just past the box's exit keep a bound.
+    /// Moves into the next cell along the ray, across the nearest boundary.
     #[inline]
     pub fn advance(&mut self, grid: &MajorantGrid<'_>, dir: Vec3) {
-        let n = &self.next_crossing;
-        let a = if n[0] <= n[1] && n[0] <= n[2] {
-            0
-        } else if n[1] <= n[2] {
-            1
+        let n = self.next_crossing;
+        let [cx, cy, cz] = &mut self.cell;
+        if n.x <= n.y && n.x <= n.z {
+            step_axis(
+                cx,
+                &mut self.next_crossing.x,
+                self.delta.x,
+                dir.x,
+                grid.res[0],
+            );
+        } else if n.y <= n.z {
+            step_axis(
+                cy,
+                &mut self.next_crossing.y,
+                self.delta.y,
+                dir.y,
+                grid.res[1],
+            );
         } else {
-            2
-        };
-        let cell = self.cell[a] + if dir[a] > 0.0 { 1 } else { -1 };
-        if cell < 0 || cell >= grid.res[a] as i32 {
-            self.next_crossing[a] = f32::INFINITY;
-        } else {
-            self.cell[a] = cell;
-            self.next_crossing[a] += self.delta[a];
+            step_axis(
+                cz,
+                &mut self.next_crossing.z,
+                self.delta.z,
+                dir.z,
+                grid.res[2],
+            );
         }
     }
 }

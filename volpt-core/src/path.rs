@@ -241,8 +241,9 @@ pub fn trace<S: Scene>(scene: &S, path: &mut PathState) {
 /// Traces samples `samples` of pixel `(px, py)` in order and adds their radiance to `sum` in `f64`.
 ///
 /// This is the per-pixel loop of the CPU renderer and of the GPU's naive strategy: one loop, one
-/// summation order, so their images agree bit for bit.
-#[inline]
+/// summation order, so their images agree bit for bit. Always inlined, like [`step`]: a GPU call
+/// taking the scene by address moves it into local memory.
+#[inline(always)]
 pub fn sample_pixel<S: Scene>(
     scene: &S,
     (px, py): (u32, u32),
@@ -263,7 +264,8 @@ pub fn sample_pixel<S: Scene>(
 
 /// A real collision at `p`: the albedo scales the throughput (the scattering/extinction ratio of the
 /// collision estimator) and the phase function, sampled exactly, gives the new direction.
-#[inline]
+/// Always inlined: a GPU call taking the scene by address moves it into local memory.
+#[inline(always)]
 fn scatter<S: Scene>(scene: &S, path: &mut PathState, p: Vec3) {
     let settings = scene.settings();
     if !path.begin_interaction(settings) {
@@ -295,7 +297,7 @@ fn scatter<S: Scene>(scene: &S, path: &mut PathState, p: Vec3) {
 /// its light takes the complementary weight. Both strategies together are unbiased. Valid only
 /// where nothing but the medium lies between `p` and the environment: an index-matched boundary.
 /// False (and the path is cut) when ratio tracking runs out of steps.
-#[inline]
+#[inline(always)]
 fn next_event_estimate<S: Scene>(scene: &S, path: &mut PathState, p: Vec3) -> bool {
     let Some(light) = scene.environment().sample(path.rng.next_2d()) else {
         return true;

@@ -128,7 +128,10 @@ pub fn delta_tracking<M: Medium>(
 /// over the tentative collisions. Once the product falls below 1/8, Russian roulette ends it with
 /// probability 1/2 (doubling it otherwise), so that a dense medium costs a bounded number of steps
 /// per shadow ray without bias. A homogeneous medium needs no estimate: `exp(-sigma_t t_max)`.
-#[inline]
+///
+/// Always inlined: as a call on a GPU it takes the medium by address, which moves the whole scene
+/// into local memory (a ~450-byte stack frame per thread).
+#[inline(always)]
 pub fn ratio_tracking<M: Medium>(
     medium: &M,
     ray: &Ray,
