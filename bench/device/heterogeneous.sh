@@ -113,5 +113,6 @@ if [ -f "$file" ]; then
 fi
 
 log "failures $failures"
-tar -czf "$OUT/heterogeneous-json.tar.gz" -C "$OUT" $(cd "$OUT" && ls bench-*.json) 2>/dev/null && rm -f "$OUT"/bench-*.json
+# Few files come back from the device: the summaries, and one archive of the JSON and logs.
+(cd "$OUT" && tar -czf heterogeneous-details.tar.gz -- *.json *.log 2>/dev/null && rm -f -- *.json *.log)
 exit $((failures > 0))
