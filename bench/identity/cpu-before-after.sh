@@ -4,6 +4,9 @@
 #
 #   bench/identity/cpu-before-after.sh OLD_VOLPT NEW_VOLPT [OUT_DIR]
 #
+# OLD_ARGS and NEW_ARGS (environment) add flags to each binary's renders, e.g.
+# NEW_ARGS="--tracking global --estimator pt" to compare a new default against the old algorithm.
+#
 # Small films and few samples keep it quick; every scene's variant and every code path it uses
 # (grids, maps, boundaries, roulette) still runs. Needs ../shared/data for smoke and bucky, and the
 # generated grids and sky (`volpt scene generate`, run here with NEW).
@@ -30,8 +33,9 @@ for entry in "${scenes[@]}"; do
     IFS=: read -r name file params <<<"$entry"
     for which in old new; do
         bin=${!which}
+        args_var=${which^^}_ARGS
         # shellcheck disable=SC2086
-        "$bin" render "$file" $params --resolution 64x64 --spp 4 --seed 5 -o "$out/$name-$which.exr" \
+        "$bin" render "$file" $params ${!args_var:-} --resolution 64x64 --spp 4 --seed 5 -o "$out/$name-$which.exr" \
             >"$out/$name-$which.log" 2>&1 || { echo "FAIL $name: $which render"; failures=$((failures + 1)); continue 2; }
     done
     if result=$("$new" compare "$out/$name-old.exr" "$out/$name-new.exr" --identical 2>&1); then

@@ -109,6 +109,16 @@ pub fn pixel_statistics(desc: &SceneDescription, spp: u32, seed: u32) -> Vec<[(f
     with_core_scene(desc, PixelStatistics { spp, seed })
 }
 
+/// [`pixel_statistics`] with the integrator settings `settings`.
+pub fn pixel_statistics_with(
+    desc: &SceneDescription,
+    spp: u32,
+    seed: u32,
+    settings: PathSettings,
+) -> Vec<[(f64, f64); 3]> {
+    with_scene(desc, settings, PixelStatistics { spp, seed })
+}
+
 struct PixelStatistics {
     spp: u32,
     seed: u32,

@@ -3,7 +3,7 @@
 //! is bathed in.
 
 use volpt_core::path::{step, trace, PathState};
-use volpt_core::PathSettings;
+use volpt_core::{Estimator, PathSettings};
 use volpt_render::{with_scene, Image, SceneVisitor};
 use volpt_scene::description::*;
 use volpt_tests::compare::{
@@ -126,8 +126,9 @@ fn assert_furnace(image: &Image, radiance: f32, tolerance: f32) {
     }
 }
 
-/// Albedo 1 inside an index-matched boundary: every path escapes with throughput exactly 1, so every
-/// pixel must be exactly the environment's radiance, whatever the density and phase function.
+/// Albedo 1 inside an index-matched boundary: every path-traced path escapes with throughput exactly
+/// 1, so every pixel must be exactly the environment's radiance, whatever the density and phase
+/// function. (With NEE the MIS weights make single paths differ; its furnace is in heterogeneous.rs.)
 #[test]
 fn white_furnace_index_matched() {
     for (sigma_t, phase) in [
@@ -143,7 +144,11 @@ fn white_furnace_index_matched() {
             BsdfDesc::Null,
             0.8,
         );
-        let (image, stats) = render_cpu(&desc, 16, 1);
+        let settings = PathSettings {
+            estimator: Estimator::PathTracing,
+            ..volpt_render::path_settings(&desc)
+        };
+        let (image, stats) = render_with(&desc, 16, 1, settings);
         assert_eq!(stats.counters.truncated, 0);
         assert_furnace(&image, 0.8, 1e-6);
     }
@@ -375,13 +380,16 @@ fn russian_roulette_is_unbiased() {
         BsdfDesc::Null,
         1.0,
     );
+    // Path tracing, so that a path killed by roulette is one with zero radiance (NEE gathers
+    // light before roulette); NEE's unbiasedness is tested in heterogeneous.rs.
     let no_rr = PathSettings {
         rr_depth: PathSettings::UNLIMITED,
+        estimator: Estimator::PathTracing,
         ..PathSettings::default()
     };
     let rr = PathSettings {
         rr_depth: 1,
-        ..PathSettings::default()
+        ..no_rr
     };
     let (reference, ref_se, _) = with_scene(&desc, no_rr, FurnaceSampleMean { paths: 200_000 });
     let (mean, se, killed) = with_scene(&desc, rr, FurnaceSampleMean { paths: 200_000 });

@@ -14,8 +14,13 @@ use volpt_scene::numerics::{check_position_resolution, MIN_FREE_PATH_SPACINGS};
 use volpt_scene::{Config, SceneAssembler, SceneBuilder, SceneError};
 use volpt_tests::{assert_matches_transmittance, cube_scene, homogeneous, look_at, render_with};
 
+/// Path tracing, whose furnaces are exact per path; NEE's furnaces hold in expectation
+/// (heterogeneous.rs).
 fn settings(desc: &SceneDescription) -> PathSettings {
-    volpt_render::path_settings(desc)
+    PathSettings {
+        estimator: volpt_core::Estimator::PathTracing,
+        ..volpt_render::path_settings(desc)
+    }
 }
 
 fn render(desc: &SceneDescription, spp: u32, seed: u32) -> (Image, RenderStats) {

@@ -26,7 +26,7 @@ use std::time::Duration;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use volpt_core::PathSettings;
+use volpt_core::{Estimator, PathSettings};
 use volpt_render::{path_settings, Effects, Image, RenderOptions};
 use volpt_scene::description::{AlbedoDesc, BsdfDesc, EnvironmentDesc};
 use volpt_scene::SceneDescription;
@@ -76,6 +76,10 @@ pub enum Choice {
     RrDepth(Option<u32>),
     /// Longest path; `None` unlimited.
     MaxDepth(Option<u32>),
+    /// Path tracing or next-event estimation (where the boundary allows it).
+    Estimator(Estimator),
+    /// Cells of the majorant grid along the longest axis; 1 is the global majorant.
+    MajorantResolution(u32),
 }
 
 impl Choice {
@@ -89,6 +93,8 @@ impl Choice {
             Choice::Roulette(false) => settings.rr_depth = PathSettings::UNLIMITED,
             Choice::RrDepth(d) => settings.rr_depth = depth(d),
             Choice::MaxDepth(d) => settings.max_depth = depth(d),
+            Choice::Estimator(e) => settings.estimator = e,
+            Choice::MajorantResolution(r) => settings.majorant_resolution = r,
         }
     }
 
@@ -98,6 +104,9 @@ impl Choice {
             Choice::Roulette(on) => format!("roulette={}", if on { "on" } else { "off" }),
             Choice::RrDepth(d) => format!("rr_depth={}", depth(d)),
             Choice::MaxDepth(d) => format!("max_depth={}", depth(d)),
+            Choice::Estimator(Estimator::PathTracing) => "estimator=pt".to_owned(),
+            Choice::Estimator(Estimator::NextEvent) => "estimator=nee".to_owned(),
+            Choice::MajorantResolution(r) => format!("majorant_resolution={r}"),
         }
     }
 }
@@ -123,8 +132,20 @@ fn parse_setting(s: &str) -> Result<Vec<Choice>, String> {
             },
             "rr_depth" => depth(v).map(Choice::RrDepth),
             "max_depth" => depth(v).map(Choice::MaxDepth),
+            "estimator" => match v {
+                "pt" => Ok(Choice::Estimator(Estimator::PathTracing)),
+                "nee" => Ok(Choice::Estimator(Estimator::NextEvent)),
+                _ => Err(format!("estimator: expected pt or nee, found {v:?}")),
+            },
+            "majorant_resolution" => match v.parse::<u32>() {
+                Ok(r) if (1..=1024).contains(&r) => Ok(Choice::MajorantResolution(r)),
+                _ => Err(format!(
+                    "majorant_resolution: expected cells from 1 to 1024, found {v:?}"
+                )),
+            },
             _ => Err(format!(
-                "unknown setting {name:?}: expected roulette, rr_depth or max_depth"
+                "unknown setting {name:?}: expected roulette, rr_depth, max_depth, estimator or \
+                 majorant_resolution"
             )),
         })
         .collect()

@@ -3,12 +3,20 @@
 use std::fmt::Write;
 use std::path::Path;
 
-use volpt_render::factory::{Effects, Parts};
+use volpt_core::{Estimator, PathSettings};
+use volpt_render::factory::{
+    majorant_ratio, BoundaryKind, Derived, Effects, EnvironmentKind, MediumKind, Parts,
+};
 use volpt_scene::{
     AlbedoDesc, BsdfDesc, DensityDesc, EnvironmentDesc, GridDesc, PhaseDesc, SceneDescription,
 };
 
-pub fn describe(path: &Path, desc: &SceneDescription, effects: Effects) -> String {
+pub fn describe(
+    path: &Path,
+    desc: &SceneDescription,
+    effects: Effects,
+    settings: &PathSettings,
+) -> String {
     let mut s = String::new();
     let b = &desc.boundary.bounds;
     let m = &desc.medium;
@@ -84,6 +92,8 @@ pub fn describe(path: &Path, desc: &SceneDescription, effects: Effects) -> Strin
     };
     let _ = writeln!(s, "density    {density}, scale {}", m.scale);
     let _ = writeln!(s, "majorant   {majorant} per unit length");
+    let _ = writeln!(s, "tracking   {}", tracking(desc, &parts, settings));
+    let _ = writeln!(s, "estimator  {}", estimator(&parts, settings));
     let albedo = match &m.albedo {
         AlbedoDesc::Constant(rgb) => format!("constant {rgb:?}"),
         AlbedoDesc::Grid(g) => grid(g),
@@ -103,4 +113,52 @@ pub fn describe(path: &Path, desc: &SceneDescription, effects: Effects) -> Strin
     };
     let _ = writeln!(s, "light      {light}");
     s
+}
+
+/// The majorants delta and ratio tracking use, and what they cost along camera rays.
+fn tracking(desc: &SceneDescription, parts: &Parts<'_>, settings: &PathSettings) -> String {
+    if parts.medium.kind() == MediumKind::Homogeneous {
+        return "homogeneous: every tentative collision is real".to_owned();
+    }
+    let bounds = &desc.boundary.bounds;
+    let derived = Derived::of(
+        parts,
+        volpt_core::Aabb::new(bounds.min.into(), bounds.max.into()),
+        settings,
+    );
+    let how = match derived.majorant_resolution() {
+        Some([x, y, z]) => format!("majorant grid {x}x{y}x{z}, DDA"),
+        None if settings.majorant_resolution > 1 => {
+            "one global majorant (every cell of a majorant grid would have it)".to_owned()
+        }
+        None => "one global majorant".to_owned(),
+    };
+    match majorant_ratio(desc, *settings) {
+        Some((ratio, global)) => format!(
+            "{how}; majorant / extinction along camera rays {ratio:.2} (global majorant {global:.2})"
+        ),
+        None => format!("{how}; camera rays see no extinction"),
+    }
+}
+
+/// The estimator the paths use, and why.
+fn estimator(parts: &Parts<'_>, settings: &PathSettings) -> &'static str {
+    let index_matched = parts.boundary.kind() == BoundaryKind::IndexMatched;
+    match (settings.estimator, index_matched) {
+        (_, false) => {
+            "path tracing: the dielectric boundary reflects and refracts, so no straight shadow ray \
+             reaches the environment (next-event estimation needs an index-matched boundary)"
+        }
+        (Estimator::NextEvent, true) => {
+            "next-event estimation of the environment (ratio tracking, MIS with the phase function)"
+        }
+        (Estimator::PathTracing, true) => {
+            if parts.environment.kind() == EnvironmentKind::Constant {
+                "path tracing (next-event estimation of a constant environment costs more than its \
+                 lower variance saves; --estimator nee)"
+            } else {
+                "path tracing (--estimator nee samples the map)"
+            }
+        }
+    }
 }

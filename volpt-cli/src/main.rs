@@ -21,6 +21,7 @@ use volpt_render::{path_settings, Image, RenderOptions, RenderStats, Variant};
 use volpt_scene::{Config, SceneAssembler, SceneDescription};
 
 use backend::{Backend, BackendKind, GpuArgs, RenderJob};
+use volpt_core::{Estimator, PathSettings};
 
 #[derive(Parser)]
 #[command(
@@ -105,9 +106,55 @@ struct SceneArgs {
     /// map) instead of the one specialised to the scene's effects: what specialisation saves.
     #[arg(long)]
     general: bool,
+    /// Delta and ratio tracking under one global majorant or a majorant grid (default: a grid of 32 cells along the longest axis).
+    #[arg(long, value_enum)]
+    tracking: Option<Tracking>,
+    /// Cells of the majorant grid along the box's longest axis (1 is the global majorant).
+    #[arg(long, value_name = "CELLS", value_parser = clap::value_parser!(u32).range(1..=1024))]
+    majorant_resolution: Option<u32>,
+    /// How paths gather the environment's light (default: nee for a lat-long map behind an
+    /// index-matched boundary, pt elsewhere; nee needs an index-matched boundary).
+    #[arg(long, value_enum)]
+    estimator: Option<EstimatorArg>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum Tracking {
+    /// One majorant, the densest voxel's extinction, everywhere.
+    Global,
+    /// A majorant per cell of a coarse grid, walked by a 3D DDA.
+    Grid,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum EstimatorArg {
+    /// Path tracing: light only where a path escapes.
+    Pt,
+    /// Next-event estimation of the environment at scattering events, with MIS.
+    Nee,
 }
 
 impl SceneArgs {
+    /// The scene's integrator settings with the command line's tracking and estimator.
+    fn settings(&self, desc: &SceneDescription) -> Result<PathSettings> {
+        let mut settings = path_settings(desc);
+        settings.majorant_resolution = match (self.tracking, self.majorant_resolution) {
+            (Some(Tracking::Global), Some(r)) if r > 1 => bail!(
+                "--tracking global uses one majorant; --majorant-resolution {r} asks for a grid"
+            ),
+            (Some(Tracking::Global), _) => 1,
+            (_, Some(r)) => r,
+            (_, None) => PathSettings::DEFAULT_MAJORANT_RESOLUTION,
+        };
+        if let Some(estimator) = self.estimator {
+            settings.estimator = match estimator {
+                EstimatorArg::Pt => Estimator::PathTracing,
+                EstimatorArg::Nee => Estimator::NextEvent,
+            };
+        }
+        Ok(settings)
+    }
+
     fn effects(&self) -> Effects {
         if self.general {
             Effects::General
@@ -251,7 +298,11 @@ fn main() -> Result<()> {
         Command::Bench(args) => bench_command(args),
         Command::Info(args) => {
             let desc = load(&args)?;
-            print!("{}", info::describe(&args.scene, &desc, args.effects()));
+            let settings = args.settings(&desc)?;
+            print!(
+                "{}",
+                info::describe(&args.scene, &desc, args.effects(), &settings)
+            );
             Ok(())
         }
         Command::Scene(SceneCommand::Export { scene, out, name }) => {
@@ -321,7 +372,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
     let desc = load(&args.scene)?;
     let job = RenderJob {
         desc: &desc,
-        settings: path_settings(&desc),
+        settings: args.scene.settings(&desc)?,
         options: options(&desc, &args.sampling)?,
         effects: args.scene.effects(),
         show_progress: true,
@@ -445,7 +496,7 @@ fn bench_command(args: BenchArgs) -> Result<()> {
     let desc = load(&args.scene)?;
     let job = RenderJob {
         desc: &desc,
-        settings: path_settings(&desc),
+        settings: args.scene.settings(&desc)?,
         options: options(&desc, &args.sampling)?,
         effects: args.scene.effects(),
         show_progress: false,

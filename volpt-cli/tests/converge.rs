@@ -20,7 +20,7 @@ fn column(csv: &str, setting: &str, name: &str) -> Vec<f64> {
         .collect()
 }
 
-/// In a white furnace every complete path returns exactly the light: unlimited depth has no error
+/// In a white furnace every complete path-traced path returns exactly the light: unlimited depth has no error
 /// at all, and max_depth 2 (paths that scatter more than once are cut) a bias that more samples
 /// do not remove, which the halves tell apart from noise.
 #[test]
@@ -32,6 +32,8 @@ fn furnace_errors_separate_bias_from_noise() {
         scene.to_str().unwrap(),
         "--resolution",
         "8x8",
+        "--setting",
+        "estimator=pt",
         "--setting",
         "max_depth=2,-1",
         "--max-spp",
@@ -47,11 +49,11 @@ fn furnace_errors_separate_bias_from_noise() {
         String::from_utf8_lossy(&out.stderr)
     );
     let csv = std::fs::read_to_string(dir.path().join("converge.csv")).unwrap();
-    let unlimited = column(&csv, "max_depth=-1", "rmse");
+    let unlimited = column(&csv, "estimator=pt max_depth=-1", "rmse");
     assert_eq!(unlimited.len(), 6, "rounds of 2, 6, ..., 126 spp: {csv}");
     assert!(unlimited.iter().all(|&e| e == 0.0), "{unlimited:?}");
-    let bias = column(&csv, "max_depth=2", "bias");
-    let variance = column(&csv, "max_depth=2", "variance");
+    let bias = column(&csv, "estimator=pt max_depth=2", "bias");
+    let variance = column(&csv, "estimator=pt max_depth=2", "variance");
     let last = bias.len() - 1;
     assert!(bias[last] > 0.1, "bias {bias:?}");
     assert!(variance[last] < variance[0] / 10.0, "variance {variance:?}");
@@ -63,7 +65,10 @@ fn furnace_errors_separate_bias_from_noise() {
         );
     }
     let table = std::fs::read_to_string(dir.path().join("table.md")).unwrap();
-    assert!(table.contains("| max_depth=2 |") && table.contains("| max_depth=-1 |"));
+    assert!(
+        table.contains("| estimator=pt max_depth=2 |")
+            && table.contains("| estimator=pt max_depth=-1 |")
+    );
 }
 
 /// A scene without an analytic value gets a rendered reference, which a second run reuses.

@@ -19,7 +19,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::camera::PerspectiveCamera;
 use crate::grid::{Grid, GridLayout, GridMapping};
-use crate::path::PathSettings;
+use crate::path::{Estimator, PathSettings};
 use crate::scene::{Scene, VolumeScene};
 use crate::{Aabb, Vec2, Vec3};
 
@@ -130,6 +130,9 @@ pub struct SettingsParams {
     pub rr_depth: u32,
     pub max_segments: u32,
     pub max_tracking_steps: u32,
+    pub majorant_resolution: u32,
+    /// 0: path tracing, 1: next-event estimation.
+    pub estimator: u32,
 }
 
 impl From<&PathSettings> for SettingsParams {
@@ -139,6 +142,11 @@ impl From<&PathSettings> for SettingsParams {
             rr_depth: s.rr_depth,
             max_segments: s.max_segments,
             max_tracking_steps: s.max_tracking_steps,
+            majorant_resolution: s.majorant_resolution,
+            estimator: match s.estimator {
+                Estimator::PathTracing => 0,
+                Estimator::NextEvent => 1,
+            },
         }
     }
 }
@@ -151,6 +159,12 @@ impl From<&SettingsParams> for PathSettings {
             rr_depth: s.rr_depth,
             max_segments: s.max_segments,
             max_tracking_steps: s.max_tracking_steps,
+            majorant_resolution: s.majorant_resolution,
+            estimator: if s.estimator == 1 {
+                Estimator::NextEvent
+            } else {
+                Estimator::PathTracing
+            },
         }
     }
 }

@@ -3,12 +3,28 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::abi::{Component, Upload};
-use crate::math::{clamp, INV_PI};
-use crate::{Spectrum, Vec3};
+use crate::math::{clamp, sin_cos_2pi, INV_4PI, INV_PI, PI};
+use crate::sampling::sample_uniform_sphere;
+use crate::{Spectrum, Vec2, Vec3};
+
+/// A direction towards the environment, sampled for next-event estimation.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// Look direction (light arrives along `-dir`).
+    pub dir: Vec3,
+    pub radiance: Spectrum,
+    /// Solid-angle density of `dir`, positive.
+    pub pdf: f32,
+}
 
 pub trait Environment {
     /// Radiance seen when looking along `dir` (arriving along `-dir`).
     fn radiance(&self, dir: Vec3) -> Spectrum;
+    /// A look direction with density roughly proportional to the radiance, or `None` when there is
+    /// none to sample (a black map, or a map without its distribution).
+    fn sample(&self, u: Vec2) -> Option<LightSample>;
+    /// The density with which [`Environment::sample`] returns `dir`.
+    fn pdf(&self, dir: Vec3) -> f32;
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -18,6 +34,20 @@ impl Environment for ConstantEnvironment {
     #[inline]
     fn radiance(&self, _dir: Vec3) -> Spectrum {
         self.0
+    }
+
+    #[inline]
+    fn sample(&self, u: Vec2) -> Option<LightSample> {
+        Some(LightSample {
+            dir: sample_uniform_sphere(u),
+            radiance: self.0,
+            pdf: INV_4PI,
+        })
+    }
+
+    #[inline]
+    fn pdf(&self, _dir: Vec3) -> f32 {
+        INV_4PI
     }
 }
 
@@ -49,6 +79,9 @@ pub struct LatLongEnvironment<'a> {
     pub scale: f32,
     pub row_scale: f32,
     pub row_offset: f32,
+    /// The sampling distribution [`LatLongEnvironment::fill_distribution`] writes, or empty (then
+    /// the map is not sampled).
+    pub distribution: &'a [f32],
 }
 
 impl<'a> LatLongEnvironment<'a> {
@@ -80,7 +113,78 @@ impl<'a> LatLongEnvironment<'a> {
             scale,
             row_scale,
             row_offset,
+            distribution: &[],
         }
+    }
+
+    /// Values of the sampling distribution of a `width x height` map.
+    pub fn distribution_len(width: u32, height: u32) -> usize {
+        height as usize * (width as usize + 1) + height as usize + 1
+    }
+
+    /// Writes the map's sampling distribution into `out` ([`Self::distribution_len`] values): a
+    /// piecewise-constant density over `width x height` cells of `(u, v)`, cell `(i, j)` weighted by
+    /// the brightest channel of the texels its bilinear lookups can read (the 3x3 around texel
+    /// `(i, j)`, so no lit direction has density 0) times `sin(theta)` at the cell's centre. The
+    /// layout is each row's running sum (`width + 1` values from 0) and then the running sum of the
+    /// rows' totals (`height + 1` values from 0); sums are taken in `f64`.
+    pub fn fill_distribution(&self, out: &mut [f32]) {
+        let (w, h) = (self.width as usize, self.height as usize);
+        assert_eq!(out.len(), Self::distribution_len(self.width, self.height));
+        let (rows, marginal) = out.split_at_mut(h * (w + 1));
+        let mut total = 0.0f64;
+        marginal[0] = 0.0;
+        for j in 0..h {
+            let sin_theta = libm::sin(PI as f64 * (j as f64 + 0.5) / h as f64);
+            let row = &mut rows[j * (w + 1)..(j + 1) * (w + 1)];
+            let mut sum = 0.0f64;
+            row[0] = 0.0;
+            for i in 0..w {
+                let mut brightest = 0.0f32;
+                for dj in [-1i64, 0, 1] {
+                    let y = (j as i64 + dj).clamp(0, h as i64 - 1) as u32;
+                    for di in [-1i64, 0, 1] {
+                        let x = (i as i64 + di).rem_euclid(w as i64) as u32;
+                        brightest = brightest.max(self.texel(x, y).max_element());
+                    }
+                }
+                sum += brightest as f64 * sin_theta;
+                row[i + 1] = sum as f32;
+            }
+            total += row[w] as f64;
+            marginal[j + 1] = total as f32;
+        }
+    }
+
+    /// Map-space direction to its world direction (the rotation's transpose).
+    #[inline]
+    fn map_dir_to_world(&self, v: Vec3) -> Vec3 {
+        self.world_to_map[0] * v.x + self.world_to_map[1] * v.y + self.world_to_map[2] * v.z
+    }
+
+    /// `(u, v)` of a world look direction, as the lookup computes them.
+    #[inline]
+    fn uv(&self, dir: Vec3) -> (f32, f32) {
+        let v = Vec3::new(
+            self.world_to_map[0].dot(dir),
+            self.world_to_map[1].dot(dir),
+            self.world_to_map[2].dot(dir),
+        );
+        let u = libm::atan2f(v.x, -v.z) * (0.5 * INV_PI);
+        let u = u - libm::floorf(u);
+        let t = libm::acosf(clamp(v.y, -1.0, 1.0)) * INV_PI;
+        (u, t)
+    }
+
+    /// The solid-angle density of cell weight `f` at polar angle `theta`: the cell's probability
+    /// `f / total` spread uniformly over its `(u, v)` area, divided by `d omega = 2 pi^2 sin(theta)
+    /// du dv`.
+    #[inline]
+    fn density(&self, f: f32, total: f32, sin_theta: f32) -> f32 {
+        if sin_theta <= 0.0 || total <= 0.0 {
+            return 0.0;
+        }
+        f / total * (self.width as f32 * self.height as f32) / (2.0 * PI * PI * sin_theta)
     }
 
     #[inline]
@@ -93,14 +197,7 @@ impl<'a> LatLongEnvironment<'a> {
 impl Environment for LatLongEnvironment<'_> {
     #[inline]
     fn radiance(&self, dir: Vec3) -> Spectrum {
-        let v = Vec3::new(
-            self.world_to_map[0].dot(dir),
-            self.world_to_map[1].dot(dir),
-            self.world_to_map[2].dot(dir),
-        );
-        let u = libm::atan2f(v.x, -v.z) * (0.5 * INV_PI);
-        let u = u - libm::floorf(u);
-        let t = libm::acosf(clamp(v.y, -1.0, 1.0)) * INV_PI;
+        let (u, t) = self.uv(dir);
         let x = u * self.width as f32 - 0.5;
         let y = clamp(
             t * self.row_scale + self.row_offset,
@@ -116,6 +213,65 @@ impl Environment for LatLongEnvironment<'_> {
         let top = self.texel(x0, y0) * (1.0 - fx) + self.texel(x1, y0) * fx;
         let bottom = self.texel(x0, y1) * (1.0 - fx) + self.texel(x1, y1) * fx;
         (top * (1.0 - fy) + bottom * fy) * self.scale
+    }
+
+    #[inline]
+    fn sample(&self, u: Vec2) -> Option<LightSample> {
+        let (w, h) = (self.width as usize, self.height as usize);
+        if self.distribution.len() != Self::distribution_len(self.width, self.height) {
+            return None;
+        }
+        let (rows, marginal) = self.distribution.split_at(h * (w + 1));
+        let total = marginal[h];
+        if total.is_nan() || total <= 0.0 {
+            return None;
+        }
+        let x = u.y * total;
+        let j = find_interval(marginal, h, x);
+        let row = &rows[j * (w + 1)..(j + 1) * (w + 1)];
+        let dy = clamp(
+            (x - marginal[j]) / (marginal[j + 1] - marginal[j]),
+            0.0,
+            1.0,
+        );
+        let xr = u.x * row[w];
+        let i = find_interval(row, w, xr);
+        let f = row[i + 1] - row[i];
+        let dx = clamp((xr - row[i]) / f, 0.0, 1.0);
+        let (cu, cv) = ((i as f32 + dx) / w as f32, (j as f32 + dy) / h as f32);
+        // `sin_cos_2pi` of half a turn per unit: no argument reduction (see `math::sin_cos_2pi`).
+        let (sin_theta, cos_theta) = sin_cos_2pi(0.5 * cv);
+        let pdf = self.density(f, total, sin_theta);
+        if !(pdf.is_finite() && pdf > 0.0) {
+            return None;
+        }
+        let (sin_phi, cos_phi) = sin_cos_2pi(cu);
+        let dir = self
+            .map_dir_to_world(Vec3::new(
+                sin_theta * sin_phi,
+                cos_theta,
+                -sin_theta * cos_phi,
+            ))
+            .normalize();
+        Some(LightSample {
+            dir,
+            radiance: self.radiance(dir),
+            pdf,
+        })
+    }
+
+    #[inline]
+    fn pdf(&self, dir: Vec3) -> f32 {
+        let (w, h) = (self.width as usize, self.height as usize);
+        if self.distribution.len() != Self::distribution_len(self.width, self.height) {
+            return 0.0;
+        }
+        let (rows, marginal) = self.distribution.split_at(h * (w + 1));
+        let (u, v) = self.uv(dir);
+        let i = ((u * w as f32) as usize).min(w - 1);
+        let j = ((v * h as f32) as usize).min(h - 1);
+        let f = rows[j * (w + 1) + i + 1] - rows[j * (w + 1) + i];
+        self.density(f, marginal[h], sin_cos_2pi(0.5 * v).0)
     }
 }
 
@@ -158,6 +314,9 @@ pub struct LatLongParams {
     pub height: u32,
     pub row_scale: f32,
     pub row_offset: f32,
+    /// Device address of the `distribution_len` values of the sampling distribution (0 if none).
+    pub distribution: u64,
+    pub distribution_len: u64,
 }
 
 impl Component for LatLongEnvironment<'_> {
@@ -174,6 +333,12 @@ impl Component for LatLongEnvironment<'_> {
             height: self.height,
             row_scale: self.row_scale,
             row_offset: self.row_offset,
+            distribution: if self.distribution.is_empty() {
+                0
+            } else {
+                upload.values(self.distribution)
+            },
+            distribution_len: self.distribution.len() as u64,
         }
     }
     #[inline]
@@ -187,6 +352,36 @@ impl Component for LatLongEnvironment<'_> {
             scale: p.scale,
             row_scale: p.row_scale,
             row_offset: p.row_offset,
+            distribution: if p.distribution_len == 0 {
+                &[]
+            } else {
+                // SAFETY: the caller guarantees the address range.
+                unsafe {
+                    core::slice::from_raw_parts(
+                        p.distribution as *const f32,
+                        p.distribution_len as usize,
+                    )
+                }
+            },
         }
     }
+}
+
+/// The index `k` in `0..n` with `cdf[k] <= x < cdf[k + 1]` of a non-decreasing `cdf` of `n + 1`
+/// values (the last interval of positive width if `x` rounds to the end).
+#[inline]
+fn find_interval(cdf: &[f32], n: usize, x: f32) -> usize {
+    let (mut lo, mut hi) = (0usize, n);
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if cdf[mid] <= x {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    while lo > 0 && cdf[lo + 1] <= cdf[lo] {
+        lo -= 1;
+    }
+    lo
 }

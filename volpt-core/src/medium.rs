@@ -7,6 +7,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::abi::{Component, GridParams, Upload};
 use crate::grid::Grid;
+use crate::majorant::{MajorantGrid, MajorantGridParams};
 use crate::{Spectrum, Vec3};
 
 pub trait Medium {
@@ -15,6 +16,12 @@ pub trait Medium {
 
     /// An upper bound of `sigma_t` over the medium (the majorant of delta tracking).
     fn majorant(&self) -> f32;
+    /// Tighter bounds cell by cell, if the medium has them; tracking then walks their cells
+    /// instead of using [`Medium::majorant`].
+    #[inline]
+    fn majorant_grid(&self) -> Option<&MajorantGrid<'_>> {
+        None
+    }
     fn sigma_t(&self, p: Vec3) -> f32;
     fn albedo(&self, p: Vec3) -> Spectrum;
 }
@@ -83,6 +90,8 @@ pub struct GridMedium<'a, A> {
     pub scale: f32,
     /// `scale * max(density)`: trilinear interpolation never exceeds the largest sample.
     pub majorant: f32,
+    /// Per-cell bounds over the medium's box ([`crate::majorant`]); `None` tracks with `majorant`.
+    pub majorants: Option<MajorantGrid<'a>>,
     pub albedo: A,
 }
 
@@ -92,6 +101,11 @@ impl<A: AlbedoField> Medium for GridMedium<'_, A> {
     #[inline]
     fn majorant(&self) -> f32 {
         self.majorant
+    }
+
+    #[inline]
+    fn majorant_grid(&self) -> Option<&MajorantGrid<'_>> {
+        self.majorants.as_ref()
     }
 
     #[inline]
@@ -177,17 +191,19 @@ pub struct GridMediumParams<A> {
     pub density: GridParams,
     pub scale: f32,
     pub majorant: f32,
+    pub majorants: MajorantGridParams,
     pub albedo: A,
 }
 
 impl<A: Pod> GridMediumParams<A> {
-    /// `GridParams` and the two scalars are a multiple of 8 bytes; an albedo of a multiple of 8
-    /// bytes follows without padding.
+    /// `GridParams` and the two scalars are a multiple of 8 bytes, the majorant grid's 56; an
+    /// albedo of a multiple of 8 bytes follows without padding.
     const LAYOUT: () = assert!(
         core::mem::size_of::<A>().is_multiple_of(8)
             && core::mem::size_of::<GridParams>().is_multiple_of(8)
+            && core::mem::size_of::<MajorantGridParams>() == 56
             && core::mem::size_of::<Self>()
-                == core::mem::size_of::<GridParams>() + 8 + core::mem::size_of::<A>()
+                == core::mem::size_of::<GridParams>() + 8 + 56 + core::mem::size_of::<A>()
     );
 }
 
@@ -207,6 +223,7 @@ impl<A: AlbedoField + Component> Component for GridMedium<'_, A> {
             density: GridParams::new(&self.density, upload),
             scale: self.scale,
             majorant: self.majorant,
+            majorants: MajorantGridParams::new(self.majorants.as_ref(), upload),
             albedo: self.albedo.to_params(upload),
         }
     }
@@ -217,6 +234,8 @@ impl<A: AlbedoField + Component> Component for GridMedium<'_, A> {
             density: unsafe { p.density.grid::<1>() },
             scale: p.scale,
             majorant: p.majorant,
+            // SAFETY: forwarded to the caller.
+            majorants: unsafe { p.majorants.grid() },
             // SAFETY: forwarded to the caller.
             albedo: unsafe { A::from_params(&p.albedo) },
         }

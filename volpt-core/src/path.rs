@@ -13,9 +13,11 @@
 //!                   dielectric    -> reflect or refract, throughput *= BSDF weight
 //! ```
 //!
-//! This is pure path tracing with the environment as the only light, an unbiased estimator of the
-//! volume rendering equation (Kajiya 1986; Veach 1997 ch. 4); every sample is importance sampled
-//! exactly except the microfacet masking, so weights stay near 1. Depth and roulette follow Mitsuba's
+//! With [`Estimator::PathTracing`] this is pure path tracing with the environment as the only light,
+//! an unbiased estimator of the volume rendering equation (Kajiya 1986; Veach 1997 ch. 4); every
+//! sample is importance sampled exactly except the microfacet masking, so weights stay near 1. With
+//! [`Estimator::NextEvent`] and an index-matched boundary, each scattering event also looks at the
+//! environment directly ([`next_event`]). Depth and roulette follow Mitsuba's
 //! `volpath`: `depth` counts scattering events and dielectric interactions, a path may see the light
 //! after at most `max_depth - 1` of them, and from `rr_depth` on it survives with probability
 //! `min(max(throughput) * eta^2, 0.95)`.
@@ -23,12 +25,13 @@
 use core::ops::Range;
 
 use crate::bsdf::Bsdf;
+use crate::environment::Environment;
 use crate::geometry::BoxHit;
 use crate::medium::Medium;
 use crate::phase::PhaseFunction;
 use crate::rng::Rng;
 use crate::scene::Scene;
-use crate::tracking::{delta_tracking, FreeFlight};
+use crate::tracking::{delta_tracking, ratio_tracking, FreeFlight};
 use crate::{Ray, Spectrum, Vec3};
 
 /// The integrator's limits.
@@ -47,10 +50,29 @@ pub struct PathSettings {
     /// non-finite one would track for ever; a path that reaches this bound is dropped and counted
     /// as truncated, and separately as cut by tracking.
     pub max_tracking_steps: u32,
+    /// Cells of the majorant grid along the box's longest axis (the render factory builds it);
+    /// 0 or 1 tracks with one global majorant.
+    pub majorant_resolution: u32,
+    /// How a path gathers the environment's light.
+    pub estimator: Estimator,
 }
 
 impl PathSettings {
     pub const UNLIMITED: u32 = u32::MAX;
+    /// Measured on the thesis scenes (`docs/heterogeneous.md`).
+    pub const DEFAULT_MAJORANT_RESOLUTION: u32 = 32;
+}
+
+/// How a path gathers the environment's light.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Estimator {
+    /// Only where a path escapes: the phase function alone picks the directions.
+    PathTracing,
+    /// Also at every scattering event, towards a direction sampled from the environment, with the
+    /// transmittance to the box estimated by ratio tracking; both strategies weighted by multiple
+    /// importance sampling. Only behind an index-matched boundary (a dielectric bends or reflects
+    /// the shadow ray): elsewhere it is path tracing.
+    NextEvent,
 }
 
 impl Default for PathSettings {
@@ -62,6 +84,9 @@ impl Default for PathSettings {
             // ~0.1-1 s of one core per path at the worst: bounded, yet far beyond any path of a
             // scene whose majorant is not wasted (the thesis scenes use ~100 steps per path).
             max_tracking_steps: 1 << 26,
+            majorant_resolution: Self::DEFAULT_MAJORANT_RESOLUTION,
+            // The render factory picks the estimator per scene (`default_estimator`).
+            estimator: Estimator::PathTracing,
         }
     }
 }
@@ -87,6 +112,9 @@ pub struct PathState {
     pub alive: bool,
     /// Whether, and by which safety bound, the path was cut.
     pub truncated: Truncation,
+    /// The phase function's density of the current direction if next-event estimation also
+    /// sampled the environment at its origin (the escape is then weighted by MIS), else 0.
+    pub mis_pdf: f32,
 }
 
 /// Which safety bound of [`PathSettings`] ended a path (it then contributes zero).
@@ -118,7 +146,22 @@ impl PathState {
             inside: scene.bounds().contains(ray.origin),
             alive: true,
             truncated: Truncation::None,
+            mis_pdf: 0.0,
         }
+    }
+
+    /// Whether this path samples the environment at its scattering events.
+    #[inline]
+    fn uses_next_event<S: Scene>(scene: &S) -> bool {
+        S::Bsdf::IS_NULL && scene.settings().estimator == Estimator::NextEvent
+    }
+
+    /// Ends the path at a safety bound; it contributes zero.
+    #[inline]
+    fn truncate(&mut self, bound: Truncation) {
+        self.truncated = bound;
+        self.radiance = Spectrum::ZERO;
+        self.alive = false;
     }
 
     /// Counts an interaction; false (and the path ends) if it is one more than `max_depth` allows.
@@ -153,8 +196,7 @@ pub fn step<S: Scene>(scene: &S, path: &mut PathState) {
     }
     path.segments += 1;
     if path.segments > scene.settings().max_segments {
-        path.truncated = Truncation::Segments;
-        path.alive = false;
+        path.truncate(Truncation::Segments);
         return;
     }
     if path.inside {
@@ -170,16 +212,18 @@ pub fn step<S: Scene>(scene: &S, path: &mut PathState) {
         match collision {
             FreeFlight::Collision(t) => scatter(scene, path, path.ray.at(t)),
             FreeFlight::Escaped => interact_with_boundary(scene, path, exit),
-            FreeFlight::OutOfSteps => {
-                path.truncated = Truncation::TrackingSteps;
-                path.alive = false;
-            }
+            FreeFlight::OutOfSteps => path.truncate(Truncation::TrackingSteps),
         }
     } else {
         match scene.bounds().entry(&path.ray) {
             Some(hit) => interact_with_boundary(scene, path, hit),
             None => {
-                path.radiance += path.throughput * scene.background(path.ray.dir);
+                let mut light = path.throughput * scene.background(path.ray.dir);
+                if PathState::uses_next_event(scene) && path.mis_pdf > 0.0 {
+                    let light_pdf = scene.environment().pdf(path.ray.dir);
+                    light *= power_heuristic(path.mis_pdf, light_pdf);
+                }
+                path.radiance += light;
                 path.alive = false;
             }
         }
@@ -197,8 +241,9 @@ pub fn trace<S: Scene>(scene: &S, path: &mut PathState) {
 /// Traces samples `samples` of pixel `(px, py)` in order and adds their radiance to `sum` in `f64`.
 ///
 /// This is the per-pixel loop of the CPU renderer and of the GPU's naive strategy: one loop, one
-/// summation order, so their images agree bit for bit.
-#[inline]
+/// summation order, so their images agree bit for bit. Always inlined, like [`step`]: a GPU call
+/// taking the scene by address moves it into local memory.
+#[inline(always)]
 pub fn sample_pixel<S: Scene>(
     scene: &S,
     (px, py): (u32, u32),
@@ -219,7 +264,8 @@ pub fn sample_pixel<S: Scene>(
 
 /// A real collision at `p`: the albedo scales the throughput (the scattering/extinction ratio of the
 /// collision estimator) and the phase function, sampled exactly, gives the new direction.
-#[inline]
+/// Always inlined: a GPU call taking the scene by address moves it into local memory.
+#[inline(always)]
 fn scatter<S: Scene>(scene: &S, path: &mut PathState, p: Vec3) {
     let settings = scene.settings();
     if !path.begin_interaction(settings) {
@@ -231,9 +277,60 @@ fn scatter<S: Scene>(scene: &S, path: &mut PathState, p: Vec3) {
         path.alive = false;
         return;
     }
+    let next_event = PathState::uses_next_event(scene);
+    if next_event && !next_event_estimate(scene, path, p) {
+        return;
+    }
     let sample = scene.phase().sample(path.ray.dir, path.rng.next_2d());
     path.ray = Ray::new(p, sample.wo);
+    if next_event {
+        path.mis_pdf = sample.pdf;
+    }
     path.russian_roulette(settings);
+}
+
+/// Next-event estimation at a scattering event at `p` (Veach 1997, ch. 9; pbrt-v4 section 14.2.2):
+/// a look direction `w` sampled from the environment with density `p_env` adds
+/// `throughput * phase(w) * T(p, w) * L_env(w) * w_env / p_env`, with `T` the transmittance to the
+/// box estimated by ratio tracking and `w_env = p_env^2 / (p_env^2 + phase(w)^2)` the power
+/// heuristic; the path's phase-sampled continuation keeps `phase(wo)` so that, should it escape,
+/// its light takes the complementary weight. Both strategies together are unbiased. Valid only
+/// where nothing but the medium lies between `p` and the environment: an index-matched boundary.
+/// False (and the path is cut) when ratio tracking runs out of steps.
+#[inline(always)]
+fn next_event_estimate<S: Scene>(scene: &S, path: &mut PathState, p: Vec3) -> bool {
+    let Some(light) = scene.environment().sample(path.rng.next_2d()) else {
+        return true;
+    };
+    let phase = scene.phase().eval(path.ray.dir, light.dir);
+    let shadow = Ray::new(p, light.dir);
+    let exit = scene.bounds().exit(&shadow);
+    let Some(transmittance) = ratio_tracking(
+        scene.medium(),
+        &shadow,
+        exit.t,
+        &mut path.rng,
+        &mut path.tracking_steps,
+        scene.settings().max_tracking_steps,
+    ) else {
+        path.truncate(Truncation::TrackingSteps);
+        return false;
+    };
+    let weight = power_heuristic(light.pdf, phase) * phase * transmittance / light.pdf;
+    path.radiance += path.throughput * light.radiance * weight;
+    true
+}
+
+/// Veach's power heuristic with exponent 2: the weight of a strategy of density `a` against one of
+/// density `b`.
+#[inline]
+fn power_heuristic(a: f32, b: f32) -> f32 {
+    let (a2, b2) = (a * a, b * b);
+    if a2 + b2 > 0.0 {
+        a2 / (a2 + b2)
+    } else {
+        0.0
+    }
 }
 
 #[inline]

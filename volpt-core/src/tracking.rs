@@ -1,6 +1,8 @@
-//! Free-flight sampling by delta (Woodcock) tracking.
+//! Free-flight sampling by delta (Woodcock) tracking and transmittance by ratio tracking, both over
+//! the medium's majorants: one global bound, or a majorant grid walked cell by cell.
 
-use crate::math::ln;
+use crate::majorant::Dda;
+use crate::math::{exp, ln};
 use crate::medium::Medium;
 use crate::rng::Rng;
 use crate::Ray;
@@ -16,19 +18,89 @@ pub enum FreeFlight {
     OutOfSteps,
 }
 
-/// Samples the distance to the next real collision along `ray` before `t_max`. `steps` counts
-/// tentative collisions; the flight gives up once it reaches `max_steps`.
+/// Samples tentative collisions along `ray` up to `t_max`, exponentially distributed under the
+/// medium's majorant, and calls `at(rng, t, majorant)` at each until it returns true (then the
+/// walk ends at `t`, `FreeFlight::Collision(t)`). `steps` counts tentative collisions; the walk
+/// gives up once it reaches `max_steps`.
 ///
-/// Woodcock et al. 1965: fly exponential steps of the constant majorant `sigma_bar` and accept a
-/// tentative collision at `x` with probability `sigma_t(x) / sigma_bar`. The accepted distances follow
-/// `sigma_t(t) exp(-int_0^t sigma_t)` exactly, for any `sigma_bar >= sigma_t`. A homogeneous medium
-/// accepts every collision, so it samples the exponential once. `1 - u` lies in (0, 1], so the
-/// logarithm is finite; a zero majorant means vacuum and never loops.
+/// With one global majorant this is Woodcock et al. 1965's loop. With a majorant grid the ray is
+/// walked through the cells (pbrt-v4's `SampleT_maj`): within a cell the steps are exponential under
+/// that cell's bound; a step past the cell's end is discarded and sampling restarts at the
+/// boundary under the next cell's bound, which the exponential's lack of memory makes exact. A
+/// cell of majorant 0 is crossed without a step.
 ///
-/// The expected number of steps is `majorant * t_max`: an enormous majorant (one dense voxel among
-/// empty ones) or a non-finite one (where `t` never grows) would spin for ever, so the budget bounds
-/// the work. It is checked before a step is counted, so `steps` never exceeds `max_steps` (nor
-/// overflows). Under the budget the random numbers and arithmetic are those of plain delta tracking.
+/// The expected number of steps is the integral of the majorant along the ray: an enormous bound
+/// (one dense voxel among empty ones) or a non-finite one (where `t` never grows) would spin for
+/// ever, so the budget bounds the work. It is checked before a step is counted, so `steps` never
+/// exceeds `max_steps` (nor overflows). The global loop's random numbers and arithmetic are those of
+/// plain delta tracking.
+#[inline(always)]
+pub fn walk_majorants<M: Medium>(
+    medium: &M,
+    ray: &Ray,
+    t_max: f32,
+    rng: &mut Rng,
+    steps: &mut u32,
+    max_steps: u32,
+    mut at: impl FnMut(&mut Rng, f32, f32) -> bool,
+) -> FreeFlight {
+    let Some(grid) = medium.majorant_grid() else {
+        let majorant = medium.majorant();
+        if majorant <= 0.0 {
+            return FreeFlight::Escaped;
+        }
+        let inv_majorant = 1.0 / majorant;
+        let mut t = 0.0;
+        loop {
+            t -= ln(1.0 - rng.next_f32()) * inv_majorant;
+            if t >= t_max {
+                return FreeFlight::Escaped;
+            }
+            if *steps >= max_steps {
+                return FreeFlight::OutOfSteps;
+            }
+            *steps += 1;
+            if at(rng, t, majorant) {
+                return FreeFlight::Collision(t);
+            }
+        }
+    };
+    let mut dda = Dda::new(grid, ray);
+    let mut start = 0.0f32;
+    loop {
+        let (majorant, cell_end) = dda.segment(grid);
+        let end = cell_end.min(t_max);
+        if majorant > 0.0 {
+            let inv_majorant = 1.0 / majorant;
+            let mut t = start;
+            loop {
+                t -= ln(1.0 - rng.next_f32()) * inv_majorant;
+                if t >= end {
+                    break;
+                }
+                if *steps >= max_steps {
+                    return FreeFlight::OutOfSteps;
+                }
+                *steps += 1;
+                if at(rng, t, majorant) {
+                    return FreeFlight::Collision(t);
+                }
+            }
+        }
+        // Anything but `end < t_max` ends the walk, a NaN `end` or `t_max` included.
+        if end.partial_cmp(&t_max) != Some(core::cmp::Ordering::Less) {
+            return FreeFlight::Escaped;
+        }
+        start = start.max(end);
+        dda.advance(grid, ray.dir);
+    }
+}
+
+/// Samples the distance to the next real collision along `ray` before `t_max`: delta tracking,
+/// accepting a tentative collision at `x` with probability `sigma_t(x) / majorant(x)`. The accepted
+/// distances follow `sigma_t(t) exp(-int_0^t sigma_t)` exactly for any majorant `>= sigma_t`
+/// (Woodcock et al. 1965; Galtier et al. 2013 for piecewise majorants). A homogeneous medium
+/// accepts every collision, so it samples the exponential once.
 #[inline]
 pub fn delta_tracking<M: Medium>(
     medium: &M,
@@ -38,23 +110,62 @@ pub fn delta_tracking<M: Medium>(
     steps: &mut u32,
     max_steps: u32,
 ) -> FreeFlight {
-    let majorant = medium.majorant();
-    if majorant <= 0.0 {
-        return FreeFlight::Escaped;
+    walk_majorants(
+        medium,
+        ray,
+        t_max,
+        rng,
+        steps,
+        max_steps,
+        |rng, t, majorant| M::HOMOGENEOUS || rng.next_f32() * majorant < medium.sigma_t(ray.at(t)),
+    )
+}
+
+/// An unbiased estimate of the transmittance `exp(-int_0^t_max sigma_t)` along `ray`, or `None`
+/// when the step budget ran out.
+///
+/// Ratio tracking (Cramer 1978; Novák et al. 2014): the product of `1 - sigma_t(x) / majorant(x)`
+/// over the tentative collisions. Once the product falls below 1/8, Russian roulette ends it with
+/// probability 1/2 (doubling it otherwise), so that a dense medium costs a bounded number of steps
+/// per shadow ray without bias. A homogeneous medium needs no estimate: `exp(-sigma_t t_max)`.
+///
+/// Always inlined: as a call on a GPU it takes the medium by address, which moves the whole scene
+/// into local memory (a ~450-byte stack frame per thread).
+#[inline(always)]
+pub fn ratio_tracking<M: Medium>(
+    medium: &M,
+    ray: &Ray,
+    t_max: f32,
+    rng: &mut Rng,
+    steps: &mut u32,
+    max_steps: u32,
+) -> Option<f32> {
+    if M::HOMOGENEOUS {
+        return Some(exp(-medium.majorant() * t_max));
     }
-    let inv_majorant = 1.0 / majorant;
-    let mut t = 0.0;
-    loop {
-        t -= ln(1.0 - rng.next_f32()) * inv_majorant;
-        if t >= t_max {
-            return FreeFlight::Escaped;
-        }
-        if *steps >= max_steps {
-            return FreeFlight::OutOfSteps;
-        }
-        *steps += 1;
-        if M::HOMOGENEOUS || rng.next_f32() * majorant < medium.sigma_t(ray.at(t)) {
-            return FreeFlight::Collision(t);
-        }
+    let mut transmittance = 1.0f32;
+    let flight = walk_majorants(
+        medium,
+        ray,
+        t_max,
+        rng,
+        steps,
+        max_steps,
+        |rng, t, majorant| {
+            transmittance *= 1.0 - medium.sigma_t(ray.at(t)) / majorant;
+            if transmittance < 0.125 {
+                if rng.next_f32() < 0.5 {
+                    transmittance *= 2.0;
+                } else {
+                    transmittance = 0.0;
+                }
+            }
+            transmittance <= 0.0
+        },
+    );
+    match flight {
+        FreeFlight::OutOfSteps => None,
+        FreeFlight::Collision(_) => Some(0.0),
+        FreeFlight::Escaped => Some(transmittance),
     }
 }
