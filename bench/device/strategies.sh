@@ -12,7 +12,7 @@
 # 3. the benchmark: every scene x strategy x math (and bin/volpt-base, if carried, as the
 #    before), each `volpt bench` with one discarded warm-up; a register-cap sweep on two scenes.
 # Knobs: TRIALS (5), SCENES_ONLY (a regex of scene names), STRATEGIES, EXACT_STRATEGIES,
-# FAST_STRATEGIES, CAPS, T (seconds per command, 60), SKIP_CHECKS=1, SKIP_CAPS=1.
+# FAST_STRATEGIES, CAPS, T (seconds per command, 60), PROBE_T (30), SKIP_CHECKS=1, SKIP_CAPS=1.
 set -uo pipefail
 cd "$(dirname "$0")"
 OUT=${OUT:-$PWD/out}
@@ -81,7 +81,7 @@ SCENES=(
 )
 # A strategy whose kernel does not finish a tiny render in time is dropped from everything below.
 for s in "${STRATEGIES[@]}"; do
-    if ! timeout 30 "$VOLPT" render scenes/cgg-logo/scene.xml -Dresolution=32 --spp 1 --backend cuda \
+    if ! timeout "${PROBE_T:-30}" "$VOLPT" render scenes/cgg-logo/scene.xml -Dresolution=32 --spp 1 --backend cuda \
         --strategy "$s" -o "$OUT/probe-$s.exr" >"$OUT/probe-$s.log" 2>&1; then
         log "FAIL probe $s (exit $?): dropped from this run"; failures=$((failures + 1))
         STRATEGIES=("${STRATEGIES[@]/$s}")
