@@ -91,6 +91,7 @@ fn grid_medium(grid: GridDesc, albedo: f32) -> MediumDesc {
         scale: 1.0,
         albedo: AlbedoDesc::Constant([albedo; 3]),
         phase: PhaseDesc::Isotropic,
+        lookup: Default::default(),
     }
 }
 
@@ -709,6 +710,7 @@ fn hopeless_majorants_hit_the_step_budget() {
     let overflowing = MediumDesc {
         scale: 1e38,
         ..grid_medium(grid([2, 1, 1], vec![10.0, 5.0]), 0.9)
+        lookup: Default::default(),
     };
     for (case, medium) in [
         ("infinite majorant", overflowing),

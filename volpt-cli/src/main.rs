@@ -11,12 +11,13 @@ mod plot;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 use tracing_subscriber::EnvFilter;
+use volpt_film::Accumulation;
 use volpt_render::factory::{Effects, Parts};
 use volpt_render::image::preview_path;
 use volpt_render::{path_settings, Image, RenderOptions, RenderStats, Variant};
-use volpt_scene::{Config, SceneAssembler, SceneDescription};
+use volpt_scene::{Config, GridLookup, SceneAssembler, SceneDescription};
 
 use backend::{Backend, BackendKind, RenderJob};
 use volpt_cuda::Strategy;
@@ -101,6 +102,43 @@ struct SceneArgs {
     /// map) instead of the one specialised to the scene's effects: what specialisation saves.
     #[arg(long)]
     general: bool,
+    /// How the medium's grids are reconstructed between samples (default: the scene's, trilinear).
+    #[arg(long, value_enum)]
+    lookup: Option<LookupArg>,
+}
+
+/// `--lookup`: a grid's reconstruction.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum LookupArg {
+    /// Trilinear interpolation of the eight samples around a point.
+    Trilinear,
+    /// The nearest sample's value: one read instead of eight.
+    Nearest,
+}
+
+impl From<LookupArg> for GridLookup {
+    fn from(lookup: LookupArg) -> Self {
+        match lookup {
+            LookupArg::Trilinear => GridLookup::Trilinear,
+            LookupArg::Nearest => GridLookup::Nearest,
+        }
+    }
+}
+
+/// The precision a film adds samples in (`volpt converge --setting accumulation=...`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum AccumulationArg {
+    F64,
+    F32,
+}
+
+impl From<AccumulationArg> for Accumulation {
+    fn from(a: AccumulationArg) -> Self {
+        match a {
+            AccumulationArg::F64 => Accumulation::F64,
+            AccumulationArg::F32 => Accumulation::F32,
+        }
+    }
 }
 
 impl SceneArgs {
@@ -124,7 +162,7 @@ impl SceneArgs {
     }
 }
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 struct SamplingArgs {
     /// Seed of the random streams: the same seed gives the same image on every backend.
     #[arg(long, default_value_t = 0)]
@@ -282,7 +320,11 @@ fn export_name(scene: &Path) -> String {
 
 fn load(args: &SceneArgs) -> Result<SceneDescription> {
     let builder = volpt_scene::builder_for(&args.scene)?;
-    Ok(SceneAssembler::new(args.config()).assemble(builder.as_ref())?)
+    let mut desc = SceneAssembler::new(args.config()).assemble(builder.as_ref())?;
+    if let Some(lookup) = args.lookup {
+        desc.medium.lookup = lookup.into();
+    }
+    Ok(desc)
 }
 
 fn options(desc: &SceneDescription, sampling: &SamplingArgs) -> Result<RenderOptions> {

@@ -18,7 +18,7 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::camera::PerspectiveCamera;
-use crate::grid::{Grid, GridMapping};
+use crate::grid::{Grid, GridLookup, GridMapping};
 use crate::path::PathSettings;
 use crate::scene::{Scene, VolumeScene};
 use crate::{Aabb, Vec2, Vec3};
@@ -136,6 +136,29 @@ pub struct GridParams {
     pub bounds_max: [f32; 3],
     pub scale: [f32; 3],
     pub offset: [f32; 3],
+    /// [`GridLookup`]: 0 trilinear, 1 nearest.
+    pub lookup: u32,
+    pub padding: u32,
+}
+
+impl GridLookup {
+    /// The code of [`GridParams::lookup`].
+    pub const fn code(self) -> u32 {
+        match self {
+            GridLookup::Trilinear => 0,
+            GridLookup::Nearest => 1,
+        }
+    }
+
+    /// The lookup of a code the host wrote with [`GridLookup::code`].
+    #[inline]
+    pub const fn from_code(code: u32) -> Self {
+        if code == GridLookup::Nearest.code() {
+            GridLookup::Nearest
+        } else {
+            GridLookup::Trilinear
+        }
+    }
 }
 
 impl GridParams {
@@ -150,6 +173,8 @@ impl GridParams {
             bounds_max: grid.mapping.bounds.max.to_array(),
             scale: grid.mapping.scale().to_array(),
             offset: grid.mapping.offset().to_array(),
+            lookup: grid.lookup.code(),
+            padding: 0,
         }
     }
 
@@ -175,6 +200,7 @@ impl GridParams {
                 Vec3::from_array(self.scale),
                 Vec3::from_array(self.offset),
             ),
+            lookup: GridLookup::from_code(self.lookup),
         }
     }
 }

@@ -1,4 +1,4 @@
-//! Dense 3D grids with trilinear reconstruction.
+//! Dense 3D grids with trilinear (or nearest-sample) reconstruction.
 
 use crate::{Aabb, Vec3};
 
@@ -60,6 +60,16 @@ impl GridMapping {
     }
 }
 
+/// How a grid reconstructs values between its samples (Mitsuba 3's `filter_type`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum GridLookup {
+    /// Trilinear interpolation of the eight samples around a point.
+    #[default]
+    Trilinear,
+    /// The value of the nearest sample: one read instead of eight, a blockier field.
+    Nearest,
+}
+
 /// A grid of `C`-channel samples, x fastest: `data[((z * res_y + y) * res_x + x) * C + c]`.
 /// Borrowed, so that the same type wraps host memory and device memory.
 #[derive(Clone, Copy, Debug)]
@@ -67,6 +77,7 @@ pub struct Grid<'a, const C: usize> {
     pub data: &'a [f32],
     pub res: [u32; 3],
     pub mapping: GridMapping,
+    pub lookup: GridLookup,
 }
 
 impl<'a, const C: usize> Grid<'a, C> {
@@ -77,7 +88,17 @@ impl<'a, const C: usize> Grid<'a, C> {
             res[0] as usize * res[1] as usize * res[2] as usize * C,
             "grid data does not match its resolution"
         );
-        Self { data, res, mapping }
+        Self {
+            data,
+            res,
+            mapping,
+            lookup: GridLookup::Trilinear,
+        }
+    }
+
+    /// The same grid, reconstructed as `lookup` says.
+    pub fn with_lookup(self, lookup: GridLookup) -> Self {
+        Self { lookup, ..self }
     }
 
     #[inline]
@@ -88,8 +109,9 @@ impl<'a, const C: usize> Grid<'a, C> {
         v
     }
 
-    /// Trilinear interpolation of the samples around `p`; zero outside the grid's box, and the edge
-    /// samples held constant between the outermost sample and the box's faces.
+    /// The value at `p`, reconstructed as [`Grid::lookup`] says: zero outside the grid's box, and
+    /// the edge samples held constant between the outermost sample and the box's faces. Either
+    /// reconstruction stays within the samples' range, so a majorant of the samples bounds it.
     #[inline]
     pub fn lookup(&self, p: Vec3) -> [f32; C] {
         if !self.mapping.bounds.contains(p) {
@@ -105,6 +127,18 @@ impl<'a, const C: usize> Grid<'a, C> {
             .to_index_space(p)
             .max(Vec3::ZERO)
             .min(max_index);
+        match self.lookup {
+            GridLookup::Trilinear => self.trilinear(q, max_index),
+            GridLookup::Nearest => {
+                let n = q.round();
+                self.at(n.x as u32, n.y as u32, n.z as u32)
+            }
+        }
+    }
+
+    /// Trilinear interpolation around index-space `q`, which lies in `[0, max_index]`.
+    #[inline]
+    fn trilinear(&self, q: Vec3, max_index: Vec3) -> [f32; C] {
         let base = q.floor().min((max_index - Vec3::ONE).max(Vec3::ZERO));
         let f = q - base;
         let (x0, y0, z0) = (base.x as u32, base.y as u32, base.z as u32);

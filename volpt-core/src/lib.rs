@@ -32,7 +32,7 @@ pub use bsdf::{Bsdf, BsdfSample, NullBoundary, RoughDielectric, SmoothDielectric
 pub use camera::PerspectiveCamera;
 pub use environment::{ConstantEnvironment, Environment, LatLongEnvironment, LatLongRows};
 pub use geometry::{Aabb, Ray};
-pub use grid::{Grid, GridMapping};
+pub use grid::{Grid, GridLookup, GridMapping};
 pub use medium::{AlbedoField, ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium, Medium};
 pub use path::{PathCounters, PathSettings, PathState};
 pub use phase::{HenyeyGreenstein, Isotropic, PhaseFunction};

@@ -181,11 +181,11 @@ pub struct GridMediumParams<A> {
 }
 
 impl<A: Pod> GridMediumParams<A> {
-    /// `GridParams` and the two scalars are 88 bytes; an albedo of a multiple of 8 bytes follows
+    /// `GridParams` and the two scalars are 96 bytes; an albedo of a multiple of 8 bytes follows
     /// without padding.
     const LAYOUT: () = assert!(
         core::mem::size_of::<A>().is_multiple_of(8)
-            && core::mem::size_of::<Self>() == 88 + core::mem::size_of::<A>()
+            && core::mem::size_of::<Self>() == 96 + core::mem::size_of::<A>()
     );
 }
 
