@@ -710,7 +710,6 @@ fn hopeless_majorants_hit_the_step_budget() {
     let overflowing = MediumDesc {
         scale: 1e38,
         ..grid_medium(grid([2, 1, 1], vec![10.0, 5.0]), 0.9)
-        lookup: Default::default(),
     };
     for (case, medium) in [
         ("infinite majorant", overflowing),
