@@ -22,7 +22,7 @@
 //! configuration opens its own backend.
 
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::{bail, Context, Result};
@@ -516,15 +516,18 @@ fn reference_key(args: &ConvergeArgs, desc: &SceneDescription) -> u64 {
     })
 }
 
+/// Writes `bytes` to `dir/name`.
+fn write(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf> {
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).with_context(|| format!("writing {}", path.display()))?;
+    Ok(path)
+}
+
+const CSV_HEADER: &str =
+    "setting,round,spp,time_s,rmse,rel_mse,variance,reference_variance,bias,efficiency";
+
 fn write_outputs(args: &ConvergeArgs, results: &[(String, Vec<Row>)]) -> Result<()> {
-    let write = |name: &str, bytes: &[u8]| -> Result<PathBuf> {
-        let path = args.out.join(name);
-        std::fs::write(&path, bytes).with_context(|| format!("writing {}", path.display()))?;
-        Ok(path)
-    };
-    let mut csv = String::from(
-        "setting,round,spp,time_s,rmse,rel_mse,variance,reference_variance,bias,efficiency\n",
-    );
+    let mut csv = format!("{CSV_HEADER}\n");
     for (label, rows) in results {
         for r in rows {
             let _ = writeln!(
@@ -542,6 +545,20 @@ fn write_outputs(args: &ConvergeArgs, results: &[(String, Vec<Row>)]) -> Result<
             );
         }
     }
+    let mut written = vec![write(&args.out, "converge.csv", csv.as_bytes())?];
+    let scene = args.scene.scene.display().to_string();
+    written.extend(write_plots(&args.out, &scene, results)?);
+    let table = table(results, args.target_rmse);
+    print!("{table}");
+    written.push(write(&args.out, "table.md", table.as_bytes())?);
+    for path in written {
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+/// `rmse` and `rel-mse` against render time, as SVG and PNG, in `dir`.
+fn write_plots(dir: &Path, title: &str, results: &[(String, Vec<Row>)]) -> Result<Vec<PathBuf>> {
     let series = |f: fn(&Row) -> f64| -> Vec<Series> {
         results
             .iter()
@@ -551,26 +568,69 @@ fn write_outputs(args: &ConvergeArgs, results: &[(String, Vec<Row>)]) -> Result<
             })
             .collect()
     };
-    let scene = args.scene.scene.display().to_string();
-    let mut written = vec![write("converge.csv", csv.as_bytes())?];
     let plots: [(&str, &str, fn(&Row) -> f64); 2] = [
         ("rmse", "RMSE", Row::rmse),
         ("rel-mse", "relative MSE", |r| r.rel_mse),
     ];
+    let mut written = Vec::new();
     for (name, y_label, y) in plots {
         let series = series(y);
-        let svg = log_log_svg(&scene, "render time (s)", y_label, &series);
-        written.push(write(&format!("{name}.svg"), svg.as_bytes())?);
-        let png = log_log_png(&scene, "render time (s)", y_label, &series)?;
-        written.push(write(&format!("{name}.png"), &png)?);
+        let svg = log_log_svg(title, "render time (s)", y_label, &series);
+        written.push(write(dir, &format!("{name}.svg"), svg.as_bytes())?);
+        let png = log_log_png(title, "render time (s)", y_label, &series)?;
+        written.push(write(dir, &format!("{name}.png"), &png)?);
     }
-    let table = table(results, args.target_rmse);
-    print!("{table}");
-    written.push(write("table.md", table.as_bytes())?);
-    for path in written {
+    Ok(written)
+}
+
+/// `volpt plot DIR`: the plots of a run again, from its `converge.csv` (e.g. one made on a
+/// machine whose plots did not come back), titled with `title`.
+pub fn replot(dir: &Path, title: &str) -> Result<()> {
+    let path = dir.join("converge.csv");
+    let text =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let results = parse_csv(&text).with_context(|| format!("{}", path.display()))?;
+    for path in write_plots(dir, title, &results)? {
         println!("wrote {}", path.display());
     }
     Ok(())
+}
+
+/// The rows of a `converge.csv`, grouped by setting in the order they appear.
+fn parse_csv(text: &str) -> Result<Vec<(String, Vec<Row>)>> {
+    let mut lines = text.lines().enumerate();
+    match lines.next() {
+        Some((_, header)) if header == CSV_HEADER => {}
+        _ => bail!("line 1: expected the header {CSV_HEADER:?}"),
+    }
+    let mut results: Vec<(String, Vec<Row>)> = Vec::new();
+    for (i, line) in lines {
+        let fields: Vec<&str> = line.split(',').collect();
+        let number = |k: usize| -> Result<f64> {
+            fields
+                .get(k)
+                .and_then(|f| f.parse::<f64>().ok())
+                .with_context(|| format!("line {}: field {k} is not a number: {line:?}", i + 1))
+        };
+        if fields.len() != CSV_HEADER.split(',').count() {
+            bail!("line {}: expected 10 fields, found {line:?}", i + 1);
+        }
+        let rmse = number(4)?;
+        let row = Row {
+            round: number(1)? as u32,
+            spp: number(2)? as u64,
+            time_s: number(3)?,
+            mse: rmse * rmse,
+            rel_mse: number(5)?,
+            variance: number(6)?,
+            reference_variance: number(7)?,
+        };
+        match results.last_mut() {
+            Some((label, rows)) if label == fields[0] => rows.push(row),
+            _ => results.push((fields[0].to_owned(), vec![row])),
+        }
+    }
+    Ok(results)
 }
 
 /// Final errors per configuration, the time each first reached the target RMSE, and its efficiency.
@@ -697,5 +757,28 @@ mod tests {
         };
         assert!((row.bias() - 0.2).abs() < 1e-12);
         assert!((row.efficiency() - 1.0 / 0.12).abs() < 1e-9);
+    }
+
+    #[test]
+    fn csv_parses_back_into_rows_per_setting() {
+        let text = format!(
+            "{CSV_HEADER}\na b,0,2,0.5,2.000000e-1,1e-2,1e-3,0,1e-1,5\n\
+             a b,1,6,1.5,1.000000e-1,5e-3,1e-4,0,1e-2,6\nc,0,2,0.25,3e-1,1e-2,1e-3,0,0,1\n"
+        );
+        let results = parse_csv(&text).unwrap();
+        assert_eq!(results.len(), 2);
+        assert_eq!((results[0].0.as_str(), results[0].1.len()), ("a b", 2));
+        let row = results[0].1[1];
+        assert_eq!((row.round, row.spp, row.time_s), (1, 6, 1.5));
+        assert!((row.rmse() - 0.1).abs() < 1e-12);
+        assert!(parse_csv("spp,rmse\n")
+            .unwrap_err()
+            .to_string()
+            .contains("header"));
+        let short = format!("{CSV_HEADER}\nc,0,2\n");
+        assert!(parse_csv(&short)
+            .unwrap_err()
+            .to_string()
+            .contains("line 2"));
     }
 }

@@ -51,8 +51,15 @@ enum Command {
     Scene(SceneCommand),
     /// Compare two OpenEXR images pixel by pixel (e.g. a CPU and a GPU render of one seed).
     Compare(compare::CompareArgs),
-    /// Error against time for each setting: progressive renders, CSV, SVG plots, a table.
+    /// Error against time for each setting: progressive renders, CSV, SVG and PNG plots, a table.
     Converge(converge::ConvergeArgs),
+    /// Plot a `volpt converge` run again from the converge.csv in DIR (SVG and PNG).
+    Plot {
+        dir: PathBuf,
+        /// Title of the plots (default: DIR's name).
+        #[arg(long)]
+        title: Option<String>,
+    },
 }
 
 #[derive(Subcommand)]
@@ -299,6 +306,10 @@ fn main() -> Result<()> {
         }
         Command::Compare(args) => compare::run(&args),
         Command::Converge(args) => converge::run(&args),
+        Command::Plot { dir, title } => {
+            let title = title.unwrap_or_else(|| export_name(&dir));
+            converge::replot(&dir, &title)
+        }
     }
 }
 

@@ -307,9 +307,10 @@ impl Canvas {
         }
     }
 
-    /// `text` in the 8x8 font scaled to about `size` pixels, its baseline at `at`.
+    /// `text` in the 8x8 font, its baseline at `at`, scaled by a whole factor so that a glyph's
+    /// advance (8 font pixels) is about 2/3 of `size`, the width of a sans-serif character.
     fn text(&mut self, at: (f64, f64), text: &str, anchor: Anchor, size: f64, vertical: bool) {
-        let k = (size / 8.0).round().max(1.0);
+        let k = (size / 12.0).round().max(1.0);
         let advance = 8.0 * k;
         let length = advance * text.chars().count() as f64;
         let start = match anchor {
