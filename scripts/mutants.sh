@@ -4,13 +4,18 @@
 #   scripts/mutants.sh core [cargo-mutants options, e.g. --shard 0/8 --sharding round-robin]
 #   scripts/mutants.sh loaders [cargo-mutants options]
 #
-# core: every mutant of volpt-core, judged in two stages. Stage `unit` runs volpt-core's own tests
-# (a mutant rebuilds one crate and ten small test binaries). The mutants it misses go to stage
-# `renderer` (cargo-mutants --iterate: caught mutants are not tried again), judged by the
-# whole-renderer tests that can see a core mutant: the independent references, the majorant checks
-# and the launch-parameter round trip (tests/tests/references.rs, majorant.rs, device_abi.rs),
-# which rebuild the render factory's variants. Results: target/mutants-core/{unit,renderer}/
-# mutants.out; a mutant's verdict is the renderer stage's (caught in either stage is caught).
+# core: every mutant of volpt-core. The files volpt-core's own tests exercise (`units`: phase, BSDF,
+# microfacet, Fresnel, frame, sampling, geometry, grid, tracking, math, RNG) are judged in two
+# stages: stage `unit` runs volpt-core's tests (a mutant rebuilds one crate and ten small test
+# binaries); the mutants it misses go to stage `unit-renderer` (cargo-mutants --iterate: caught
+# mutants are not tried again), judged by the whole-renderer tests that can see a core mutant: the
+# independent references, the majorant checks and the launch-parameter round trip
+# (tests/tests/references.rs, majorant.rs, device_abi.rs), which rebuild the render factory's
+# variants. The files only the whole renderer exercises (camera, medium, environment, the path
+# step, the device ABI, scene and variant plumbing) go to stage `renderer` directly. Each stage
+# takes the same cargo-mutants options, so `--shard k/n` names one sample throughout. Results:
+# target/mutants-core/{unit,unit-renderer,renderer}/mutants.out; a mutant of the units is caught
+# if either of its stages caught it. STAGES (default "unit unit-renderer renderer") picks stages.
 # loaders: the scene loaders (volpt-scene), judged by volpt-scene's tests.
 #
 # What makes a mutant cheap: the `mutants` profile (Cargo.toml) is the release profile,
@@ -44,21 +49,35 @@ cd "$tree"
 
 mutants() {
     cargo mutants --in-place --no-shuffle --profile mutants --baseline skip \
-        --timeout 120 --build-timeout 1800 "$@"
+        --timeout 120 --build-timeout 900 "$@"
 }
 
 case "$scope" in
 core)
     out="$root/target/mutants-core"
-    mkdir -p "$out/unit" "$out/renderer"
-    # Exit status 2 means mutants survived, 3 timeouts: the next stage runs either way.
-    status=0
-    mutants --package volpt-core --output "$out/unit" "$@" --test-package volpt-core || status=$?
-    echo "== unit stage: exit $status; the survivors go to the renderer stage"
-    rm -rf "$out/renderer/mutants.out"
-    cp -r "$out/unit/mutants.out" "$out/renderer/"
-    mutants --package volpt-core --output "$out/renderer" --iterate "$@" \
-        --test-package volpt-tests -- --test references --test majorant --test device_abi
+    renderer_files='volpt-core/src/{camera,medium,environment,path,abi,scene,variant,lib}.rs'
+    renderer_tests=(--test-package volpt-tests -- --test references --test majorant --test device_abi)
+    for stage in ${STAGES:-unit unit-renderer renderer}; do
+        echo "== stage $stage"
+        mkdir -p "$out/$stage"
+        # Exit status 2 means mutants survived, 3 timeouts: the next stage runs either way.
+        case "$stage" in
+        unit)
+            mutants --package volpt-core --output "$out/unit" --exclude "$renderer_files" "$@" \
+                --test-package volpt-core || true
+            ;;
+        unit-renderer)
+            rm -rf "$out/unit-renderer/mutants.out"
+            cp -r "$out/unit/mutants.out" "$out/unit-renderer/"
+            mutants --package volpt-core --output "$out/unit-renderer" --iterate \
+                --exclude "$renderer_files" "$@" "${renderer_tests[@]}" || true
+            ;;
+        renderer)
+            mutants --package volpt-core --output "$out/renderer" --file "$renderer_files" "$@" \
+                "${renderer_tests[@]}" || true
+            ;;
+        esac
+    done
     ;;
 loaders)
     mutants --package volpt-scene --output "$root/target/mutants-loaders" "$@" \
