@@ -568,7 +568,9 @@ fn write_plots(dir: &Path, title: &str, results: &[(String, Vec<Row>)]) -> Resul
             })
             .collect()
     };
-    let plots: [(&str, &str, fn(&Row) -> f64); 2] = [
+    /// A plot: its file name, its y axis and the row's value on it.
+    type Plot = (&'static str, &'static str, fn(&Row) -> f64);
+    let plots: [Plot; 2] = [
         ("rmse", "RMSE", Row::rmse),
         ("rel-mse", "relative MSE", |r| r.rel_mse),
     ];
