@@ -7,13 +7,12 @@
 # core: every mutant of volpt-core. The files volpt-core's own tests exercise (`units`: phase, BSDF,
 # microfacet, Fresnel, frame, sampling, geometry, grid, tracking, math, RNG) are judged in two
 # stages: stage `unit` runs volpt-core's tests (a mutant rebuilds one crate and ten small test
-# binaries); the mutants it misses go to stage `unit-renderer` (cargo-mutants --iterate: caught
-# mutants are not tried again), judged by the whole-renderer tests that can see a core mutant: the
+# binaries); the mutants it misses (and only those, by name) go to stage `unit-renderer`, judged by the whole-renderer tests that can see a core mutant: the
 # independent references, the majorant checks and the launch-parameter round trip
 # (tests/tests/references.rs, majorant.rs, device_abi.rs), which rebuild the render factory's
 # variants. The files only the whole renderer exercises (camera, medium, environment, the path
-# step, the device ABI, scene and variant plumbing) go to stage `renderer` directly. Each stage
-# takes the same cargo-mutants options, so `--shard k/n` names one sample throughout. Results:
+# step, the device ABI, scene and variant plumbing) go to stage `renderer` directly. The unit and
+# renderer stages take the cargo-mutants options, so `--shard k/n` names one sample of each. Results:
 # target/mutants-core/{unit,unit-renderer,renderer}/mutants.out; a mutant of the units is caught
 # if either of its stages caught it. STAGES (default "unit unit-renderer renderer") picks stages.
 # loaders: the scene loaders (volpt-scene), judged by volpt-scene's tests.
@@ -43,8 +42,12 @@ fi
 
 tree="$root/target/mutants-tree"
 mkdir -p "$tree"
-# Copy the sources (not target/ or .git) over the previous copy; unchanged files keep their mtimes.
-(cd "$root" && git ls-files -co --exclude-standard -z | xargs -0 cp --parents -p -t "$tree")
+# Copy the sources (not target/ or .git) that differ from the previous copy, with a fresh mtime:
+# unchanged files keep theirs (no needless rebuild), and a changed file is always newer than the
+# builds of the previous run (copying with its own, older mtime once left a stale build "fresh").
+(cd "$root" && git ls-files -co --exclude-standard -z | while IFS= read -r -d '' f; do
+    cmp -s "$f" "$tree/$f" || cp --parents -t "$tree" "$f"
+done)
 cd "$tree"
 
 mutants() {
@@ -67,10 +70,15 @@ core)
                 --test-package volpt-core || true
             ;;
         unit-renderer)
-            rm -rf "$out/unit-renderer/mutants.out"
-            cp -r "$out/unit/mutants.out" "$out/unit-renderer/"
-            mutants --package volpt-core --output "$out/unit-renderer" --iterate \
-                --exclude "$renderer_files" "$@" "${renderer_tests[@]}" || true
+            # Exactly the unit stage's survivors (its sample already), by name.
+            filters=()
+            while IFS= read -r name; do
+                filters+=(-F "^$(printf '%s' "$name" | sed 's/[][\\.*+?(){}|^$]/\\&/g')\$")
+            done < <(cat "$out/unit/mutants.out/missed.txt" "$out/unit/mutants.out/timeout.txt")
+            if [ ${#filters[@]} -gt 0 ]; then
+                mutants --package volpt-core --output "$out/unit-renderer" "${filters[@]}" \
+                    "${renderer_tests[@]}" || true
+            fi
             ;;
         renderer)
             mutants --package volpt-core --output "$out/renderer" --file "$renderer_files" "$@" \
