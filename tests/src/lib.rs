@@ -67,6 +67,7 @@ pub fn homogeneous(sigma_t: f32, albedo: f32, phase: PhaseDesc) -> MediumDesc {
         scale: 1.0,
         albedo: AlbedoDesc::Constant([albedo; 3]),
         phase,
+        lookup: Default::default(),
     }
 }
 

@@ -88,6 +88,7 @@ fn grid_absorber_transmits_beer_lambert_for_both_grid_conventions() {
             scale: 1.5,
             albedo: AlbedoDesc::Constant([0.0; 3]),
             phase: PhaseDesc::Isotropic,
+            lookup: Default::default(),
         };
         let desc = cube_scene(32, 32, medium, BsdfDesc::Null, 1.0);
         assert_eq!(

@@ -92,6 +92,12 @@ fn descriptions() -> Vec<SceneDescription> {
                         scale: 3.0,
                         albedo: albedo.clone(),
                         phase,
+                        // Both lookups cross the ABI: a grid decoded with the other one renders
+                        // a different image.
+                        lookup: match phase {
+                            PhaseDesc::Isotropic => GridLookup::Trilinear,
+                            PhaseDesc::HenyeyGreenstein { .. } => GridLookup::Nearest,
+                        },
                     };
                     let mut desc = cube_scene(12, 9, medium, bsdf, 1.0);
                     desc.environment = environment.clone();

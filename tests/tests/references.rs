@@ -92,6 +92,7 @@ fn single_scattering_matches_numerical_integration() {
             scale: 0.5,
             albedo: AlbedoDesc::Constant([0.9, 0.7, 0.5]),
             phase: PhaseDesc::HenyeyGreenstein { g },
+            lookup: Default::default(),
         };
         let mut desc = scene(
             [0.5, 1.3, 1.9],
@@ -224,6 +225,7 @@ fn grid_absorber_matches_independent_beer_lambert() {
             scale: 2.5,
             albedo: AlbedoDesc::Constant([0.0; 3]),
             phase: PhaseDesc::Isotropic,
+            lookup: Default::default(),
         };
         let desc = scene(
             [2.0, 1.5, 2.5],
@@ -267,6 +269,7 @@ fn image_orientation_matches_the_reference_camera() {
             scale: 1.0,
             albedo: AlbedoDesc::Constant([0.0; 3]),
             phase: PhaseDesc::Isotropic,
+            lookup: Default::default(),
         },
         EnvironmentDesc::Constant([1.0; 3]),
     );

@@ -96,6 +96,7 @@ fn grid_medium(grid: GridDesc, albedo: f32) -> MediumDesc {
         scale: 1.0,
         albedo: AlbedoDesc::Constant([albedo; 3]),
         phase: PhaseDesc::Isotropic,
+        lookup: Default::default(),
     }
 }
 

@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 use anyhow::{bail, Context, Result};
 use volpt_film::checkpoint::{Checkpoint, Fnv};
 use volpt_render::{Effects, Film, Image, RenderStats};
-use volpt_scene::{AlbedoDesc, DensityDesc, EnvironmentDesc, SceneDescription};
+use volpt_scene::{AlbedoDesc, DensityDesc, EnvironmentDesc, GridLookup, SceneDescription};
 
 use crate::backend::{Backend, RenderJob};
 
@@ -119,6 +119,11 @@ pub fn fingerprint(job: &RenderJob) -> u64 {
         desc.medium.scale,
         job.effects == Effects::General
     ));
+    // Only a non-default lookup enters, so that checkpoints of trilinear renders written before
+    // the lookup existed still resume.
+    if desc.medium.lookup != GridLookup::Trilinear {
+        text(format!("{:?}", desc.medium.lookup));
+    }
     let mut floats = |values: &[f32]| {
         for v in values {
             h.write(&v.to_bits().to_le_bytes());

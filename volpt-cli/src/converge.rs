@@ -16,24 +16,28 @@
 //! `--reference-spp` with the scene's own settings (roulette from depth 5 at the latest, which
 //! changes the noise, not the mean), cached in the output directory.
 //!
-//! Settings are knobs the renderer really has ([`Choice`]); a new knob (GPU math, strategy) adds a
-//! variant there and nothing else.
+//! Settings are knobs the renderer really has ([`Choice`]): integrator limits, the grid lookup,
+//! the film's precision and the GPU strategy. A knob of the GPU backend (as GPU math will be) is a
+//! variant there that sets a field of the configuration's [`SamplingArgs`], from which each
+//! configuration opens its own backend.
 
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::{bail, Context, Result};
-use clap::Args;
+use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use volpt_core::{Estimator, PathSettings};
-use volpt_render::{path_settings, Effects, Image, RenderOptions};
+use volpt_cuda::{Math, Strategy};
+use volpt_film::Film;
+use volpt_render::{path_settings, Image, RenderOptions};
 use volpt_scene::description::{AlbedoDesc, BsdfDesc, EnvironmentDesc};
 use volpt_scene::SceneDescription;
 
-use crate::backend::{Backend, RenderJob};
-use crate::plot::{log_log_svg, Series};
-use crate::{load, options, SamplingArgs, SceneArgs};
+use crate::backend::{Backend, BackendKind, RenderJob, StrategyArg};
+use crate::plot::{log_log_png, log_log_svg, Series};
+use crate::{load, options, AccumulationArg, LookupArg, SamplingArgs, SceneArgs};
 
 #[derive(Args)]
 pub struct ConvergeArgs {
@@ -42,7 +46,9 @@ pub struct ConvergeArgs {
     #[command(flatten)]
     sampling: SamplingArgs,
     /// A knob and the values to compare, e.g. `rr_depth=1,5,-1`, `roulette=on,off`,
-    /// `max_depth=2,4,8,-1`. Several give every combination. Without any, the scene's own settings.
+    /// `max_depth=2,4,8,-1`, `lookup=trilinear,nearest`, `accumulation=f64,f32` (CPU),
+    /// `strategy=naive-sk,regeneration-sk` (GPU). Several give every combination. Without any, the
+    /// scene's own settings.
     #[arg(long = "setting", value_name = "NAME=A,B,...", value_parser = parse_setting)]
     settings: Vec<Vec<Choice>>,
     /// Reference image (OpenEXR); default: the analytic value of a white furnace, or a render at
@@ -80,11 +86,20 @@ pub enum Choice {
     Estimator(Estimator),
     /// Cells of the majorant grid along the longest axis; 1 is the global majorant.
     MajorantResolution(u32),
+    /// Trilinear or nearest-sample reconstruction of the medium's grids.
+    Lookup(LookupArg),
+    /// The precision the film adds samples in (the CPU backend's; the GPU film sums in f64).
+    Accumulation(AccumulationArg),
+    /// The GPU scheduling strategy.
+    Strategy(Strategy),
+    /// Exact or fast GPU kernels.
+    Math(Math),
 }
 
 impl Choice {
-    fn apply(self, settings: &mut PathSettings, scene: &PathSettings) {
+    fn apply(self, config: &mut Configuration, scene: &PathSettings) {
         let depth = |d: Option<u32>| d.unwrap_or(PathSettings::UNLIMITED);
+        let settings = &mut config.settings;
         match self {
             Choice::Roulette(true) if scene.rr_depth == PathSettings::UNLIMITED => {
                 settings.rr_depth = PathSettings::default().rr_depth
@@ -95,6 +110,12 @@ impl Choice {
             Choice::MaxDepth(d) => settings.max_depth = depth(d),
             Choice::Estimator(e) => settings.estimator = e,
             Choice::MajorantResolution(r) => settings.majorant_resolution = r,
+            Choice::Lookup(lookup) => config.lookup = Some(lookup),
+            Choice::Accumulation(accumulation) => config.accumulation = accumulation,
+            Choice::Strategy(strategy) => {
+                config.sampling.gpu.strategy = Some(StrategyArg::Fixed(strategy))
+            }
+            Choice::Math(math) => config.sampling.gpu.math = Some(math),
         }
     }
 
@@ -107,8 +128,27 @@ impl Choice {
             Choice::Estimator(Estimator::PathTracing) => "estimator=pt".to_owned(),
             Choice::Estimator(Estimator::NextEvent) => "estimator=nee".to_owned(),
             Choice::MajorantResolution(r) => format!("majorant_resolution={r}"),
+            Choice::Lookup(lookup) => format!("lookup={}", value_name(&lookup)),
+            Choice::Accumulation(a) => format!("accumulation={}", value_name(&a)),
+            Choice::Strategy(strategy) => format!("strategy={}", value_name(&strategy)),
+            Choice::Math(math) => format!("math={}", value_name(&math)),
         }
     }
+}
+
+/// A knob's value as the command line spells it.
+fn value_name<T: ValueEnum>(value: &T) -> String {
+    value
+        .to_possible_value()
+        .map_or_else(String::new, |v| v.get_name().to_owned())
+}
+
+/// A value of an enumerated knob, or an error listing the values it takes.
+fn enum_value<T: ValueEnum>(name: &str, v: &str) -> Result<T, String> {
+    T::from_str(v, false).map_err(|_| {
+        let names: Vec<String> = T::value_variants().iter().map(value_name).collect();
+        format!("{name}: expected one of {}, found {v:?}", names.join(", "))
+    })
 }
 
 fn parse_setting(s: &str) -> Result<Vec<Choice>, String> {
@@ -143,40 +183,57 @@ fn parse_setting(s: &str) -> Result<Vec<Choice>, String> {
                     "majorant_resolution: expected cells from 1 to 1024, found {v:?}"
                 )),
             },
+            "lookup" => enum_value(name, v).map(Choice::Lookup),
+            "accumulation" => enum_value(name, v).map(Choice::Accumulation),
+            "strategy" => enum_value(name, v).map(Choice::Strategy),
+            "math" => enum_value(name, v).map(Choice::Math),
             _ => Err(format!(
-                "unknown setting {name:?}: expected roulette, rr_depth, max_depth, estimator or \
-                 majorant_resolution"
+                "unknown setting {name:?}: expected roulette, rr_depth, max_depth, estimator, \
+                 majorant_resolution, lookup, accumulation, strategy or math"
             )),
         })
         .collect()
 }
 
-/// One configuration: its name and the integrator settings it renders with.
+/// One configuration: its name and what it renders with.
+#[derive(Clone)]
 struct Configuration {
     label: String,
     settings: PathSettings,
+    /// The grid lookup; `None` keeps the scene's (or `--lookup`'s).
+    lookup: Option<LookupArg>,
+    accumulation: AccumulationArg,
+    /// Backend, GPU strategy: each configuration opens its own backend from these.
+    sampling: SamplingArgs,
 }
 
 /// Every combination of the settings' values (the scene's own settings if there are none).
-fn configurations(desc: &SceneDescription, settings: &[Vec<Choice>]) -> Vec<Configuration> {
+fn configurations(
+    desc: &SceneDescription,
+    sampling: &SamplingArgs,
+    settings: &[Vec<Choice>],
+) -> Vec<Configuration> {
     let scene = path_settings(desc);
     let mut out = vec![Configuration {
         label: String::new(),
         settings: scene,
+        lookup: None,
+        accumulation: AccumulationArg::F64,
+        sampling: sampling.clone(),
     }];
     for values in settings {
         out = out
             .iter()
             .flat_map(|c| {
                 values.iter().map(move |choice| {
-                    let mut settings = c.settings;
-                    choice.apply(&mut settings, &scene);
-                    let label = if c.label.is_empty() {
+                    let mut config = c.clone();
+                    choice.apply(&mut config, &scene);
+                    config.label = if c.label.is_empty() {
                         choice.label()
                     } else {
                         format!("{} {}", c.label, choice.label())
                     };
-                    Configuration { label, settings }
+                    config
                 })
             })
             .collect();
@@ -250,27 +307,20 @@ impl Reference {
     }
 }
 
-/// The sums of both halves of the samples, per pixel channel.
+/// Both halves of the samples: two films that grow by a batch per round, in the configuration's
+/// precision, each from its own seed.
 struct Halves {
-    a: Vec<[f64; 3]>,
-    b: Vec<[f64; 3]>,
-    spp_each: u64,
+    films: [Film; 2],
+    spp_each: u32,
 }
 
 impl Halves {
-    fn add(sums: &mut [[f64; 3]], image: &Image, spp: u32) {
-        for (s, p) in sums.iter_mut().zip(&image.pixels) {
-            for c in 0..3 {
-                s[c] += p[c] as f64 * spp as f64;
-            }
-        }
-    }
-
     /// MSE, relative MSE and the variance of the estimate, over all pixel channels.
     fn errors(&self, reference: &Reference) -> (f64, f64, f64) {
         let n = self.spp_each as f64;
+        let [a, b] = [&self.films[0].sums, &self.films[1].sums];
         let (mut mse, mut rel, mut var) = (0.0, 0.0, 0.0);
-        for (i, (a, b)) in self.a.iter().zip(&self.b).enumerate() {
+        for (i, (a, b)) in a.iter().zip(b).enumerate() {
             for c in 0..3 {
                 let (ma, mb) = (a[c] / n, b[c] / n);
                 let estimate = 0.5 * (ma + mb);
@@ -281,46 +331,50 @@ impl Halves {
                 var += (0.5 * (ma - mb)).powi(2);
             }
         }
-        let count = 3.0 * self.a.len() as f64;
+        let count = 3.0 * a.len() as f64;
         (mse / count, rel / count, var / count)
     }
 }
 
-/// Renders `desc` with `settings`, `spp` samples and `seed`: every render of this command.
-fn render_once(
+/// Adds samples `samples` (of seed `options.seed`) to `film`: every batch of the runs.
+fn add_batch(
     backend: &Backend,
-    desc: &SceneDescription,
-    settings: PathSettings,
-    options: RenderOptions,
-    effects: Effects,
-) -> Result<(Image, Duration)> {
-    let job = RenderJob {
-        desc,
-        settings,
-        options,
-        effects,
-        show_progress: false,
-    };
-    let (image, stats) = backend.render(&job)?;
+    job: &RenderJob,
+    film: &mut Film,
+    samples: std::ops::Range<u32>,
+) -> Result<Duration> {
+    let stats = backend.render_into(job, film, samples)?;
     if stats.counters.truncated > 0 {
         tracing::warn!(
             truncated = stats.counters.truncated,
             "paths reached a safety bound and were dropped"
         );
     }
-    Ok((image, stats.elapsed))
+    Ok(stats.elapsed)
 }
 
 pub fn run(args: &ConvergeArgs) -> Result<()> {
-    let desc = load(&args.scene)?;
+    let mut desc = load(&args.scene)?;
     let base = options(&desc, &args.sampling)?;
+    let configurations = configurations(&desc, &args.sampling, &args.settings);
+    // Before the reference, so that a configuration a backend cannot render costs nothing.
+    if let Some(c) = configurations
+        .iter()
+        .find(|c| c.sampling.backend == BackendKind::Cuda && c.accumulation == AccumulationArg::F32)
+    {
+        bail!(
+            "{}: the GPU film sums in f64 only; compare accumulations with --backend cpu",
+            c.label
+        );
+    }
     let mut backend = Backend::open(args.sampling.backend, args.sampling.gpu)?;
     backend.place_volumes(&args.sampling.volumes)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let reference = reference(args, &desc, &backend, base)?;
-    let configurations = configurations(&desc, &args.settings);
-    let pixels = (desc.film.width * desc.film.height) as usize;
+    drop(backend);
+    let scene_lookup = desc.medium.lookup;
+    let (w, h) = (desc.film.width, desc.film.height);
 
     let mut results = Vec::new();
     for (k, config) in configurations.iter().enumerate() {
@@ -335,38 +389,38 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
             configurations.len(),
             config.label
         ));
+        let mut backend = Backend::open(config.sampling.backend, config.sampling.gpu)?;
+        backend.place_volumes(&config.sampling.volumes)?;
+        desc.medium.lookup = config.lookup.map_or(scene_lookup, Into::into);
+        let film = Film::new(w, h).with_accumulation(config.accumulation.into());
         let mut halves = Halves {
-            a: vec![[0.0; 3]; pixels],
-            b: vec![[0.0; 3]; pixels],
+            films: [film.clone(), film],
             spp_each: 0,
         };
         let mut time = 0.0;
         let mut rows = Vec::new();
         for round in 0.. {
             let spp = 1u32 << round.min(20);
-            // Distinct seeds for every batch of every round (and not the reference's).
-            let seed = |half: u32| base.seed.wrapping_add(2 * round + half + 1);
-            for (half, sums) in [(0, &mut halves.a), (1, &mut halves.b)] {
-                let options = RenderOptions {
-                    spp,
-                    seed: seed(half),
-                    ..base
+            let samples = halves.spp_each..halves.spp_each + spp;
+            for (half, film) in (0u32..).zip(&mut halves.films) {
+                let job = RenderJob {
+                    desc: &desc,
+                    settings: config.settings,
+                    // One seed per half (not the reference's); each round continues its samples.
+                    options: RenderOptions {
+                        seed: base.seed.wrapping_add(half + 1),
+                        ..base
+                    },
+                    effects: args.scene.effects(),
+                    show_progress: false,
                 };
-                let (image, elapsed) = render_once(
-                    &backend,
-                    &desc,
-                    config.settings,
-                    options,
-                    args.scene.effects(),
-                )?;
-                Halves::add(sums, &image, spp);
-                time += elapsed.as_secs_f64();
+                time += add_batch(&backend, &job, film, samples.clone())?.as_secs_f64();
             }
-            halves.spp_each += spp as u64;
+            halves.spp_each += spp;
             let (mse, rel_mse, variance) = halves.errors(&reference);
             let row = Row {
                 round,
-                spp: 2 * halves.spp_each,
+                spp: 2 * halves.spp_each as u64,
                 time_s: time,
                 mse,
                 rel_mse,
@@ -478,9 +532,10 @@ fn white_furnace(desc: &SceneDescription) -> Option<[f32; 3]> {
 /// FNV-1a of everything the reference depends on, so that a changed scene renders a new one.
 fn reference_key(args: &ConvergeArgs, desc: &SceneDescription) -> u64 {
     let key = format!(
-        "{:?} {:?} {:?} {} {}",
+        "{:?} {:?} {:?} {:?} {} {}",
         std::fs::canonicalize(&args.scene.scene).unwrap_or_else(|_| args.scene.scene.clone()),
         args.scene.config(),
+        desc.medium.lookup,
         reference_settings(desc),
         args.reference_spp,
         args.sampling.seed
@@ -490,15 +545,18 @@ fn reference_key(args: &ConvergeArgs, desc: &SceneDescription) -> u64 {
     })
 }
 
+/// Writes `bytes` to `dir/name`.
+fn write(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf> {
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).with_context(|| format!("writing {}", path.display()))?;
+    Ok(path)
+}
+
+const CSV_HEADER: &str =
+    "setting,round,spp,time_s,rmse,rel_mse,variance,reference_variance,bias,efficiency";
+
 fn write_outputs(args: &ConvergeArgs, results: &[(String, Vec<Row>)]) -> Result<()> {
-    let write = |name: &str, text: &str| -> Result<PathBuf> {
-        let path = args.out.join(name);
-        std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
-        Ok(path)
-    };
-    let mut csv = String::from(
-        "setting,round,spp,time_s,rmse,rel_mse,variance,reference_variance,bias,efficiency\n",
-    );
+    let mut csv = format!("{CSV_HEADER}\n");
     for (label, rows) in results {
         for r in rows {
             let _ = writeln!(
@@ -516,6 +574,20 @@ fn write_outputs(args: &ConvergeArgs, results: &[(String, Vec<Row>)]) -> Result<
             );
         }
     }
+    let mut written = vec![write(&args.out, "converge.csv", csv.as_bytes())?];
+    let scene = args.scene.scene.display().to_string();
+    written.extend(write_plots(&args.out, &scene, results)?);
+    let table = table(results, args.target_rmse);
+    print!("{table}");
+    written.push(write(&args.out, "table.md", table.as_bytes())?);
+    for path in written {
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+/// `rmse` and `rel-mse` against render time, as SVG and PNG, in `dir`.
+fn write_plots(dir: &Path, title: &str, results: &[(String, Vec<Row>)]) -> Result<Vec<PathBuf>> {
     let series = |f: fn(&Row) -> f64| -> Vec<Series> {
         results
             .iter()
@@ -525,30 +597,71 @@ fn write_outputs(args: &ConvergeArgs, results: &[(String, Vec<Row>)]) -> Result<
             })
             .collect()
     };
-    let scene = args.scene.scene.display().to_string();
-    let mut written = vec![
-        write("converge.csv", &csv)?,
-        write(
-            "rmse.svg",
-            &log_log_svg(&scene, "render time (s)", "RMSE", &series(Row::rmse)),
-        )?,
-        write(
-            "rel-mse.svg",
-            &log_log_svg(
-                &scene,
-                "render time (s)",
-                "relative MSE",
-                &series(|r| r.rel_mse),
-            ),
-        )?,
+    /// A plot: its file name, its y axis and the row's value on it.
+    type Plot = (&'static str, &'static str, fn(&Row) -> f64);
+    let plots: [Plot; 2] = [
+        ("rmse", "RMSE", Row::rmse),
+        ("rel-mse", "relative MSE", |r| r.rel_mse),
     ];
-    let table = table(results, args.target_rmse);
-    print!("{table}");
-    written.push(write("table.md", &table)?);
-    for path in written {
+    let mut written = Vec::new();
+    for (name, y_label, y) in plots {
+        let series = series(y);
+        let svg = log_log_svg(title, "render time (s)", y_label, &series);
+        written.push(write(dir, &format!("{name}.svg"), svg.as_bytes())?);
+        let png = log_log_png(title, "render time (s)", y_label, &series)?;
+        written.push(write(dir, &format!("{name}.png"), &png)?);
+    }
+    Ok(written)
+}
+
+/// `volpt plot DIR`: the plots of a run again, from its `converge.csv` (e.g. one made on a
+/// machine whose plots did not come back), titled with `title`.
+pub fn replot(dir: &Path, title: &str) -> Result<()> {
+    let path = dir.join("converge.csv");
+    let text =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let results = parse_csv(&text).with_context(|| format!("{}", path.display()))?;
+    for path in write_plots(dir, title, &results)? {
         println!("wrote {}", path.display());
     }
     Ok(())
+}
+
+/// The rows of a `converge.csv`, grouped by setting in the order they appear.
+fn parse_csv(text: &str) -> Result<Vec<(String, Vec<Row>)>> {
+    let mut lines = text.lines().enumerate();
+    match lines.next() {
+        Some((_, header)) if header == CSV_HEADER => {}
+        _ => bail!("line 1: expected the header {CSV_HEADER:?}"),
+    }
+    let mut results: Vec<(String, Vec<Row>)> = Vec::new();
+    for (i, line) in lines {
+        let fields: Vec<&str> = line.split(',').collect();
+        let number = |k: usize| -> Result<f64> {
+            fields
+                .get(k)
+                .and_then(|f| f.parse::<f64>().ok())
+                .with_context(|| format!("line {}: field {k} is not a number: {line:?}", i + 1))
+        };
+        if fields.len() != CSV_HEADER.split(',').count() {
+            bail!("line {}: expected 10 fields, found {line:?}", i + 1);
+        }
+        let rmse = number(4)?;
+        let row = Row {
+            round: number(1)? as u32,
+            spp: number(2)? as u64,
+            time_s: number(3)?,
+            mse: rmse * rmse,
+            rel_mse: number(5)?,
+            variance: number(6)?,
+            reference_variance: number(7)?,
+        };
+        match results.last_mut() {
+            Some((label, rows)) if label == fields[0] => rows.push(row),
+            _ => results.push((fields[0].to_owned(), vec![row])),
+        }
+    }
+    Ok(results)
 }
 
 /// Final errors per configuration, the time each first reached the target RMSE, and its efficiency.
@@ -593,11 +706,62 @@ mod tests {
         assert!(parse_setting("depth=3")
             .unwrap_err()
             .contains("unknown setting"));
+        assert_eq!(
+            parse_setting("lookup=trilinear,nearest").unwrap(),
+            vec![
+                Choice::Lookup(LookupArg::Trilinear),
+                Choice::Lookup(LookupArg::Nearest)
+            ]
+        );
+        assert_eq!(
+            parse_setting("accumulation=f32").unwrap(),
+            vec![Choice::Accumulation(AccumulationArg::F32)]
+        );
+        assert_eq!(
+            parse_setting("strategy=naive-sk").unwrap(),
+            vec![Choice::Strategy(Strategy::NaiveSk)]
+        );
+        assert_eq!(
+            parse_setting("lookup=cubic").unwrap_err(),
+            "lookup: expected one of trilinear, nearest, found \"cubic\""
+        );
+
         let scene = PathSettings::default();
-        let mut s = scene;
-        Choice::MaxDepth(Some(3)).apply(&mut s, &scene);
-        Choice::Roulette(false).apply(&mut s, &scene);
+        let sampling = SamplingArgs {
+            seed: 0,
+            threads: None,
+            backend: BackendKind::Cpu,
+            gpu: crate::backend::GpuArgs::default(),
+            volumes: Default::default(),
+        };
+        let mut config = Configuration {
+            label: String::new(),
+            settings: scene,
+            lookup: None,
+            accumulation: AccumulationArg::F64,
+            sampling,
+        };
+        for choice in [
+            Choice::MaxDepth(Some(3)),
+            Choice::Roulette(false),
+            Choice::Lookup(LookupArg::Nearest),
+            Choice::Accumulation(AccumulationArg::F32),
+            Choice::Strategy(Strategy::NaiveSk),
+        ] {
+            choice.apply(&mut config, &scene);
+        }
+        let s = config.settings;
         assert_eq!((s.max_depth, s.rr_depth), (3, PathSettings::UNLIMITED));
+        assert_eq!(config.lookup, Some(LookupArg::Nearest));
+        assert_eq!(config.accumulation, AccumulationArg::F32);
+        assert_eq!(
+            config.sampling.gpu.strategy,
+            Some(StrategyArg::Fixed(Strategy::NaiveSk))
+        );
+        assert_eq!(
+            Choice::Accumulation(AccumulationArg::F32).label(),
+            "accumulation=f32"
+        );
     }
 
     /// Two halves that differ by +-d around an estimate that is off by e: the variance estimate is
@@ -605,9 +769,12 @@ mod tests {
     #[test]
     fn errors_split_into_variance_and_bias() {
         let (r, e, d) = (0.5, 0.1, 0.2);
+        let film = |v: f64| Film {
+            sums: vec![[v; 3]; 4],
+            ..Film::new(2, 2)
+        };
         let halves = Halves {
-            a: vec![[r + e + d; 3]; 4],
-            b: vec![[r + e - d; 3]; 4],
+            films: [film(r + e + d), film(r + e - d)],
             spp_each: 1,
         };
         let (mse, rel, var) = halves.errors(&Reference::Constant([r as f32; 3]));
@@ -625,5 +792,28 @@ mod tests {
         };
         assert!((row.bias() - 0.2).abs() < 1e-12);
         assert!((row.efficiency() - 1.0 / 0.12).abs() < 1e-9);
+    }
+
+    #[test]
+    fn csv_parses_back_into_rows_per_setting() {
+        let text = format!(
+            "{CSV_HEADER}\na b,0,2,0.5,2.000000e-1,1e-2,1e-3,0,1e-1,5\n\
+             a b,1,6,1.5,1.000000e-1,5e-3,1e-4,0,1e-2,6\nc,0,2,0.25,3e-1,1e-2,1e-3,0,0,1\n"
+        );
+        let results = parse_csv(&text).unwrap();
+        assert_eq!(results.len(), 2);
+        assert_eq!((results[0].0.as_str(), results[0].1.len()), ("a b", 2));
+        let row = results[0].1[1];
+        assert_eq!((row.round, row.spp, row.time_s), (1, 6, 1.5));
+        assert!((row.rmse() - 0.1).abs() < 1e-12);
+        assert!(parse_csv("spp,rmse\n")
+            .unwrap_err()
+            .to_string()
+            .contains("header"));
+        let short = format!("{CSV_HEADER}\nc,0,2\n");
+        assert!(parse_csv(&short)
+            .unwrap_err()
+            .to_string()
+            .contains("line 2"));
     }
 }

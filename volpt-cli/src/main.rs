@@ -13,12 +13,13 @@ mod volume;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 use tracing_subscriber::EnvFilter;
+use volpt_film::Accumulation;
 use volpt_render::factory::{Effects, Parts};
 use volpt_render::image::preview_path;
 use volpt_render::{path_settings, Image, RenderOptions, RenderStats, Variant};
-use volpt_scene::{Config, SceneAssembler, SceneDescription};
+use volpt_scene::{Config, GridLookup, SceneAssembler, SceneDescription};
 
 use backend::{Backend, BackendKind, GpuArgs, RenderJob};
 use volpt_core::{Estimator, PathSettings};
@@ -52,11 +53,18 @@ enum Command {
     Scene(SceneCommand),
     /// Compare two OpenEXR images pixel by pixel (e.g. a CPU and a GPU render of one seed).
     Compare(compare::CompareArgs),
-    /// Error against time for each setting: progressive renders, CSV, SVG plots, a table.
+    /// Error against time for each setting: progressive renders, CSV, SVG and PNG plots, a table.
     Converge(converge::ConvergeArgs),
     /// Test the GPU strategies' collective building blocks (block scan, warp and block index
     /// takers) on the GPU against plain CPU implementations.
     Selftest,
+    /// Plot a `volpt converge` run again from the converge.csv in DIR (SVG and PNG).
+    Plot {
+        dir: PathBuf,
+        /// Title of the plots (default: DIR's name).
+        #[arg(long)]
+        title: Option<String>,
+    },
 }
 
 #[derive(Subcommand)]
@@ -116,6 +124,9 @@ struct SceneArgs {
     /// index-matched boundary, pt elsewhere; nee needs an index-matched boundary).
     #[arg(long, value_enum)]
     estimator: Option<EstimatorArg>,
+    /// How the medium's grids are reconstructed between samples (default: the scene's, trilinear).
+    #[arg(long, value_enum)]
+    lookup: Option<LookupArg>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -132,6 +143,40 @@ enum EstimatorArg {
     Pt,
     /// Next-event estimation of the environment at scattering events, with MIS.
     Nee,
+}
+
+/// `--lookup`: a grid's reconstruction.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum LookupArg {
+    /// Trilinear interpolation of the eight samples around a point.
+    Trilinear,
+    /// The nearest sample's value: one read instead of eight.
+    Nearest,
+}
+
+impl From<LookupArg> for GridLookup {
+    fn from(lookup: LookupArg) -> Self {
+        match lookup {
+            LookupArg::Trilinear => GridLookup::Trilinear,
+            LookupArg::Nearest => GridLookup::Nearest,
+        }
+    }
+}
+
+/// The precision a film adds samples in (`volpt converge --setting accumulation=...`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum AccumulationArg {
+    F64,
+    F32,
+}
+
+impl From<AccumulationArg> for Accumulation {
+    fn from(a: AccumulationArg) -> Self {
+        match a {
+            AccumulationArg::F64 => Accumulation::F64,
+            AccumulationArg::F32 => Accumulation::F32,
+        }
+    }
 }
 
 impl SceneArgs {
@@ -175,7 +220,7 @@ impl SceneArgs {
     }
 }
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 struct SamplingArgs {
     /// Seed of the random streams: the same seed gives the same image on every backend.
     #[arg(long, default_value_t = 0)]
@@ -322,6 +367,10 @@ fn main() -> Result<()> {
         Command::Compare(args) => compare::run(&args),
         Command::Converge(args) => converge::run(&args),
         Command::Selftest => selftest(),
+        Command::Plot { dir, title } => {
+            let title = title.unwrap_or_else(|| export_name(&dir));
+            converge::replot(&dir, &title)
+        }
     }
 }
 
@@ -343,7 +392,11 @@ fn export_name(scene: &Path) -> String {
 
 fn load(args: &SceneArgs) -> Result<SceneDescription> {
     let builder = volpt_scene::builder_for(&args.scene)?;
-    Ok(SceneAssembler::new(args.config()).assemble(builder.as_ref())?)
+    let mut desc = SceneAssembler::new(args.config()).assemble(builder.as_ref())?;
+    if let Some(lookup) = args.lookup {
+        desc.medium.lookup = lookup.into();
+    }
+    Ok(desc)
 }
 
 fn options(desc: &SceneDescription, sampling: &SamplingArgs) -> Result<RenderOptions> {

@@ -145,6 +145,13 @@ fn damaged_or_foreign_checkpoints_are_clear_errors() {
         &p("b.exr"),
     ));
     assert!(e.contains("c.ckpt") && e.contains("another render"), "{e}");
+    // Another grid lookup: not the same medium.
+    let e = err(render(
+        4,
+        &["--resume", s(&ckpt), "--lookup", "nearest"],
+        &p("b.exr"),
+    ));
+    assert!(e.contains("c.ckpt") && e.contains("another render"), "{e}");
     // Another film size.
     let mut args = vec!["render".to_owned(), example(), "--spp".into(), "4".into()];
     args.extend(["-o", s(&p("b.exr")), "--resolution", "8x8", "--seed", "9"].map(String::from));

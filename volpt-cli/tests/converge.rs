@@ -139,3 +139,65 @@ fn unknown_setting_is_a_clear_error() {
     );
     assert!(!err.contains("panicked"));
 }
+
+/// The film-precision and lookup knobs run end to end (in a furnace every sample is exactly the
+/// light, so an f32 film is exact too, and the homogeneous medium has no grid to look up), and
+/// both plots come as PNG beside the SVG.
+#[test]
+fn accumulation_and_lookup_knobs_run_and_plot_as_png() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = stability_cube();
+    let out = volpt(&[
+        "converge",
+        scene.to_str().unwrap(),
+        "--resolution",
+        "4x4",
+        "--setting",
+        "accumulation=f64,f32",
+        "--setting",
+        "lookup=trilinear,nearest",
+        "--max-spp",
+        "8",
+        "-o",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(dir.path().join("converge.csv")).unwrap();
+    for setting in [
+        "accumulation=f64 lookup=trilinear",
+        "accumulation=f32 lookup=nearest",
+    ] {
+        let rmse = column(&csv, setting, "rmse");
+        assert!(
+            !rmse.is_empty() && rmse.iter().all(|&e| e == 0.0),
+            "{setting}: {csv}"
+        );
+    }
+    for plot in ["rmse.png", "rel-mse.png"] {
+        let bytes = std::fs::read(dir.path().join(plot)).unwrap();
+        assert!(bytes.starts_with(b"\x89PNG\r\n\x1a\n"), "{plot}");
+    }
+}
+
+/// The GPU film sums in f64 only: asking for an f32 film there is refused before anything renders.
+#[test]
+fn f32_accumulation_on_the_gpu_is_a_clear_error() {
+    let scene = stability_cube();
+    let out = volpt(&[
+        "converge",
+        scene.to_str().unwrap(),
+        "--backend",
+        "cuda",
+        "--setting",
+        "accumulation=f32",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("the GPU film sums in f64 only"),
+        "{err}"
+    );
+}

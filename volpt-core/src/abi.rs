@@ -18,7 +18,7 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::camera::PerspectiveCamera;
-use crate::grid::{Grid, GridLayout, GridMapping};
+use crate::grid::{Grid, GridLayout, GridLookup, GridMapping};
 use crate::path::{Estimator, PathSettings};
 use crate::scene::{Scene, VolumeScene};
 use crate::{Aabb, Vec2, Vec3};
@@ -183,8 +183,30 @@ pub struct GridParams {
     pub bounds_max: [f32; 3],
     pub scale: [f32; 3],
     pub offset: [f32; 3],
+    /// [`GridLayout`], as [`GridLayout::to_u32`] writes it.
     pub layout: u32,
-    pub padding: u32,
+    /// [`GridLookup`]: 0 trilinear, 1 nearest.
+    pub lookup: u32,
+}
+
+impl GridLookup {
+    /// The code of [`GridParams::lookup`].
+    pub const fn code(self) -> u32 {
+        match self {
+            GridLookup::Trilinear => 0,
+            GridLookup::Nearest => 1,
+        }
+    }
+
+    /// The lookup of a code the host wrote with [`GridLookup::code`].
+    #[inline]
+    pub const fn from_code(code: u32) -> Self {
+        if code == GridLookup::Nearest.code() {
+            GridLookup::Nearest
+        } else {
+            GridLookup::Trilinear
+        }
+    }
 }
 
 impl GridParams {
@@ -197,13 +219,13 @@ impl GridParams {
             data: placed.address,
             len: placed.len,
             layout: placed.layout.to_u32(),
-            padding: 0,
             res: grid.res,
             channels: C as u32,
             bounds_min: grid.mapping.bounds.min.to_array(),
             bounds_max: grid.mapping.bounds.max.to_array(),
             scale: grid.mapping.scale().to_array(),
             offset: grid.mapping.offset().to_array(),
+            lookup: grid.lookup.code(),
         }
     }
 
@@ -230,6 +252,7 @@ impl GridParams {
                 Vec3::from_array(self.offset),
             ),
             layout: GridLayout::from_u32(self.layout),
+            lookup: GridLookup::from_code(self.lookup),
         }
     }
 }

@@ -1,4 +1,4 @@
-//! Dense 3D grids with trilinear reconstruction.
+//! Dense 3D grids with trilinear (or nearest-sample) reconstruction.
 
 use crate::{Aabb, Vec3};
 
@@ -134,6 +134,16 @@ fn bricked_index(res: [u32; 3], x: u32, y: u32, z: u32) -> u32 {
     (brick << (3 * BRICK_SHIFT)) | inner
 }
 
+/// How a grid reconstructs values between its samples (Mitsuba 3's `filter_type`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum GridLookup {
+    /// Trilinear interpolation of the eight samples around a point.
+    #[default]
+    Trilinear,
+    /// The value of the nearest sample: one read instead of eight, a blockier field.
+    Nearest,
+}
+
 /// A grid of `C`-channel samples, ordered as its [`GridLayout`] says (dense: x fastest,
 /// `data[((z * res_y + y) * res_x + x) * C + c]`).
 /// Borrowed, so that the same type wraps host memory and device memory.
@@ -143,12 +153,18 @@ pub struct Grid<'a, const C: usize> {
     pub res: [u32; 3],
     pub mapping: GridMapping,
     pub layout: GridLayout,
+    pub lookup: GridLookup,
 }
 
 impl<'a, const C: usize> Grid<'a, C> {
     /// A dense grid: `data.len()` must be `res_x * res_y * res_z * C`; lookups index within that.
     pub fn new(data: &'a [f32], res: [u32; 3], mapping: GridMapping) -> Self {
         Self::with_layout(data, res, mapping, GridLayout::Dense)
+    }
+
+    /// The same grid, reconstructed as `lookup` says.
+    pub fn with_lookup(self, lookup: GridLookup) -> Self {
+        Self { lookup, ..self }
     }
 
     /// A grid in `layout`: `data.len()` must be `layout.values(res, C)`.
@@ -168,11 +184,13 @@ impl<'a, const C: usize> Grid<'a, C> {
             res,
             mapping,
             layout,
+            lookup: GridLookup::Trilinear,
         }
     }
 
-    /// Trilinear interpolation of the samples around `p`; zero outside the grid's box, and the edge
-    /// samples held constant between the outermost sample and the box's faces.
+    /// The value at `p`, reconstructed as [`Grid::lookup`] says: zero outside the grid's box, and
+    /// the edge samples held constant between the outermost sample and the box's faces. Either
+    /// reconstruction stays within the samples' range, so a majorant of the samples bounds it.
     #[inline]
     pub fn lookup(&self, p: Vec3) -> [f32; C] {
         // One branch per lookup, not per corner: each layout gets its own copy of the
@@ -207,27 +225,45 @@ impl<'a, const C: usize> Grid<'a, C> {
             .to_index_space(p)
             .max(Vec3::ZERO)
             .min(max_index);
-        let base = q.floor().min((max_index - Vec3::ONE).max(Vec3::ZERO));
-        let f = q - base;
-        let (x0, y0, z0) = (base.x as u32, base.y as u32, base.z as u32);
-        let x1 = (x0 + 1).min(self.res[0] - 1);
-        let y1 = (y0 + 1).min(self.res[1] - 1);
-        let z1 = (z0 + 1).min(self.res[2] - 1);
-        // Rounding can carry `a + (b - a) * t` one ulp above `max(a, b)`; clamped, no lookup ever
-        // exceeds the largest sample, which the majorant of delta tracking relies on.
-        let lerp_c = |a: [f32; C], b: [f32; C], t: f32| {
-            let mut r = [0.0; C];
-            for c in 0..C {
-                r[c] = (a[c] + (b[c] - a[c]) * t).min(a[c].max(b[c]));
+        match self.lookup {
+            GridLookup::Trilinear => trilinear(q, max_index, self.res, at),
+            GridLookup::Nearest => {
+                let n = q.round();
+                at(n.x as u32, n.y as u32, n.z as u32)
             }
-            r
-        };
-        let c00 = lerp_c(at(x0, y0, z0), at(x1, y0, z0), f.x);
-        let c10 = lerp_c(at(x0, y1, z0), at(x1, y1, z0), f.x);
-        let c01 = lerp_c(at(x0, y0, z1), at(x1, y0, z1), f.x);
-        let c11 = lerp_c(at(x0, y1, z1), at(x1, y1, z1), f.x);
-        lerp_c(lerp_c(c00, c10, f.y), lerp_c(c01, c11, f.y), f.z)
+        }
     }
+}
+
+/// Trilinear interpolation around index-space `q`, which lies in `[0, max_index]`, of the samples
+/// `at(x, y, z)` of a grid of `res` samples.
+#[inline(always)]
+fn trilinear<const C: usize>(
+    q: Vec3,
+    max_index: Vec3,
+    res: [u32; 3],
+    at: impl Fn(u32, u32, u32) -> [f32; C],
+) -> [f32; C] {
+    let base = q.floor().min((max_index - Vec3::ONE).max(Vec3::ZERO));
+    let f = q - base;
+    let (x0, y0, z0) = (base.x as u32, base.y as u32, base.z as u32);
+    let x1 = (x0 + 1).min(res[0] - 1);
+    let y1 = (y0 + 1).min(res[1] - 1);
+    let z1 = (z0 + 1).min(res[2] - 1);
+    // Rounding can carry `a + (b - a) * t` one ulp above `max(a, b)`; clamped, no lookup ever
+    // exceeds the largest sample, which the majorant of delta tracking relies on.
+    let lerp_c = |a: [f32; C], b: [f32; C], t: f32| {
+        let mut r = [0.0; C];
+        for c in 0..C {
+            r[c] = (a[c] + (b[c] - a[c]) * t).min(a[c].max(b[c]));
+        }
+        r
+    };
+    let c00 = lerp_c(at(x0, y0, z0), at(x1, y0, z0), f.x);
+    let c10 = lerp_c(at(x0, y1, z0), at(x1, y1, z0), f.x);
+    let c01 = lerp_c(at(x0, y0, z1), at(x1, y0, z1), f.x);
+    let c11 = lerp_c(at(x0, y1, z1), at(x1, y1, z1), f.x);
+    lerp_c(lerp_c(c00, c10, f.y), lerp_c(c01, c11, f.y), f.z)
 }
 
 #[cfg(test)]

@@ -12,7 +12,7 @@ use std::f64::consts::PI;
 use common::*;
 use glam::DVec3;
 use volpt_core::microfacet::Ggx;
-use volpt_core::{Bsdf, BsdfSample, RoughDielectric, SmoothDielectric, Vec2, Vec3};
+use volpt_core::{Bsdf, BsdfSample, NullBoundary, RoughDielectric, SmoothDielectric, Vec2, Vec3};
 
 const ETA: f32 = 1.5;
 
@@ -472,4 +472,16 @@ fn no_nan_or_inf_at_extreme_directions() {
         }
     }
     assert!(some > 1000, "almost every sample was None: {some}");
+}
+
+/// The index-matched boundary passes every direction through unweighted. The path step never asks
+/// it (`Bsdf::IS_NULL` short-circuits the interaction), so only this test holds it to the contract
+/// (mutation testing: `sample` returning `None` left every other test green).
+#[test]
+fn null_boundary_passes_light_through() {
+    let d = Vec3::new(0.6, -0.8, 0.0);
+    let s = NullBoundary
+        .sample(Vec3::Z, d, 0.3, Vec2::new(0.1, 0.9))
+        .expect("an index-matched boundary always transmits");
+    assert_eq!((s.wo, s.weight, s.transmitted, s.eta), (d, 1.0, true, 1.0));
 }

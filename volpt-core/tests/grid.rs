@@ -7,7 +7,7 @@
 mod common;
 
 use common::*;
-use volpt_core::{Aabb, Grid, GridMapping, Vec3};
+use volpt_core::{Aabb, Grid, GridLookup, GridMapping, Vec3};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Convention {
@@ -401,6 +401,52 @@ fn lookups_never_exceed_the_largest_sample() {
                     "{v} above the largest sample {largest} at {p}"
                 );
             }
+        }
+    }
+}
+
+/// Nearest lookup returns the sample whose position is closest along every axis (in f64, from the
+/// sample positions of the convention), so never more than the largest sample; positions within
+/// 1e-4 of a midpoint between samples are skipped, where f32 rounding may pick either side.
+#[test]
+fn nearest_lookup_returns_the_nearest_sample() {
+    let mut rng = TestRng::new(43);
+    for convention in CONVENTIONS {
+        for res in RESOLUTIONS {
+            let data = random_data(&mut rng, res, 1);
+            let grid = Grid::<1>::new(&data, res, mapping(convention, res))
+                .with_lookup(GridLookup::Nearest);
+            let b = bounds();
+            let (lo, hi) = (
+                b.min.to_array().map(f64::from),
+                b.max.to_array().map(f64::from),
+            );
+            let mut checked = 0;
+            for _ in 0..2000 {
+                let p = rounded(random_point(&mut rng, lo, hi));
+                let mut index = [0u32; 3];
+                let mut ambiguous = false;
+                for a in 0..3 {
+                    let mut by_distance: Vec<(f64, u32)> = (0..res[a])
+                        .map(|i| ((sample_position(convention, res, a, i) - p[a]).abs(), i))
+                        .collect();
+                    by_distance.sort_by(|x, y| x.0.total_cmp(&y.0));
+                    index[a] = by_distance[0].1;
+                    ambiguous |=
+                        by_distance.len() > 1 && by_distance[1].0 - by_distance[0].0 < 1e-4;
+                }
+                if ambiguous {
+                    continue;
+                }
+                let i = ((index[2] * res[1] + index[1]) * res[0] + index[0]) as usize;
+                assert_eq!(
+                    grid.lookup(to_vec3(p))[0],
+                    data[i],
+                    "{convention:?} {res:?} at {p:?}: expected sample {index:?}"
+                );
+                checked += 1;
+            }
+            assert!(checked > 1000, "{checked} unambiguous points");
         }
     }
 }

@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use thiserror::Error;
 use volpt_core::path::{sample_pixel, PathCounters};
 use volpt_core::Scene;
-use volpt_film::{Film, Image, NothingToRender, RenderOptions, RenderStats};
+use volpt_film::{Accumulation, Film, Image, NothingToRender, RenderOptions, RenderStats};
 
 #[derive(Debug, Error)]
 pub enum RenderError {
@@ -61,6 +61,7 @@ pub fn render_samples<S: Scene + Sync>(
 
     let total = width as u64 * height as u64 * samples.len() as u64;
     let done = AtomicU64::new(0);
+    let accumulation = film.accumulation;
     let start = Instant::now();
     let counters = pool.install(|| {
         let mut counters = PathCounters::default();
@@ -76,7 +77,29 @@ pub fn render_samples<S: Scene + Sync>(
                     for (x, sum) in row.iter_mut().enumerate() {
                         let pixel = (x as u32, y as u32);
                         let (range, seed) = (pass_samples.clone(), options.seed);
-                        sample_pixel(scene, pixel, range, seed, sum, &mut row_counters);
+                        match accumulation {
+                            Accumulation::F64 => {
+                                sample_pixel(scene, pixel, range, seed, sum, &mut row_counters)
+                            }
+                            // One sample at a time: its f64 "sum" is the f32 radiance exactly.
+                            Accumulation::F32 => {
+                                for sample in range {
+                                    let mut one = [0.0; 3];
+                                    let range = sample..sample + 1;
+                                    sample_pixel(
+                                        scene,
+                                        pixel,
+                                        range,
+                                        seed,
+                                        &mut one,
+                                        &mut row_counters,
+                                    );
+                                    for (s, o) in sum.iter_mut().zip(one) {
+                                        *s = accumulation.add(*s, o);
+                                    }
+                                }
+                            }
+                        }
                     }
                     let n = width as u64 * pass_samples.len() as u64;
                     progress(done.fetch_add(n, Ordering::Relaxed) + n, total);

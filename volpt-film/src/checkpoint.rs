@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
-use crate::Film;
+use crate::{Accumulation, Film};
 
 const MAGIC: &[u8; 8] = b"VOLPTCK1";
 const HEADER: usize = 8 + 8 + 4 * 4;
@@ -181,10 +181,12 @@ impl Checkpoint {
             fingerprint,
             seed,
             samples,
+            // `volpt render`, the one writer of checkpoints, always sums in f64.
             film: Film {
                 width,
                 height,
                 sums,
+                accumulation: Accumulation::F64,
             },
         })
     }

@@ -35,6 +35,31 @@ pub struct Film {
     pub width: u32,
     pub height: u32,
     pub sums: Vec<[f64; 3]>,
+    /// The precision a backend adds samples in (the sums are stored in `f64` either way).
+    pub accumulation: Accumulation,
+}
+
+/// The precision of a film's per-pixel sums.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Accumulation {
+    /// Every sample is added in `f64`.
+    #[default]
+    F64,
+    /// Every sample is added in `f32` and the sum rounded to `f32`, as an `f32` film would: once a
+    /// sum is 2^24 times a sample, the sample's low bits are lost. CPU backend only; the GPU film
+    /// sums in `f64`.
+    F32,
+}
+
+impl Accumulation {
+    /// `sum + sample` in this precision.
+    #[inline]
+    pub fn add(self, sum: f64, sample: f64) -> f64 {
+        match self {
+            Accumulation::F64 => sum + sample,
+            Accumulation::F32 => (sum as f32 + sample as f32) as f64,
+        }
+    }
 }
 
 impl Film {
@@ -43,6 +68,15 @@ impl Film {
             width,
             height,
             sums: vec![[0.0; 3]; width as usize * height as usize],
+            accumulation: Accumulation::F64,
+        }
+    }
+
+    /// The same film, adding samples in `accumulation`.
+    pub fn with_accumulation(self, accumulation: Accumulation) -> Self {
+        Self {
+            accumulation,
+            ..self
         }
     }
 
@@ -111,5 +145,19 @@ impl RenderStats {
     }
     pub fn tracking_steps_per_second(&self) -> f64 {
         self.counters.tracking_steps as f64 / self.elapsed.as_secs_f64()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// At 2^24 an f32 sum no longer changes by 1; an f64 sum does.
+    #[test]
+    fn f32_accumulation_loses_what_f32_cannot_hold() {
+        let big = (1u32 << 24) as f64;
+        assert_eq!(Accumulation::F32.add(big, 1.0), big);
+        assert_eq!(Accumulation::F64.add(big, 1.0), big + 1.0);
+        assert_eq!(Accumulation::F32.add(0.1, 0.2), (0.1f32 + 0.2f32) as f64);
     }
 }

@@ -20,7 +20,7 @@
 use std::fmt;
 
 use volpt_core::abi::SceneAbi;
-use volpt_core::grid::{Grid, GridMapping};
+use volpt_core::grid::{Grid, GridLookup, GridMapping};
 use volpt_core::majorant::{build_majorants, MajorantGrid};
 use volpt_core::math::tan;
 use volpt_core::microfacet::Ggx;
@@ -32,7 +32,8 @@ use volpt_core::{
 };
 use volpt_scene::description::{
     AlbedoDesc, Bounds, BsdfDesc, CameraDesc, DensityDesc, EnvironmentDesc, FilmDesc, FovAxis,
-    GridConvention, GridDesc, LatLongDesc, PhaseDesc, SceneDescription,
+    GridConvention, GridDesc, GridLookup as GridLookupDesc, LatLongDesc, PhaseDesc,
+    SceneDescription,
 };
 
 /// What a backend can render: the CPU needs a [`Scene`] it can share between threads, a GPU backend
@@ -413,15 +414,17 @@ fn medium<'a>(desc: &'a SceneDescription, fired: &mut dyn FnMut(Simplification))
             })
         }
         (Density::Grid(density), Albedo::Constant(albedo)) => MediumPart::GridDensity(GridMedium {
-            density: grid::<1>(density),
+            density: grid::<1>(density, medium.lookup),
             scale: medium.scale,
             majorant: medium.scale * density.max_value(),
             majorants: None,
             albedo: ConstantAlbedo(Spectrum::from_array(albedo)),
         }),
-        (density, Albedo::Grid(albedo)) => {
-            MediumPart::GridDensityAlbedo(grid_medium(desc, density, GridAlbedo(grid::<3>(albedo))))
-        }
+        (density, Albedo::Grid(albedo)) => MediumPart::GridDensityAlbedo(grid_medium(
+            desc,
+            density,
+            GridAlbedo(grid::<3>(albedo, medium.lookup)),
+        )),
     }
 }
 
@@ -434,7 +437,7 @@ fn general_medium(desc: &SceneDescription) -> GridMedium<'_, GridAlbedo<'_>> {
         DensityDesc::Constant(sigma) => Density::Constant(sigma),
     };
     let albedo = match &medium.albedo {
-        AlbedoDesc::Grid(albedo) => grid::<3>(albedo),
+        AlbedoDesc::Grid(albedo) => grid::<3>(albedo, medium.lookup),
         AlbedoDesc::Constant(rgb) => one_voxel(desc, rgb),
     };
     grid_medium(desc, density, GridAlbedo(albedo))
@@ -458,7 +461,7 @@ fn grid_medium<'a>(
     albedo: GridAlbedo<'a>,
 ) -> GridMedium<'a, GridAlbedo<'a>> {
     let density = match density {
-        Density::Grid(density) => grid::<1>(density),
+        Density::Grid(density) => grid::<1>(density, desc.medium.lookup),
         Density::Constant(sigma) => one_voxel(desc, std::slice::from_ref(sigma)),
     };
     let max_density = density.data.iter().copied().fold(0.0, f32::max);
@@ -549,13 +552,17 @@ fn aabb(b: &Bounds) -> Aabb {
     Aabb::new(Vec3::from_array(b.min), Vec3::from_array(b.max))
 }
 
-fn grid<const C: usize>(g: &GridDesc) -> Grid<'_, C> {
+fn grid<const C: usize>(g: &GridDesc, lookup: GridLookupDesc) -> Grid<'_, C> {
     let bounds = aabb(&g.bounds);
     let mapping = match g.convention {
         GridConvention::Vertex => GridMapping::vertex_centred(bounds, g.resolution),
         GridConvention::Cell => GridMapping::cell_centred(bounds, g.resolution),
     };
-    Grid::new(&g.data, g.resolution, mapping)
+    let lookup = match lookup {
+        GridLookupDesc::Trilinear => GridLookup::Trilinear,
+        GridLookupDesc::Nearest => GridLookup::Nearest,
+    };
+    Grid::new(&g.data, g.resolution, mapping).with_lookup(lookup)
 }
 
 /// Mitsuba's perspective camera: the field of view spans `fov_axis`, the other axis follows from the

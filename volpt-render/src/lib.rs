@@ -12,4 +12,6 @@ pub use factory::{
     path_settings, with_scene, with_scene_as, Effects, RenderScene, SceneVisitor, Variant,
 };
 pub use volpt_cpu::{render, render_samples, RenderError};
-pub use volpt_film::{image, Checkpoint, Film, Image, ImageError, RenderOptions, RenderStats};
+pub use volpt_film::{
+    image, Accumulation, Checkpoint, Film, Image, ImageError, RenderOptions, RenderStats,
+};

@@ -99,6 +99,18 @@ pub struct MediumDesc {
     pub scale: f32,
     pub albedo: AlbedoDesc,
     pub phase: PhaseDesc,
+    /// How the medium's grids are reconstructed between their samples.
+    pub lookup: GridLookup,
+}
+
+/// How a grid is reconstructed between its samples (Mitsuba 3's `filter_type`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum GridLookup {
+    /// Trilinear interpolation of the eight samples around a point.
+    #[default]
+    Trilinear,
+    /// The value of the nearest sample.
+    Nearest,
 }
 
 #[derive(Clone, Debug, PartialEq)]

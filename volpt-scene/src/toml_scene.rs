@@ -562,6 +562,7 @@ fn assemble(
             scale: v.scale,
             albedo,
             phase,
+            lookup: Default::default(),
         },
         environment: EnvironmentDesc::Constant(radiance),
     })

@@ -68,6 +68,7 @@ pub(crate) fn medium(el: &Element, ctx: &Ctx<'_>) -> Result<MediumDesc, SceneErr
         scale,
         albedo,
         phase,
+        lookup: Default::default(),
     })
 }
 
