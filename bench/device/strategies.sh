@@ -19,6 +19,7 @@ OUT=${OUT:-$PWD/out}
 mkdir -p "$OUT"
 VOLPT=$PWD/bin/volpt
 BASE=$PWD/bin/volpt-base
+[ -f "$BASE.gz" ] && [ ! -f "$BASE" ] && gunzip -k "$BASE.gz"
 DATA=$PWD/data
 TRIALS=${TRIALS:-5}
 STRATEGIES=(${STRATEGIES:-naive-sk regeneration-sk regeneration-warp-sk regeneration-block-sk streaming-sk})
