@@ -63,8 +63,8 @@ impl std::fmt::Display for StrategyArg {
 /// The flags that only the GPU backend takes: how it schedules and computes.
 #[derive(Clone, Copy, Debug, Default, clap::Args)]
 pub struct GpuArgs {
-    /// GPU scheduling strategy (default: auto, the fastest for the scene by a short calibration,
-    /// cached per scene and GPU).
+    /// GPU scheduling strategy (default: regeneration-sk); `auto` picks the fastest for the scene
+    /// by a short calibration, cached per scene and GPU.
     #[arg(long, value_enum)]
     pub strategy: Option<StrategyArg>,
     /// GPU arithmetic: `exact` is bit-identical to the CPU (default), `fast` uses the GPU's
@@ -128,7 +128,10 @@ impl Backend {
             }
             BackendKind::Cuda => {
                 let math = gpu.math.unwrap_or_default();
-                let schedule = match gpu.strategy.unwrap_or(StrategyArg::Auto) {
+                let schedule = match gpu
+                    .strategy
+                    .unwrap_or(StrategyArg::Fixed(Strategy::RegenerationSk))
+                {
                     StrategyArg::Auto => {
                         if let Some(n) = gpu.max_registers {
                             anyhow::bail!(
