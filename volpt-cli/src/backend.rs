@@ -9,7 +9,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use volpt_core::PathSettings;
 use volpt_cuda::{CudaRenderer, Math, Schedule, Strategy};
 
-use crate::auto::{self, AutoCache, Choice};
+use crate::auto::{self, AutoCache};
 use volpt_render::{
     render_samples, with_scene_as, Effects, Film, Image, RenderOptions, RenderScene, RenderStats,
     SceneVisitor,
@@ -279,9 +279,8 @@ fn auto_schedule<S: RenderScene>(
     scene: &S,
     options: &RenderOptions,
 ) -> Result<Schedule> {
-    if let Some(schedule) = cache.get(key).as_ref().and_then(Choice::schedule) {
-        tracing::info!(strategy = %schedule.strategy, max_registers = ?schedule.max_registers,
-            "auto: cached choice for this scene and GPU");
+    if let Some((choice, schedule)) = cache.get(key).and_then(|c| c.schedule().map(|s| (c, s))) {
+        eprint!("(cached) {}", choice.report());
         return Ok(schedule);
     }
     eprintln!("auto: calibrating the GPU strategies on this scene (cached afterwards)");
