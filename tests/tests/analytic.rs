@@ -3,7 +3,7 @@
 //! is bathed in.
 
 use volpt_core::path::{step, trace, PathState};
-use volpt_core::{Estimator, PathSettings};
+use volpt_core::{Estimator, PathSettings, Roulette};
 use volpt_render::{with_scene, Image, SceneVisitor};
 use volpt_scene::description::*;
 use volpt_tests::compare::{
@@ -388,17 +388,57 @@ fn russian_roulette_is_unbiased() {
         estimator: Estimator::PathTracing,
         ..PathSettings::default()
     };
-    let rr = PathSettings {
-        rr_depth: 1,
-        ..no_rr
-    };
     let (reference, ref_se, _) = with_scene(&desc, no_rr, FurnaceSampleMean { paths: 200_000 });
-    let (mean, se, killed) = with_scene(&desc, rr, FurnaceSampleMean { paths: 200_000 });
-    assert!(killed > 10_000, "roulette never ran");
-    let z = (mean - reference) / (se * se + ref_se * ref_se).sqrt();
+    // Both survival rules: any probability in (0, 1] with the throughput divided by it.
+    for roulette in [Roulette::Mitsuba, Roulette::Throughput] {
+        let rr = PathSettings {
+            rr_depth: 1,
+            roulette,
+            ..no_rr
+        };
+        let (mean, se, killed) = with_scene(&desc, rr, FurnaceSampleMean { paths: 200_000 });
+        assert!(killed > 10_000, "{roulette:?}: roulette never ran");
+        let z = (mean - reference) / (se * se + ref_se * ref_se).sqrt();
+        assert!(
+            z.abs() < 5.0,
+            "{roulette:?} roulette {mean} vs none {reference}: z = {z}"
+        );
+    }
+}
+
+/// The thesis's rule never raises a throughput: in an albedo-1 medium (throughput 1 at every
+/// bounce) no path is killed and every path returns exactly the environment, where Mitsuba's
+/// 0.95 cap kills some paths and multiplies the survivors by 1/0.95 per bounce.
+#[test]
+fn the_throughput_roulette_leaves_a_white_furnace_exact() {
+    // 16x16, so that `FurnaceSampleMean`'s pixel (8, 8) sees the medium.
+    let desc = cube_scene(
+        16,
+        16,
+        homogeneous(5.0, 1.0, PhaseDesc::Isotropic),
+        BsdfDesc::Null,
+        1.0,
+    );
+    let settings = |roulette| PathSettings {
+        rr_depth: 0,
+        estimator: Estimator::PathTracing,
+        roulette,
+        ..PathSettings::default()
+    };
+    let (_, se, killed) = with_scene(
+        &desc,
+        settings(Roulette::Throughput),
+        FurnaceSampleMean { paths: 20_000 },
+    );
+    assert_eq!((killed, se), (0, 0.0));
+    let (_, se, killed) = with_scene(
+        &desc,
+        settings(Roulette::Mitsuba),
+        FurnaceSampleMean { paths: 20_000 },
+    );
     assert!(
-        z.abs() < 5.0,
-        "roulette {mean} vs none {reference}: z = {z}"
+        killed > 0 && se > 0.0,
+        "Mitsuba's rule: {killed} killed, se {se}"
     );
 }
 

@@ -46,6 +46,7 @@ pub struct ConvergeArgs {
     #[command(flatten)]
     sampling: SamplingArgs,
     /// A knob and the values to compare, e.g. `rr_depth=1,5,-1`, `roulette=on,off`,
+    /// `roulette_rule=mitsuba,throughput`,
     /// `max_depth=2,4,8,-1`, `lookup=trilinear,nearest`, `accumulation=f64,f32` (CPU),
     /// `strategy=naive-sk,regeneration-sk` (GPU). Several give every combination. Without any, the
     /// scene's own settings.
@@ -94,6 +95,8 @@ pub enum Choice {
     Strategy(Strategy),
     /// Exact or fast GPU kernels.
     Math(Math),
+    /// Russian roulette's survival probability.
+    RouletteRule(crate::RouletteArg),
 }
 
 impl Choice {
@@ -116,6 +119,7 @@ impl Choice {
                 config.sampling.gpu.strategy = Some(StrategyArg::Fixed(strategy))
             }
             Choice::Math(math) => config.sampling.gpu.math = Some(math),
+            Choice::RouletteRule(rule) => settings.roulette = rule.into(),
         }
     }
 
@@ -132,6 +136,7 @@ impl Choice {
             Choice::Accumulation(a) => format!("accumulation={}", value_name(&a)),
             Choice::Strategy(strategy) => format!("strategy={}", value_name(&strategy)),
             Choice::Math(math) => format!("math={}", value_name(&math)),
+            Choice::RouletteRule(rule) => format!("roulette_rule={}", value_name(&rule)),
         }
     }
 }
@@ -187,9 +192,10 @@ fn parse_setting(s: &str) -> Result<Vec<Choice>, String> {
             "accumulation" => enum_value(name, v).map(Choice::Accumulation),
             "strategy" => enum_value(name, v).map(Choice::Strategy),
             "math" => enum_value(name, v).map(Choice::Math),
+            "roulette_rule" => enum_value(name, v).map(Choice::RouletteRule),
             _ => Err(format!(
-                "unknown setting {name:?}: expected roulette, rr_depth, max_depth, estimator, \
-                 majorant_resolution, lookup, accumulation, strategy or math"
+                "unknown setting {name:?}: expected roulette, roulette_rule, rr_depth, max_depth, \
+                 estimator, majorant_resolution, lookup, accumulation, strategy or math"
             )),
         })
         .collect()

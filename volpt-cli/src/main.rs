@@ -22,7 +22,7 @@ use volpt_render::{path_settings, Image, RenderOptions, RenderStats, Variant};
 use volpt_scene::{Config, GridLookup, SceneAssembler, SceneDescription};
 
 use backend::{Backend, BackendKind, GpuArgs, RenderJob};
-use volpt_core::{Estimator, PathSettings};
+use volpt_core::{Estimator, PathSettings, Roulette};
 
 #[derive(Parser)]
 #[command(
@@ -127,6 +127,27 @@ struct SceneArgs {
     /// How the medium's grids are reconstructed between samples (default: the scene's, trilinear).
     #[arg(long, value_enum)]
     lookup: Option<LookupArg>,
+    /// Russian roulette's survival probability (default: mitsuba); where it starts is --rr-depth.
+    #[arg(long, value_enum)]
+    roulette: Option<RouletteArg>,
+}
+
+/// `--roulette`: Russian roulette's survival probability (`volpt_core::Roulette`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum RouletteArg {
+    /// Mitsuba's: min(max(throughput) * eta^2, 0.95).
+    Mitsuba,
+    /// The thesis's: min(1, max(throughput)).
+    Throughput,
+}
+
+impl From<RouletteArg> for Roulette {
+    fn from(r: RouletteArg) -> Self {
+        match r {
+            RouletteArg::Mitsuba => Roulette::Mitsuba,
+            RouletteArg::Throughput => Roulette::Throughput,
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -191,6 +212,9 @@ impl SceneArgs {
             (_, Some(r)) => r,
             (_, None) => PathSettings::DEFAULT_MAJORANT_RESOLUTION,
         };
+        if let Some(roulette) = self.roulette {
+            settings.roulette = roulette.into();
+        }
         if let Some(estimator) = self.estimator {
             settings.estimator = match estimator {
                 EstimatorArg::Pt => Estimator::PathTracing,

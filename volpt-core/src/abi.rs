@@ -19,7 +19,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::camera::PerspectiveCamera;
 use crate::grid::{Grid, GridLayout, GridLookup, GridMapping};
-use crate::path::{Estimator, PathSettings};
+use crate::path::{Estimator, PathSettings, Roulette};
 use crate::scene::{Scene, VolumeScene};
 use crate::{Aabb, Vec2, Vec3};
 
@@ -133,6 +133,9 @@ pub struct SettingsParams {
     pub majorant_resolution: u32,
     /// 0: path tracing, 1: next-event estimation.
     pub estimator: u32,
+    /// 0: Mitsuba's roulette, 1: the thesis's ([`Roulette`]).
+    pub roulette: u32,
+    pub padding: u32,
 }
 
 impl From<&PathSettings> for SettingsParams {
@@ -147,6 +150,11 @@ impl From<&PathSettings> for SettingsParams {
                 Estimator::PathTracing => 0,
                 Estimator::NextEvent => 1,
             },
+            roulette: match s.roulette {
+                Roulette::Mitsuba => 0,
+                Roulette::Throughput => 1,
+            },
+            padding: 0,
         }
     }
 }
@@ -164,6 +172,11 @@ impl From<&SettingsParams> for PathSettings {
                 Estimator::NextEvent
             } else {
                 Estimator::PathTracing
+            },
+            roulette: if s.roulette == 1 {
+                Roulette::Throughput
+            } else {
+                Roulette::Mitsuba
             },
         }
     }

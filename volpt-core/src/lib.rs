@@ -36,7 +36,7 @@ pub use geometry::{Aabb, Ray};
 pub use grid::{Grid, GridLayout, GridLookup, GridMapping};
 pub use majorant::MajorantGrid;
 pub use medium::{AlbedoField, ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium, Medium};
-pub use path::{Estimator, PathCounters, PathSettings, PathState};
+pub use path::{Estimator, PathCounters, PathSettings, PathState, Roulette};
 pub use phase::{HenyeyGreenstein, Isotropic, PhaseFunction};
 pub use rng::Rng;
 pub use scene::{Scene, VolumeScene};
