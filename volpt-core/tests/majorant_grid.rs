@@ -15,7 +15,9 @@ const RES: [u32; 3] = [4, 3, 5];
 
 /// One distinct value per cell, so that a majorant names the cell it came from.
 fn cell_values() -> Vec<f32> {
-    (0..RES[0] * RES[1] * RES[2]).map(|i| i as f32 + 1.0).collect()
+    (0..RES[0] * RES[1] * RES[2])
+        .map(|i| i as f32 + 1.0)
+        .collect()
 }
 
 fn cell_centre(grid: &MajorantGrid<'_>, x: u32, y: u32, z: u32) -> Vec3 {
@@ -166,7 +168,10 @@ fn dda_walks_the_cells_the_ray_crosses() {
                 );
             }
             segments += 1;
-            assert!(segments < 20, "{ray:?}: more segments than cells along the way");
+            assert!(
+                segments < 20,
+                "{ray:?}: more segments than cells along the way"
+            );
             if end >= exit {
                 break;
             }
