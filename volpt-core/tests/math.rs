@@ -39,3 +39,17 @@ fn sin_cos_2pi_is_exact_on_the_axes() {
     assert_eq!(sin_cos_2pi(0.5), (0.0, -1.0));
     assert_eq!(sin_cos_2pi(0.75), (-1.0, 0.0));
 }
+
+/// Outside [0, 1) the argument is wrapped first (a whole turn changes nothing); negative turns are
+/// where a wrong wrap shows (mutation testing: `u + floor(u)` passed the tests of one turn).
+#[test]
+fn sin_cos_2pi_wraps_whole_turns() {
+    for u in [-0.25f32, -0.1, -1.3, 1.25, 2.6] {
+        let (s, c) = sin_cos_2pi(u);
+        let angle = 2.0 * std::f64::consts::PI * u as f64;
+        assert!(
+            (s as f64 - angle.sin()).abs() < 1e-6 && (c as f64 - angle.cos()).abs() < 1e-6,
+            "sin_cos_2pi({u}) = ({s}, {c})"
+        );
+    }
+}

@@ -11,9 +11,9 @@
 mod common;
 
 use common::*;
-use volpt_core::math::ln;
-use volpt_core::tracking::{delta_tracking, FreeFlight};
-use volpt_core::{HomogeneousMedium, Medium, Ray, Rng, Spectrum, Vec3};
+use volpt_core::math::{exp, ln};
+use volpt_core::tracking::{delta_tracking, ratio_tracking, FreeFlight};
+use volpt_core::{Aabb, HomogeneousMedium, MajorantGrid, Medium, Ray, Rng, Spectrum, Vec3};
 
 const N: u32 = 100_000;
 
@@ -331,5 +331,110 @@ fn step_budget_does_not_change_flights_under_it() {
         let bounded = delta_tracking(&medium, &ray(), 3.0, &mut b, &mut sb, 1000);
         assert_eq!(unbounded, bounded);
         assert_eq!(sa, sb);
+    }
+}
+
+/// `Layered` under a majorant grid of four cells along x (bounds 1.5, 4, 0.5, 1: loose, tight,
+/// tight, loose), so that tracking walks the cells.
+struct LayeredOnGrid<'a> {
+    majorants: MajorantGrid<'a>,
+}
+
+impl Medium for LayeredOnGrid<'_> {
+    const HOMOGENEOUS: bool = false;
+
+    fn majorant(&self) -> f32 {
+        4.0
+    }
+
+    fn majorant_grid(&self) -> Option<&MajorantGrid<'_>> {
+        Some(&self.majorants)
+    }
+
+    fn sigma_t(&self, p: Vec3) -> f32 {
+        Layered { majorant: 4.0 }.sigma_t(p)
+    }
+
+    fn albedo(&self, _p: Vec3) -> Spectrum {
+        Spectrum::ONE
+    }
+}
+
+const GRID_MAJORANTS: [f32; 4] = [1.5, 4.0, 0.5, 1.0];
+
+fn layered_on_grid() -> LayeredOnGrid<'static> {
+    let bounds = Aabb::new(Vec3::new(0.0, -1.0, -1.0), Vec3::new(4.0, 1.0, 1.0));
+    LayeredOnGrid {
+        majorants: MajorantGrid::new(&GRID_MAJORANTS, [4, 1, 1], bounds),
+    }
+}
+
+/// Delta tracking through the majorant grid escapes with probability `exp(-tau(t_max))` (5
+/// binomial sigma) and collides where the analytic distribution says (KS).
+#[test]
+fn delta_tracking_through_a_majorant_grid_matches_optical_depth() {
+    let medium = layered_on_grid();
+    let t_max = 2.5;
+    let f = fly(&medium, t_max, 11);
+    let p = (-layered_tau(t_max as f64)).exp();
+    let n = N as f64;
+    let escaped = f.escaped as f64 / n;
+    let se = (p * (1.0 - p) / n).sqrt();
+    assert!(
+        (escaped - p).abs() < 5.0 * se,
+        "escaped {escaped} vs {p} +- {se}"
+    );
+    let cdf = |t: f64| (1.0 - (-layered_tau(t)).exp()) / (1.0 - p);
+    let ks = ks_test(&f.distances, cdf);
+    assert!(ks.p_value > ALPHA, "{ks:?}");
+}
+
+/// Ratio tracking's estimate has mean `exp(-tau(t_max))` (5 standard errors), with one global
+/// majorant and through the grid, and is exact for a homogeneous medium. With these optical depths
+/// (3 and 5.25) the product falls below 1/8 on most rays, so the roulette is exercised too.
+#[test]
+fn ratio_tracking_is_unbiased() {
+    let homogeneous = HomogeneousMedium {
+        sigma_t: 2.0,
+        albedo: Spectrum::ONE,
+    };
+    let mut rng = Rng::new(3, 0, 0);
+    let mut steps = 0;
+    let t = ratio_tracking(&homogeneous, &ray(), 0.7, &mut rng, &mut steps, u32::MAX);
+    assert_eq!(t, Some(exp(-1.4)));
+
+    for t_max in [1.5f32, 2.5] {
+        let expected = (-layered_tau(t_max as f64)).exp();
+        let global = Layered { majorant: 4.0 };
+        let grid = layered_on_grid();
+        let estimates = |medium: &dyn Fn(&mut Rng, &mut u32) -> Option<f32>| {
+            let mut m = Moments::default();
+            for i in 0..N {
+                let mut rng = Rng::new(5, 1, i);
+                let mut steps = 0;
+                m.push(medium(&mut rng, &mut steps).expect("no step budget") as f64);
+            }
+            m
+        };
+        let cases = [
+            (
+                "global majorant",
+                estimates(&|rng, steps| {
+                    ratio_tracking(&global, &ray(), t_max, rng, steps, u32::MAX)
+                }),
+            ),
+            (
+                "majorant grid",
+                estimates(&|rng, steps| ratio_tracking(&grid, &ray(), t_max, rng, steps, u32::MAX)),
+            ),
+        ];
+        for (name, m) in cases {
+            assert!(
+                (m.mean() - expected).abs() < 5.0 * m.std_error(),
+                "{name}, t_max {t_max}: transmittance {} +- {} vs {expected}",
+                m.mean(),
+                m.std_error()
+            );
+        }
     }
 }
