@@ -7,33 +7,26 @@
 #   v1-dense-trilinear    grid reads without the layout and lookup dispatch
 #   v2-no-dda             also delta tracking without the majorant grid's walk (global majorant)
 #   v3-no-dda-no-nee      also no NEE code in the index-matched kernels
-# Run from the repository root after `cargo xtask device-bundle`; it restores the sources after.
+# Run from the repository root after `cargo xtask device-bundle`; it edits the sources and restores
+# them from git after, so it refuses to start while they have uncommitted changes. NAME_PREFIX
+# (default empty) prefixes the file names, to keep builds of several commits side by side.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
+edited="volpt-core/src/grid.rs volpt-core/src/tracking.rs volpt-core/src/path.rs"
+# shellcheck disable=SC2086
+git diff --quiet HEAD -- $edited || { echo "commit or stash the changes to $edited first" >&2; exit 1; }
+prefix=${NAME_PREFIX:-}
 mkdir -p bundle/ab
-trap 'git checkout -- volpt-core/src/grid.rs volpt-core/src/tracking.rs volpt-core/src/path.rs' EXIT
+# shellcheck disable=SC2086
+trap 'git checkout -- $edited' EXIT
 
-build() { # build NAME: the exact PTX of the working tree, cut down, as bundle/ab/NAME.ptx
+build() { # build NAME: the exact PTX of the working tree, cut down, as bundle/ab/PREFIXNAME.ptx
     RUSTC_BOOTSTRAP=1 CARGO_TARGET_NVPTX64_NVIDIA_CUDA_RUSTFLAGS="-C target-cpu=sm_70 --emit=asm" \
         CARGO_TARGET_NVPTX64_NVIDIA_CUDA_LINKER=/bin/true \
         cargo build -q -Zbuild-std=core --target nvptx64-nvidia-cuda --profile nvptx -p volpt-kernels \
         --target-dir target-ptx/ab
-    python3 - target-ptx/ab/nvptx64-nvidia-cuda/nvptx/deps/volpt_kernels.s "bundle/ab/$1.ptx" <<'PY'
-import re, sys
-keep = re.compile(r"^regeneration_sk__(homogeneous__index_matched__isotropic|homogeneous__rough_dielectric__isotropic|grid_density_albedo__rough_dielectric__isotropic|grid_density__index_matched__isotropic|grid_density_albedo__rough_dielectric__henyey_greenstein)__constant$")
-out, lines, i = [], open(sys.argv[1]).read().split("\n"), 0
-while i < len(lines):
-    m = re.search(r"\.entry (\w+)", lines[i])
-    if not m:
-        out.append(lines[i]); i += 1; continue
-    j = i
-    while lines[j] != "{": j += 1
-    while lines[j] != "}": j += 1
-    if keep.search(m.group(1)): out.extend(lines[i:j + 1])
-    i = j + 1
-open(sys.argv[2], "w").write("\n".join(out))
-PY
-    echo "bundle/ab/$1.ptx: $(grep -c '\.entry' "bundle/ab/$1.ptx") kernels"
+    python3 bench/device/ptx_cut.py target-ptx/ab/nvptx64-nvidia-cuda/nvptx/deps/volpt_kernels.s \
+        "bundle/ab/$prefix$1.ptx" "^regeneration_sk__(homogeneous__index_matched__isotropic|homogeneous__rough_dielectric__isotropic|grid_density_albedo__rough_dielectric__isotropic|grid_density__index_matched__isotropic|grid_density_albedo__rough_dielectric__henyey_greenstein)__constant$"
 }
 
 replace() { # replace FILE OLD NEW: one literal replacement, or fail

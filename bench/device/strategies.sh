@@ -44,21 +44,8 @@ ARCH=sm_$(nvidia-smi --query-gpu=compute_cap --format=csv,noheader | head -n 1 |
 # ptxas runs on the CPU beside the GPU work (its reports only), on the kernels of every variant
 # for regeneration-sk and naive-sk and of three variants for the other strategies.
 subset() { # subset IN.ptx OUT.ptx
-    python3 - "$1" "$2" <<'PY'
-import re, sys
-keep = re.compile(r"^(regeneration_sk|naive_sk)__|__(homogeneous__index_matched__isotropic|grid_density__index_matched__isotropic|grid_density_albedo__rough_dielectric__isotropic)__constant$")
-out, lines, i = [], open(sys.argv[1]).read().split("\n"), 0
-while i < len(lines):
-    m = re.search(r"\.entry (\w+)", lines[i])
-    if not m:
-        out.append(lines[i]); i += 1; continue
-    j = i
-    while lines[j] != "{": j += 1
-    while lines[j] != "}": j += 1
-    if keep.search(m.group(1)): out.extend(lines[i:j + 1])
-    i = j + 1
-open(sys.argv[2], "w").write("\n".join(out))
-PY
+    python3 ptx_cut.py "$1" "$2" \
+        "^(regeneration_sk|naive_sk)__|__(homogeneous__index_matched__isotropic|grid_density__index_matched__isotropic|grid_density_albedo__rough_dielectric__isotropic)__constant$" >/dev/null
 }
 for f in volpt_kernels volpt_kernels_fast; do
     [ -f $f.ptx ] || gunzip -kf $f.ptx.gz

@@ -76,18 +76,18 @@ impl Aabb {
         let near = Vec3::select(parallel, Vec3::select(in_slab, -inf, inf), near);
         let far = Vec3::select(parallel, Vec3::select(in_slab, inf, -inf), far);
         let axis = argmax(near);
-        let t_enter = near[axis];
+        let t_enter = component(near, axis);
         let t_leave = far.min_element();
         if !(t_enter >= 0.0 && t_enter < t_leave) {
             return None;
         }
-        let mut point = ray.at(t_enter);
-        let entering_max_face = ray.dir[axis] < 0.0;
-        point[axis] = if entering_max_face {
-            self.max[axis]
+        let entering_max_face = component(ray.dir, axis) < 0.0;
+        let face = if entering_max_face {
+            component(self.max, axis)
         } else {
-            self.min[axis]
+            component(self.min, axis)
         };
+        let point = with_component(ray.at(t_enter), axis, face);
         Some(BoxHit {
             t: t_enter,
             point: self.clamp(point),
@@ -105,13 +105,12 @@ impl Aabb {
         let t = Vec3::select(t.cmpeq(t), t, Vec3::splat(f32::INFINITY));
         let t = Vec3::select(ray.dir.cmpeq(Vec3::ZERO), Vec3::splat(f32::INFINITY), t);
         let axis = argmin(t);
-        let t_exit = t[axis].max(0.0);
-        let mut point = ray.at(t_exit);
-        point[axis] = far_plane[axis];
+        let t_exit = component(t, axis).max(0.0);
+        let point = with_component(ray.at(t_exit), axis, component(far_plane, axis));
         BoxHit {
             t: t_exit,
             point: self.clamp(point),
-            normal: axis_normal(axis, ray.dir[axis] > 0.0),
+            normal: axis_normal(axis, component(ray.dir, axis) > 0.0),
         }
     }
 
@@ -123,9 +122,29 @@ impl Aabb {
 
 #[inline]
 fn axis_normal(axis: usize, positive: bool) -> Vec3 {
-    let mut n = Vec3::ZERO;
-    n[axis] = if positive { 1.0 } else { -1.0 };
-    n
+    with_component(Vec3::ZERO, axis, if positive { 1.0 } else { -1.0 })
+}
+
+// Component access by a computed axis, written as selects: indexing a `Vec3` by a runtime
+// `usize` makes the GPU compiler put the vector in local memory (an 88-byte stack frame in every
+// kernel, stores and loads on each boundary hit).
+
+#[inline(always)]
+fn component(v: Vec3, axis: usize) -> f32 {
+    match axis {
+        0 => v.x,
+        1 => v.y,
+        _ => v.z,
+    }
+}
+
+#[inline(always)]
+fn with_component(v: Vec3, axis: usize, value: f32) -> Vec3 {
+    Vec3::new(
+        if axis == 0 { value } else { v.x },
+        if axis == 1 { value } else { v.y },
+        if axis == 2 { value } else { v.z },
+    )
 }
 
 #[inline]

@@ -191,7 +191,11 @@ impl<'a, const C: usize> Grid<'a, C> {
     /// The value at `p`, reconstructed as [`Grid::lookup`] says: zero outside the grid's box, and
     /// the edge samples held constant between the outermost sample and the box's faces. Either
     /// reconstruction stays within the samples' range, so a majorant of the samples bounds it.
-    #[inline]
+    ///
+    /// Always inlined: on a GPU a call takes the grid, and with it the whole scene, by address,
+    /// which moves the scene into local memory (a 456-byte stack frame per thread, 1.5x the time
+    /// of cgg-logo on an H100).
+    #[inline(always)]
     pub fn lookup(&self, p: Vec3) -> [f32; C] {
         // One branch per lookup, not per corner: each layout gets its own copy of the
         // interpolation, and the dense copy is exactly the code of a grid without layouts.

@@ -77,7 +77,7 @@ pub struct GridAlbedo<'a>(pub Grid<'a, 3>);
 impl AlbedoField for GridAlbedo<'_> {
     const GRID_MEDIUM_NAME: &'static str = "grid_density_albedo";
 
-    #[inline]
+    #[inline(always)]
     fn albedo(&self, p: Vec3) -> Spectrum {
         Spectrum::from_array(self.0.lookup(p))
     }
@@ -108,12 +108,13 @@ impl<A: AlbedoField> Medium for GridMedium<'_, A> {
         self.majorants.as_ref()
     }
 
-    #[inline]
+    // Lookups are always inlined, as `Grid::lookup` says why.
+    #[inline(always)]
     fn sigma_t(&self, p: Vec3) -> f32 {
         self.scale * self.density.lookup(p)[0]
     }
 
-    #[inline]
+    #[inline(always)]
     fn albedo(&self, p: Vec3) -> Spectrum {
         self.albedo.albedo(p)
     }

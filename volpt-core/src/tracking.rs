@@ -18,8 +18,24 @@ pub enum FreeFlight {
     OutOfSteps,
 }
 
+/// What a walk over the majorants does at each tentative collision: `stop_at(rng, t, majorant)`
+/// returns true to end the walk at distance `t`. Closures implement it (tests); the trackers use
+/// named types whose method is always inlined, because the walk calls it from two loops and LLVM
+/// then keeps a closure's body as a function of its own, which on a GPU takes the medium, and the
+/// whole scene with it, by address into local memory (a ~500-byte stack frame per thread).
+pub trait TentativeCollision {
+    fn stop_at(&mut self, rng: &mut Rng, t: f32, majorant: f32) -> bool;
+}
+
+impl<F: FnMut(&mut Rng, f32, f32) -> bool> TentativeCollision for F {
+    #[inline(always)]
+    fn stop_at(&mut self, rng: &mut Rng, t: f32, majorant: f32) -> bool {
+        self(rng, t, majorant)
+    }
+}
+
 /// Samples tentative collisions along `ray` up to `t_max`, exponentially distributed under the
-/// medium's majorant, and calls `at(rng, t, majorant)` at each until it returns true (then the
+/// medium's majorant, and calls `at.stop_at(rng, t, majorant)` at each until it returns true (then the
 /// walk ends at `t`, `FreeFlight::Collision(t)`). `steps` counts tentative collisions; the walk
 /// gives up once it reaches `max_steps`.
 ///
@@ -42,7 +58,7 @@ pub fn walk_majorants<M: Medium>(
     rng: &mut Rng,
     steps: &mut u32,
     max_steps: u32,
-    mut at: impl FnMut(&mut Rng, f32, f32) -> bool,
+    mut at: impl TentativeCollision,
 ) -> FreeFlight {
     let Some(grid) = medium.majorant_grid() else {
         let majorant = medium.majorant();
@@ -60,7 +76,7 @@ pub fn walk_majorants<M: Medium>(
                 return FreeFlight::OutOfSteps;
             }
             *steps += 1;
-            if at(rng, t, majorant) {
+            if at.stop_at(rng, t, majorant) {
                 return FreeFlight::Collision(t);
             }
         }
@@ -82,7 +98,7 @@ pub fn walk_majorants<M: Medium>(
                     return FreeFlight::OutOfSteps;
                 }
                 *steps += 1;
-                if at(rng, t, majorant) {
+                if at.stop_at(rng, t, majorant) {
                     return FreeFlight::Collision(t);
                 }
             }
@@ -117,8 +133,21 @@ pub fn delta_tracking<M: Medium>(
         rng,
         steps,
         max_steps,
-        |rng, t, majorant| M::HOMOGENEOUS || rng.next_f32() * majorant < medium.sigma_t(ray.at(t)),
+        DeltaAcceptance { medium, ray },
     )
+}
+
+/// Delta tracking's test: a tentative collision is real with probability `sigma_t / majorant`.
+struct DeltaAcceptance<'a, M> {
+    medium: &'a M,
+    ray: &'a Ray,
+}
+
+impl<M: Medium> TentativeCollision for DeltaAcceptance<'_, M> {
+    #[inline(always)]
+    fn stop_at(&mut self, rng: &mut Rng, t: f32, majorant: f32) -> bool {
+        M::HOMOGENEOUS || rng.next_f32() * majorant < self.medium.sigma_t(self.ray.at(t))
+    }
 }
 
 /// An unbiased estimate of the transmittance `exp(-int_0^t_max sigma_t)` along `ray`, or `None`
@@ -143,29 +172,37 @@ pub fn ratio_tracking<M: Medium>(
     if M::HOMOGENEOUS {
         return Some(exp(-medium.majorant() * t_max));
     }
-    let mut transmittance = 1.0f32;
-    let flight = walk_majorants(
+    let mut ratio = RatioProduct {
         medium,
         ray,
-        t_max,
-        rng,
-        steps,
-        max_steps,
-        |rng, t, majorant| {
-            transmittance *= 1.0 - medium.sigma_t(ray.at(t)) / majorant;
-            if transmittance < 0.125 {
-                if rng.next_f32() < 0.5 {
-                    transmittance *= 2.0;
-                } else {
-                    transmittance = 0.0;
-                }
-            }
-            transmittance <= 0.0
-        },
-    );
+        transmittance: 1.0,
+    };
+    let flight = walk_majorants(medium, ray, t_max, rng, steps, max_steps, &mut ratio);
     match flight {
         FreeFlight::OutOfSteps => None,
         FreeFlight::Collision(_) => Some(0.0),
-        FreeFlight::Escaped => Some(transmittance),
+        FreeFlight::Escaped => Some(ratio.transmittance),
+    }
+}
+
+/// Ratio tracking's running product, with its roulette; it stops the walk once it is zero.
+struct RatioProduct<'a, M> {
+    medium: &'a M,
+    ray: &'a Ray,
+    transmittance: f32,
+}
+
+impl<M: Medium> TentativeCollision for &mut RatioProduct<'_, M> {
+    #[inline(always)]
+    fn stop_at(&mut self, rng: &mut Rng, t: f32, majorant: f32) -> bool {
+        self.transmittance *= 1.0 - self.medium.sigma_t(self.ray.at(t)) / majorant;
+        if self.transmittance < 0.125 {
+            if rng.next_f32() < 0.5 {
+                self.transmittance *= 2.0;
+            } else {
+                self.transmittance = 0.0;
+            }
+        }
+        self.transmittance <= 0.0
     }
 }

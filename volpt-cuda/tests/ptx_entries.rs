@@ -63,3 +63,43 @@ fn every_kernel_compiles_alone() {
         }
     }
 }
+
+/// No kernel keeps per-thread state in local memory beyond the 64 bytes of the path counters'
+/// final warp reduction (an array walked once, at the kernel's end). A larger local depot means
+/// LLVM left a scene part behind a pointer: a call it did not inline takes the scene by address,
+/// or a vector is indexed at run time. That cost cgg-logo 1.5x its time on an H100 (a 456-byte
+/// frame from a grid lookup that was not inlined, `docs/strategies.md`).
+#[test]
+fn no_kernel_keeps_the_scene_in_local_memory() {
+    const COUNTER_FLUSH_BYTES: usize = 64;
+    for math in Math::ALL.iter().copied() {
+        let Some(ptx) = volpt_cuda::kernels_ptx(math) else {
+            continue;
+        };
+        let mut heavy = Vec::new();
+        for entry in registry_entries() {
+            let alone = volpt_cuda::entry::single_kernel_ptx(ptx, &entry, None)
+                .unwrap_or_else(|| panic!("{math}: {entry} not in the PTX"));
+            let depot = local_depot_bytes(&alone);
+            if depot > COUNTER_FLUSH_BYTES {
+                heavy.push(format!("{entry}: {depot} bytes"));
+            }
+        }
+        assert!(
+            heavy.is_empty(),
+            "{math}: kernels with local memory: {heavy:?}"
+        );
+    }
+}
+
+/// The largest `.local ... __local_depotN[BYTES]` of a PTX module (0 without one).
+fn local_depot_bytes(ptx: &str) -> usize {
+    ptx.lines()
+        .filter(|line| line.contains(".local") && line.contains("__local_depot"))
+        .filter_map(|line| {
+            let size = line.rsplit('[').next()?.split(']').next()?;
+            size.parse::<usize>().ok()
+        })
+        .max()
+        .unwrap_or(0)
+}

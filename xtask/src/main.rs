@@ -229,10 +229,11 @@ fn device_bundle() -> Result<()> {
             shared.display()
         );
     }
-    // Every device script: run.sh (checks and benchmark), stability.sh, accuracy.sh, ab.sh.
+    // Every device script: run.sh (checks and benchmark), stability.sh, accuracy.sh, ab.sh, and
+    // their Python helpers (ptx_cut.py).
     for entry in std::fs::read_dir(root.join("bench/device"))? {
         let path = entry?.path();
-        if path.extension().is_some_and(|e| e == "sh") {
+        if path.extension().is_some_and(|e| e == "sh" || e == "py") {
             let name = path.file_name().expect("directory entries have names");
             std::fs::copy(&path, bundle.join(name))?;
         }
