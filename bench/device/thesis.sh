@@ -45,6 +45,9 @@ LOGS=$WORK/logs
 mkdir -p "$LOGS" "$WORK/img"
 [ -d "$PEER/lib" ] && export LD_LIBRARY_PATH=$PEER/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 START=$SECONDS
+why() { # why LOG: the lines of a failed command's log that say why, on one line
+    { grep -m 2 -i -E "error|what\(\)|abort" "$1" || tail -n 2 "$1"; } | tr '\n' ' '
+}
 failures=0
 log() { echo "== $*" | tee -a "$OUT/thesis-log.txt"; }
 limit() { # the time a command may take: T, less near the deadline; fails past the deadline
@@ -60,17 +63,21 @@ nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.max.sm --format=c
 columns=(scene engine estimator strategy math time_mean_s segments_per_s paths_per_s segments_per_path mean_r mean_g mean_b)
 (IFS=$'\t'; echo "${columns[*]}") >"$RESULTS"
 
-# The binaries travel as one xz tarball (they share most of their bytes); python's lzma unpacks it
-# where no xz is installed.
-if [ "$BACKEND" = cuda ] && [ ! -d "$PEER/bin" ]; then
-    python3 -c 'import sys, tarfile; tarfile.open(sys.argv[1]).extractall(sys.argv[2])' "$PEER/bin.tar.xz" "$PEER" \
+# The binaries travel as one xz tarball (they share most of their bytes), unpacked by python's lzma
+# (no xz needed) into the work directory.
+PEER_BIN=$PEER/bin
+if [ "$BACKEND" = cuda ] && [ ! -d "$PEER_BIN" ]; then
+    PEER_BIN=$WORK/bin
+    python3 -c 'import sys, tarfile
+safe = {"filter": "data"} if hasattr(tarfile, "data_filter") else {}
+tarfile.open(sys.argv[1]).extractall(sys.argv[2], **safe)' "$PEER/bin.tar.xz" "$WORK" \
         || { log "FAIL unpacking $PEER/bin.tar.xz"; exit 1; }
 fi
 python3 "$PEER/gen_scenes.py" "$WORK/scenes" >"$LOGS/gen.log" 2>&1 \
-    || { log "FAIL gen_scenes: $(tail -n 2 "$LOGS/gen.log" | tr '\n' ' ')"; exit 1; }
+    || { log "FAIL gen_scenes: $(why "$LOGS/gen.log")"; exit 1; }
 
 run_thesis() { # run_thesis SCENE ESTIMATOR STRATEGY BINARY KERNEL
-    local scene=$1 est=$2 strategy=$3 bin=$PEER/bin/cvr_$4 kernel=$5 tmo name
+    local scene=$1 est=$2 strategy=$3 bin=$PEER_BIN/cvr_$4 kernel=$5 tmo name
     name=thesis-$scene-$est-$strategy
     [ -x "$bin" ] || { log "SKIP $name: the peer has no $bin"; return; }
     tmo=$(limit) || { log "SKIP $name (deadline)"; return; }
@@ -126,7 +133,7 @@ print("\t".join([scene, "thesis", est, strategy, "-", f"{t:.6g}", f"{mrays_s * 1
                  f"{rays / (paths_s * t):.4g}"] + [f"{v:.6g}" for v in mean]))
 PY
     then log "ok $name"
-    else log "FAIL $name (exit $?): $(tail -n 3 "$LOGS/$name.log" | tr '\n' ' ')"; failures=$((failures + 1))
+    else log "FAIL $name (exit $?): $(why "$LOGS/$name.log")"; failures=$((failures + 1))
     fi
 }
 
@@ -147,7 +154,7 @@ print("\t".join([scene, "volpt", est, strategy, math, f"{r['time_mean_s']:.6g}",
                 + [f"{v:.6g}" for v in r["image_mean"]]))
 PY
     then log "ok $name"
-    else log "FAIL $name (exit $?): $(head -n 2 "$LOGS/$name.err" | tr '\n' ' ')"; failures=$((failures + 1))
+    else log "FAIL $name (exit $?): $(why "$LOGS/$name.err")"; failures=$((failures + 1))
     fi
 }
 
