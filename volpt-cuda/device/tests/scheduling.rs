@@ -89,3 +89,16 @@ fn strategy_names_are_the_kernels_prefixes() {
         assert_eq!(s.name().replace('-', "_"), s.entry_prefix());
     }
 }
+
+/// `path_of`'s 32-bit shortcut gives the 64-bit division's pixel and sample on both sides of 2^32,
+/// for indices and for films of 2^32 pixels or more.
+#[test]
+fn path_indices_divide_the_same_above_and_below_two_to_the_32() {
+    let edge = 1u64 << 32;
+    for pixels in [1, 3, 160_000, edge - 1, edge, edge + 7] {
+        for index in [0, 1, pixels - 1, pixels, edge - 2, edge - 1, edge, edge + 1, 3 * edge + 5] {
+            let expected = ((index % pixels) as u32, (index / pixels) as u32);
+            assert_eq!(path_of(index, pixels, 0), expected, "index {index} of {pixels} pixels");
+        }
+    }
+}
