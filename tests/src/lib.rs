@@ -68,6 +68,7 @@ pub fn homogeneous(sigma_t: f32, albedo: f32, phase: PhaseDesc) -> MediumDesc {
         albedo: AlbedoDesc::Constant([albedo; 3]),
         phase,
         lookup: Default::default(),
+        storage: Default::default(),
     }
 }
 

@@ -89,6 +89,7 @@ fn grid_absorber_transmits_beer_lambert_for_both_grid_conventions() {
             albedo: AlbedoDesc::Constant([0.0; 3]),
             phase: PhaseDesc::Isotropic,
             lookup: Default::default(),
+            storage: Default::default(),
         };
         let desc = cube_scene(32, 32, medium, BsdfDesc::Null, 1.0);
         assert_eq!(

@@ -35,18 +35,29 @@ fn descriptions() -> Vec<SceneDescription> {
         min: [-0.6, -0.45, -0.5],
         max: [0.55, 0.5, 0.6],
     };
+    // The last medium's nearest-sample lookups select the any-layout grid medium (a constant
+    // albedo becomes a one-voxel grid); a grid decoded with the other lookup renders a different
+    // image, so both lookups cross the ABI.
     let media = [
         (
             DensityDesc::Constant(2.0),
             AlbedoDesc::Constant([0.9, 0.7, 0.5]),
+            GridLookup::Trilinear,
         ),
         (
             DensityDesc::Grid(grid(1, grid_bounds, GridConvention::Vertex)),
             AlbedoDesc::Constant([0.8, 0.9, 0.6]),
+            GridLookup::Trilinear,
         ),
         (
             DensityDesc::Grid(grid(1, grid_bounds, GridConvention::Cell)),
             AlbedoDesc::Grid(grid(3, grid_bounds, GridConvention::Vertex)),
+            GridLookup::Trilinear,
+        ),
+        (
+            DensityDesc::Grid(grid(1, grid_bounds, GridConvention::Vertex)),
+            AlbedoDesc::Constant([0.8, 0.9, 0.6]),
+            GridLookup::Nearest,
         ),
     ];
     let boundaries = [
@@ -83,7 +94,7 @@ fn descriptions() -> Vec<SceneDescription> {
         }),
     ];
     let mut descs = Vec::new();
-    for (density, albedo) in &media {
+    for (density, albedo, lookup) in &media {
         for bsdf in boundaries {
             for phase in phases {
                 for environment in &environments {
@@ -92,12 +103,8 @@ fn descriptions() -> Vec<SceneDescription> {
                         scale: 3.0,
                         albedo: albedo.clone(),
                         phase,
-                        // Both lookups cross the ABI: a grid decoded with the other one renders
-                        // a different image.
-                        lookup: match phase {
-                            PhaseDesc::Isotropic => GridLookup::Trilinear,
-                            PhaseDesc::HenyeyGreenstein { .. } => GridLookup::Nearest,
-                        },
+                        lookup: *lookup,
+                        storage: GridStorage::Dense,
                     };
                     let mut desc = cube_scene(12, 9, medium, bsdf, 1.0);
                     desc.environment = environment.clone();
@@ -122,8 +129,14 @@ impl Uploader for HostUploader {
         values.as_ptr() as u64
     }
 
-    fn grid(&mut self, values: &[f32], res: [u32; 3], channels: u32) -> PlacedGrid {
-        if self.layout == GridLayout::Dense {
+    fn grid(
+        &mut self,
+        values: &[f32],
+        res: [u32; 3],
+        channels: u32,
+        any_layout: bool,
+    ) -> PlacedGrid {
+        if self.layout == GridLayout::Dense || !any_layout {
             return PlacedGrid {
                 address: self.values(values),
                 len: values.len() as u64,
@@ -183,9 +196,23 @@ fn every_variant_with_bricked_grids_renders_bit_for_bit() {
 }
 
 fn round_trips(layout: GridLayout) {
-    let descs = descriptions();
+    let mut descs = descriptions();
+    // Dense: every variant of the registry. Bricked storage selects the any-layout grid medium for
+    // every grid, so that the uploader may brick it: its 12 variants and the homogeneous ones.
+    let expected = if layout == GridLayout::Bricked {
+        for desc in &mut descs {
+            desc.medium.storage = GridStorage::Bricked;
+        }
+        24
+    } else {
+        48
+    };
     let variants: BTreeSet<String> = descs.iter().map(|d| Variant::of(d).to_string()).collect();
-    assert_eq!(variants.len(), 36, "the descriptions cover every variant");
+    assert_eq!(
+        variants.len(),
+        expected,
+        "the descriptions cover the variants"
+    );
     for desc in &descs {
         let trip = RoundTrip { layout };
         let (original, decoded) = with_scene(desc, volpt_render::path_settings(desc), trip);

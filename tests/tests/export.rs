@@ -78,6 +78,7 @@ fn cell_centred_grids_and_settings_come_back_exactly() {
             albedo: AlbedoDesc::Grid(grid([3, 4, 5], 3, bounds, GridConvention::Cell)),
             phase: PhaseDesc::HenyeyGreenstein { g: -0.3 },
             lookup: Default::default(),
+            storage: Default::default(),
         },
         BsdfDesc::RoughDielectric {
             alpha: 0.1,
@@ -171,6 +172,7 @@ fn vertex_centred_grids_keep_their_field() {
             albedo: AlbedoDesc::Grid(grid([4, 6, 3], 3, bounds, GridConvention::Vertex)),
             phase: PhaseDesc::Isotropic,
             lookup: Default::default(),
+            storage: Default::default(),
         },
         BsdfDesc::Null,
         1.0,

@@ -116,6 +116,7 @@ fn every_lookup_in_a_cell_is_at_most_its_majorant() {
             majorant: scale * data.iter().copied().fold(0.0, f32::max),
             majorants: Some(grid),
             albedo: ConstantAlbedo(Spectrum::ONE),
+            reads: volpt_core::DenseTrilinear,
         };
         for i in 0..20 {
             let origin = bounds.min
@@ -132,7 +133,7 @@ fn every_lookup_in_a_cell_is_at_most_its_majorant() {
                 &mut walk_rng,
                 &mut steps,
                 1 << 20,
-                |_, t, m| {
+                |_: &mut Rng, t: f32, m: f32| {
                     let sigma = medium.sigma_t(ray.at(t));
                     assert!(
                         sigma <= m,

@@ -88,6 +88,7 @@ fn delta_tracking_matches_analytic_transmittance_where_density_reaches_the_major
             albedo: AlbedoDesc::Constant([0.5; 3]),
             phase: PhaseDesc::Isotropic,
             lookup: Default::default(),
+            storage: Default::default(),
         };
         let desc = cube_scene(4, 4, medium, BsdfDesc::Null, 1.0);
         let reference = RefMedium::new(&desc);
@@ -272,6 +273,7 @@ fn majorant_bounds_every_lookup_the_renderer_can_make() {
             albedo,
             phase: PhaseDesc::Isotropic,
             lookup: Default::default(),
+            storage: Default::default(),
         };
         let desc = cube_scene(2, 2, medium, BsdfDesc::Null, 1.0);
         let variant = Variant::of(&desc);

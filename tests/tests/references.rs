@@ -93,6 +93,7 @@ fn single_scattering_matches_numerical_integration() {
             albedo: AlbedoDesc::Constant([0.9, 0.7, 0.5]),
             phase: PhaseDesc::HenyeyGreenstein { g },
             lookup: Default::default(),
+            storage: Default::default(),
         };
         let mut desc = scene(
             [0.5, 1.3, 1.9],
@@ -226,6 +227,7 @@ fn grid_absorber_matches_independent_beer_lambert() {
             albedo: AlbedoDesc::Constant([0.0; 3]),
             phase: PhaseDesc::Isotropic,
             lookup: Default::default(),
+            storage: Default::default(),
         };
         let desc = scene(
             [2.0, 1.5, 2.5],
@@ -270,6 +272,7 @@ fn image_orientation_matches_the_reference_camera() {
             albedo: AlbedoDesc::Constant([0.0; 3]),
             phase: PhaseDesc::Isotropic,
             lookup: Default::default(),
+            storage: Default::default(),
         },
         EnvironmentDesc::Constant([1.0; 3]),
     );

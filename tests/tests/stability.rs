@@ -97,6 +97,7 @@ fn grid_medium(grid: GridDesc, albedo: f32) -> MediumDesc {
         albedo: AlbedoDesc::Constant([albedo; 3]),
         phase: PhaseDesc::Isotropic,
         lookup: Default::default(),
+        storage: Default::default(),
     }
 }
 

@@ -6,7 +6,7 @@ use std::time::Duration;
 use anyhow::Result;
 use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressStyle};
-use volpt_core::PathSettings;
+use volpt_core::{GridLayout, PathSettings};
 use volpt_cuda::{CudaRenderer, Math, Schedule, Strategy};
 
 use crate::auto::{self, AutoCache};
@@ -14,7 +14,7 @@ use volpt_render::{
     render_samples, with_scene_as, Effects, Film, Image, RenderOptions, RenderScene, RenderStats,
     SceneVisitor,
 };
-use volpt_scene::SceneDescription;
+use volpt_scene::{GridStorage, SceneDescription};
 
 use crate::volume::VolumeArgs;
 
@@ -156,12 +156,21 @@ impl Backend {
         }
     }
 
-    /// Where the GPU reads the scene's grids from (`--volume-memory` and its companions).
-    pub fn place_volumes(&mut self, volumes: &VolumeArgs) -> Result<()> {
+    /// Where the GPU reads the scene's grids from (`--volume-memory` and its companions). Bricked
+    /// storage is recorded in `desc`, so that the factory picks kernels that read bricks.
+    pub fn place_volumes(
+        &mut self,
+        volumes: &VolumeArgs,
+        desc: &mut SceneDescription,
+    ) -> Result<()> {
         match self {
             Backend::Cpu => volumes.check_cpu(),
             Backend::Cuda { renderer, .. } => {
-                renderer.set_volume_policy(volumes.policy());
+                let policy = volumes.policy();
+                if policy.layout == GridLayout::Bricked {
+                    desc.medium.storage = GridStorage::Bricked;
+                }
+                renderer.set_volume_policy(policy);
                 Ok(())
             }
         }

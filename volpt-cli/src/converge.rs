@@ -374,12 +374,13 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         );
     }
     let mut backend = Backend::open(args.sampling.backend, args.sampling.gpu)?;
-    backend.place_volumes(&args.sampling.volumes)?;
+    backend.place_volumes(&args.sampling.volumes, &mut desc)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let reference = reference(args, &desc, &backend, base)?;
     drop(backend);
     let scene_lookup = desc.medium.lookup;
+    let scene_storage = desc.medium.storage;
     let (w, h) = (desc.film.width, desc.film.height);
 
     let mut results = Vec::new();
@@ -396,7 +397,8 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
             config.label
         ));
         let mut backend = Backend::open(config.sampling.backend, config.sampling.gpu)?;
-        backend.place_volumes(&config.sampling.volumes)?;
+        desc.medium.storage = scene_storage;
+        backend.place_volumes(&config.sampling.volumes, &mut desc)?;
         desc.medium.lookup = config.lookup.map_or(scene_lookup, Into::into);
         let film = Film::new(w, h).with_accumulation(config.accumulation.into());
         let mut halves = Halves {

@@ -446,7 +446,9 @@ fn options(desc: &SceneDescription, sampling: &SamplingArgs) -> Result<RenderOpt
 fn render_command(args: RenderArgs) -> Result<()> {
     // Before the render, so that a bad name costs nothing.
     let preview = preview_for(&args.output)?;
-    let desc = load(&args.scene)?;
+    let mut desc = load(&args.scene)?;
+    let mut backend = Backend::open(args.sampling.backend, args.sampling.gpu)?;
+    backend.place_volumes(&args.sampling.volumes, &mut desc)?;
     let job = RenderJob {
         desc: &desc,
         settings: args.scene.settings(&desc)?,
@@ -454,8 +456,6 @@ fn render_command(args: RenderArgs) -> Result<()> {
         effects: args.scene.effects(),
         show_progress: true,
     };
-    let mut backend = Backend::open(args.sampling.backend, args.sampling.gpu)?;
-    backend.place_volumes(&args.sampling.volumes)?;
     let variant = Parts::of(&desc, job.effects).variant();
     tracing::info!(
         scene = %args.scene.scene.display(),
@@ -570,7 +570,9 @@ fn truncation_warning(c: &volpt_core::PathCounters) -> Option<String> {
 }
 
 fn bench_command(args: BenchArgs) -> Result<()> {
-    let desc = load(&args.scene)?;
+    let mut desc = load(&args.scene)?;
+    let mut backend = Backend::open(args.sampling.backend, args.sampling.gpu)?;
+    backend.place_volumes(&args.sampling.volumes, &mut desc)?;
     let job = RenderJob {
         desc: &desc,
         settings: args.scene.settings(&desc)?,
@@ -578,8 +580,6 @@ fn bench_command(args: BenchArgs) -> Result<()> {
         effects: args.scene.effects(),
         show_progress: false,
     };
-    let mut backend = Backend::open(args.sampling.backend, args.sampling.gpu)?;
-    backend.place_volumes(&args.sampling.volumes)?;
     let mut trials = Vec::new();
     let mut last = None;
     for trial in 0..=args.trials {

@@ -31,9 +31,16 @@ pub trait Uploader {
     fn values(&mut self, values: &[f32]) -> u64;
 
     /// Places the samples of a dense grid of `res` samples of `channels` channels, in a layout of
-    /// the uploader's choice (by default dense, through [`Uploader::values`]).
-    fn grid(&mut self, values: &[f32], res: [u32; 3], channels: u32) -> PlacedGrid {
-        let _ = (res, channels);
+    /// the uploader's choice (by default dense, through [`Uploader::values`]); dense unless
+    /// `any_layout` (the medium's [`crate::GridReads::ANY_LAYOUT`]: its kernels read bricks).
+    fn grid(
+        &mut self,
+        values: &[f32],
+        res: [u32; 3],
+        channels: u32,
+        any_layout: bool,
+    ) -> PlacedGrid {
+        let _ = (res, channels, any_layout);
         PlacedGrid {
             address: self.values(values),
             len: values.len() as u64,
@@ -224,10 +231,16 @@ impl GridLookup {
 
 impl GridParams {
     /// The parameters of `grid`, whose values `upload` copies to the device.
-    /// `grid` must be dense (the host's grids are; the uploader picks the device's layout).
-    pub fn new<const C: usize>(grid: &Grid<'_, C>, upload: &mut Upload<'_>) -> Self {
+    /// `grid` must be dense (the host's grids are; the uploader picks the device's layout, dense
+    /// unless `any_layout` says the kernels read any).
+    pub fn new<const C: usize>(
+        grid: &Grid<'_, C>,
+        upload: &mut Upload<'_>,
+        any_layout: bool,
+    ) -> Self {
         debug_assert_eq!(grid.layout, GridLayout::Dense);
-        let placed = upload.grid(grid.data, grid.res, C as u32);
+        let placed = upload.grid(grid.data, grid.res, C as u32, any_layout);
+        debug_assert!(any_layout || placed.layout == GridLayout::Dense);
         Self {
             data: placed.address,
             len: placed.len,

@@ -200,13 +200,21 @@ impl<'a, const C: usize> Grid<'a, C> {
         // One branch per lookup, not per corner: each layout gets its own copy of the
         // interpolation, and the dense copy is exactly the code of a grid without layouts.
         match self.layout {
-            GridLayout::Dense => self.interpolate(p, dense_index),
-            GridLayout::Bricked => self.interpolate(p, bricked_index),
+            GridLayout::Dense => self.interpolate(p, dense_index, self.lookup),
+            GridLayout::Bricked => self.interpolate(p, bricked_index, self.lookup),
         }
     }
 
+    /// [`Grid::lookup`] of a dense grid with trilinear reconstruction, the grid's `layout` and
+    /// `lookup` not read: the code a kernel needs when the variant fixes them ([`DenseTrilinear`]).
     #[inline(always)]
-    fn interpolate<I>(&self, p: Vec3, index: I) -> [f32; C]
+    pub fn lookup_dense_trilinear(&self, p: Vec3) -> [f32; C] {
+        debug_assert!(self.layout == GridLayout::Dense && self.lookup == GridLookup::Trilinear);
+        self.interpolate(p, dense_index, GridLookup::Trilinear)
+    }
+
+    #[inline(always)]
+    fn interpolate<I>(&self, p: Vec3, index: I, lookup: GridLookup) -> [f32; C]
     where
         I: Fn([u32; 3], u32, u32, u32) -> u32,
     {
@@ -229,13 +237,56 @@ impl<'a, const C: usize> Grid<'a, C> {
             .to_index_space(p)
             .max(Vec3::ZERO)
             .min(max_index);
-        match self.lookup {
+        match lookup {
             GridLookup::Trilinear => trilinear(q, max_index, self.res, at),
             GridLookup::Nearest => {
                 let n = q.round();
                 at(n.x as u32, n.y as u32, n.z as u32)
             }
         }
+    }
+}
+
+/// How a grid medium reads its grids, fixed by the variant: a kernel then carries the code of
+/// one layout and one reconstruction instead of a branch between four copies of the
+/// interpolation at every read (8-9% of the time of cgg-logo and bucky on an H100,
+/// `docs/strategies.md`).
+pub trait GridReads: Copy + Default + core::fmt::Debug {
+    /// Whether grids read this way may be stored bricked or reconstructed by nearest sample; the
+    /// uploader keeps the grids of a medium that cannot read bricks dense.
+    const ANY_LAYOUT: bool;
+    /// The kernel-entry name of a grid medium that reads this way, if not its albedo's.
+    const MEDIUM_NAME: Option<&'static str>;
+
+    fn lookup<const C: usize>(grid: &Grid<'_, C>, p: Vec3) -> [f32; C];
+}
+
+/// Dense samples, trilinear reconstruction: every scene's grids unless the description asks for
+/// nearest-sample lookups or bricked storage.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DenseTrilinear;
+
+impl GridReads for DenseTrilinear {
+    const ANY_LAYOUT: bool = false;
+    const MEDIUM_NAME: Option<&'static str> = None;
+
+    #[inline(always)]
+    fn lookup<const C: usize>(grid: &Grid<'_, C>, p: Vec3) -> [f32; C] {
+        grid.lookup_dense_trilinear(p)
+    }
+}
+
+/// Whatever each grid's `layout` and `lookup` say, read at every lookup.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct AnyLayout;
+
+impl GridReads for AnyLayout {
+    const ANY_LAYOUT: bool = true;
+    const MEDIUM_NAME: Option<&'static str> = Some("grid_any_layout");
+
+    #[inline(always)]
+    fn lookup<const C: usize>(grid: &Grid<'_, C>, p: Vec3) -> [f32; C] {
+        grid.lookup(p)
     }
 }
 

@@ -6,7 +6,7 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::abi::{Component, GridParams, Upload};
-use crate::grid::Grid;
+use crate::grid::{DenseTrilinear, Grid, GridReads};
 use crate::majorant::{MajorantGrid, MajorantGridParams};
 use crate::{Spectrum, Vec3};
 
@@ -71,21 +71,22 @@ impl AlbedoField for ConstantAlbedo {
     }
 }
 
+/// An albedo grid, read as `R` says (the medium's own [`GridReads`]).
 #[derive(Clone, Copy, Debug)]
-pub struct GridAlbedo<'a>(pub Grid<'a, 3>);
+pub struct GridAlbedo<'a, R = DenseTrilinear>(pub Grid<'a, 3>, pub R);
 
-impl AlbedoField for GridAlbedo<'_> {
+impl<R: GridReads> AlbedoField for GridAlbedo<'_, R> {
     const GRID_MEDIUM_NAME: &'static str = "grid_density_albedo";
 
     #[inline(always)]
     fn albedo(&self, p: Vec3) -> Spectrum {
-        Spectrum::from_array(self.0.lookup(p))
+        Spectrum::from_array(R::lookup(&self.0, p))
     }
 }
 
-/// A heterogeneous medium: `sigma_t(p) = scale * density(p)` from a trilinear grid.
+/// A heterogeneous medium: `sigma_t(p) = scale * density(p)` from a grid, read as `R` says.
 #[derive(Clone, Copy, Debug)]
-pub struct GridMedium<'a, A> {
+pub struct GridMedium<'a, A, R = DenseTrilinear> {
     pub density: Grid<'a, 1>,
     pub scale: f32,
     /// `scale * max(density)`: trilinear interpolation never exceeds the largest sample.
@@ -93,9 +94,10 @@ pub struct GridMedium<'a, A> {
     /// Per-cell bounds over the medium's box ([`crate::majorant`]); `None` tracks with `majorant`.
     pub majorants: Option<MajorantGrid<'a>>,
     pub albedo: A,
+    pub reads: R,
 }
 
-impl<A: AlbedoField> Medium for GridMedium<'_, A> {
+impl<A: AlbedoField, R: GridReads> Medium for GridMedium<'_, A, R> {
     const HOMOGENEOUS: bool = false;
 
     #[inline]
@@ -111,7 +113,7 @@ impl<A: AlbedoField> Medium for GridMedium<'_, A> {
     // Lookups are always inlined, as `Grid::lookup` says why.
     #[inline(always)]
     fn sigma_t(&self, p: Vec3) -> f32 {
-        self.scale * self.density.lookup(p)[0]
+        self.scale * R::lookup(&self.density, p)[0]
     }
 
     #[inline(always)]
@@ -171,17 +173,17 @@ impl Component for ConstantAlbedo {
     }
 }
 
-impl Component for GridAlbedo<'_> {
+impl<R: GridReads> Component for GridAlbedo<'_, R> {
     const NAME: &'static str = "grid";
     type Params = GridParams;
 
     fn to_params(&self, upload: &mut Upload<'_>) -> GridParams {
-        GridParams::new(&self.0, upload)
+        GridParams::new(&self.0, upload, R::ANY_LAYOUT)
     }
     #[inline]
     unsafe fn from_params(p: &GridParams) -> Self {
         // SAFETY: forwarded to the caller.
-        Self(unsafe { p.grid::<3>() })
+        Self(unsafe { p.grid::<3>() }, R::default())
     }
 }
 
@@ -213,15 +215,18 @@ unsafe impl<A: Pod> Zeroable for GridMediumParams<A> {}
 // SAFETY: as above.
 unsafe impl<A: Pod> Pod for GridMediumParams<A> {}
 
-impl<A: AlbedoField + Component> Component for GridMedium<'_, A> {
-    const NAME: &'static str = A::GRID_MEDIUM_NAME;
+impl<A: AlbedoField + Component, R: GridReads> Component for GridMedium<'_, A, R> {
+    const NAME: &'static str = match R::MEDIUM_NAME {
+        Some(name) => name,
+        None => A::GRID_MEDIUM_NAME,
+    };
     type Params = GridMediumParams<A::Params>;
 
     fn to_params(&self, upload: &mut Upload<'_>) -> Self::Params {
         #[allow(clippy::let_unit_value)]
         let () = GridMediumParams::<A::Params>::LAYOUT;
         GridMediumParams {
-            density: GridParams::new(&self.density, upload),
+            density: GridParams::new(&self.density, upload, R::ANY_LAYOUT),
             scale: self.scale,
             majorant: self.majorant,
             majorants: MajorantGridParams::new(self.majorants.as_ref(), upload),
@@ -239,6 +244,7 @@ impl<A: AlbedoField + Component> Component for GridMedium<'_, A> {
             majorants: unsafe { p.majorants.grid() },
             // SAFETY: forwarded to the caller.
             albedo: unsafe { A::from_params(&p.albedo) },
+            reads: R::default(),
         }
     }
 }

@@ -42,6 +42,8 @@ macro_rules! variants {
                     (GridDensity, grid_density, $crate::GridMedium<$lt, $crate::ConstantAlbedo>)
                     (GridDensityAlbedo, grid_density_albedo,
                         $crate::GridMedium<$lt, $crate::GridAlbedo<$lt>>)
+                    (GridAnyLayout, grid_any_layout, $crate::GridMedium<$lt,
+                        $crate::GridAlbedo<$lt, $crate::AnyLayout>, $crate::AnyLayout>)
                 ]
                 boundary [
                     (IndexMatched, index_matched, $crate::NullBoundary)
@@ -86,7 +88,7 @@ mod tests {
     /// `(registry name, Component::NAME)` of every part of every variant.
     macro_rules! registry_facts {
         (axes $axes:tt variants [$([$(($camel:ident, $snake:ident, $ty:ty))*])*]) => {
-            fn facts() -> [[(&'static str, &'static str); 4]; 36] {
+            fn facts() -> [[(&'static str, &'static str); 4]; 48] {
                 [$([$((stringify!($snake), <$ty as Component>::NAME)),*]),*]
             }
         };

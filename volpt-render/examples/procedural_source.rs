@@ -71,6 +71,7 @@ impl SceneBuilder for Shell {
                 albedo: AlbedoDesc::Constant([0.95, 0.7, 0.4]),
                 phase: PhaseDesc::HenyeyGreenstein { g: 0.3 },
                 lookup: Default::default(),
+                storage: Default::default(),
             },
             environment: EnvironmentDesc::Constant([1.0; 3]),
         })

@@ -20,7 +20,7 @@
 use std::fmt;
 
 use volpt_core::abi::SceneAbi;
-use volpt_core::grid::{Grid, GridLookup, GridMapping};
+use volpt_core::grid::{AnyLayout, DenseTrilinear, Grid, GridLookup, GridMapping, GridReads};
 use volpt_core::majorant::{build_majorants, MajorantGrid};
 use volpt_core::math::tan;
 use volpt_core::microfacet::Ggx;
@@ -32,8 +32,8 @@ use volpt_core::{
 };
 use volpt_scene::description::{
     AlbedoDesc, Bounds, BsdfDesc, CameraDesc, DensityDesc, EnvironmentDesc, FilmDesc, FovAxis,
-    GridConvention, GridDesc, GridLookup as GridLookupDesc, LatLongDesc, PhaseDesc,
-    SceneDescription,
+    GridConvention, GridDesc, GridLookup as GridLookupDesc, GridStorage, LatLongDesc, MediumDesc,
+    PhaseDesc, SceneDescription,
 };
 
 /// What a backend can render: the CPU needs a [`Scene`] it can share between threads, a GPU backend
@@ -228,7 +228,7 @@ impl<'a> Parts<'a> {
                 environment(&desc.environment),
             ),
             Effects::General => (
-                MediumPart::GridDensityAlbedo(general_medium(desc)),
+                general_medium(desc),
                 boundary(desc, &mut |_| ()),
                 PhasePart::HenyeyGreenstein(match desc.medium.phase {
                     PhaseDesc::Isotropic => HenyeyGreenstein { g: 0.0 },
@@ -316,6 +316,7 @@ impl Derived {
             MediumPart::Homogeneous(_) => None,
             MediumPart::GridDensity(m) => Some((m.density, m.scale)),
             MediumPart::GridDensityAlbedo(m) => Some((m.density, m.scale)),
+            MediumPart::GridAnyLayout(m) => Some((m.density, m.scale)),
         };
         let majorants = density
             .filter(|_| settings.majorant_resolution > 1)
@@ -364,6 +365,7 @@ impl<'a> Parts<'a> {
             MediumPart::Homogeneous(_) => {}
             MediumPart::GridDensity(m) => m.majorants = grid,
             MediumPart::GridDensityAlbedo(m) => m.majorants = grid,
+            MediumPart::GridAnyLayout(m) => m.majorants = grid,
         }
         if let EnvironmentPart::LatLong(map) = &mut self.environment {
             map.distribution = &derived.distribution;
@@ -400,37 +402,53 @@ fn medium<'a>(desc: &'a SceneDescription, fired: &mut dyn FnMut(Simplification))
         AlbedoDesc::Grid(grid) => match uniform(grid, bounds) {
             Some(value) => {
                 fired(Simplification::ConstantAlbedoGrid);
-                Albedo::Constant([value[0], value[1], value[2]])
+                Albedo::Constant(value)
             }
             None => Albedo::Grid(grid),
         },
-        AlbedoDesc::Constant(rgb) => Albedo::Constant(*rgb),
+        AlbedoDesc::Constant(rgb) => Albedo::Constant(rgb),
     };
+    let any_layout = any_layout(medium);
     match (density, albedo) {
         (Density::Constant(density), Albedo::Constant(albedo)) => {
             MediumPart::Homogeneous(HomogeneousMedium {
                 sigma_t: medium.scale * density,
-                albedo: Spectrum::from_array(albedo),
+                albedo: Spectrum::new(albedo[0], albedo[1], albedo[2]),
             })
+        }
+        (density, albedo) if any_layout => {
+            let albedo = match albedo {
+                Albedo::Grid(albedo) => grid::<3>(albedo, medium.lookup),
+                Albedo::Constant(rgb) => one_voxel(desc, rgb),
+            };
+            MediumPart::GridAnyLayout(grid_medium(desc, density, GridAlbedo(albedo, AnyLayout)))
         }
         (Density::Grid(density), Albedo::Constant(albedo)) => MediumPart::GridDensity(GridMedium {
             density: grid::<1>(density, medium.lookup),
             scale: medium.scale,
             majorant: medium.scale * density.max_value(),
             majorants: None,
-            albedo: ConstantAlbedo(Spectrum::from_array(albedo)),
+            albedo: ConstantAlbedo(Spectrum::new(albedo[0], albedo[1], albedo[2])),
+            reads: DenseTrilinear,
         }),
         (density, Albedo::Grid(albedo)) => MediumPart::GridDensityAlbedo(grid_medium(
             desc,
             density,
-            GridAlbedo(grid::<3>(albedo, medium.lookup)),
+            GridAlbedo(grid::<3>(albedo, medium.lookup), DenseTrilinear),
         )),
     }
 }
 
+/// Whether the medium's grids need the any-layout reads ([`AnyLayout`]): nearest-sample lookups,
+/// or bricked storage on a GPU. Every other grid is read dense and trilinear, with only that code
+/// in the kernel.
+fn any_layout(medium: &MediumDesc) -> bool {
+    medium.lookup != GridLookupDesc::Trilinear || medium.storage != GridStorage::Dense
+}
+
 /// The medium as grids of density and albedo, whatever the description holds: constants become
 /// one-voxel grids over the medium's box, whose trilinear lookup is that constant everywhere.
-fn general_medium(desc: &SceneDescription) -> GridMedium<'_, GridAlbedo<'_>> {
+fn general_medium(desc: &SceneDescription) -> MediumPart<'_> {
     let medium = &desc.medium;
     let density = match &medium.density {
         DensityDesc::Grid(grid) => Density::Grid(grid),
@@ -438,9 +456,25 @@ fn general_medium(desc: &SceneDescription) -> GridMedium<'_, GridAlbedo<'_>> {
     };
     let albedo = match &medium.albedo {
         AlbedoDesc::Grid(albedo) => grid::<3>(albedo, medium.lookup),
-        AlbedoDesc::Constant(rgb) => one_voxel(desc, rgb),
+        AlbedoDesc::Constant(_) => one_voxel_albedo(desc),
     };
-    grid_medium(desc, density, GridAlbedo(albedo))
+    if any_layout(medium) {
+        MediumPart::GridAnyLayout(grid_medium(desc, density, GridAlbedo(albedo, AnyLayout)))
+    } else {
+        MediumPart::GridDensityAlbedo(grid_medium(
+            desc,
+            density,
+            GridAlbedo(albedo, DenseTrilinear),
+        ))
+    }
+}
+
+/// The description's constant albedo as a one-voxel grid over the medium's box.
+fn one_voxel_albedo(desc: &SceneDescription) -> Grid<'_, 3> {
+    match &desc.medium.albedo {
+        AlbedoDesc::Constant(rgb) => one_voxel(desc, rgb),
+        AlbedoDesc::Grid(albedo) => grid::<3>(albedo, desc.medium.lookup),
+    }
 }
 
 /// A medium's density as the description has it, before it becomes a part.
@@ -450,16 +484,17 @@ enum Density<'a> {
 }
 
 enum Albedo<'a> {
-    Constant([f32; 3]),
+    /// Three channels.
+    Constant(&'a [f32]),
     Grid(&'a GridDesc),
 }
 
 /// A grid medium with `albedo`; a constant density becomes a one-voxel grid over the medium's box.
-fn grid_medium<'a>(
+fn grid_medium<'a, R: GridReads>(
     desc: &'a SceneDescription,
     density: Density<'a>,
-    albedo: GridAlbedo<'a>,
-) -> GridMedium<'a, GridAlbedo<'a>> {
+    albedo: GridAlbedo<'a, R>,
+) -> GridMedium<'a, GridAlbedo<'a, R>, R> {
     let density = match density {
         Density::Grid(density) => grid::<1>(density, desc.medium.lookup),
         Density::Constant(sigma) => one_voxel(desc, std::slice::from_ref(sigma)),
@@ -471,6 +506,7 @@ fn grid_medium<'a>(
         majorant: desc.medium.scale * max_density,
         majorants: None,
         albedo,
+        reads: R::default(),
     }
 }
 

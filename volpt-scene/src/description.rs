@@ -101,6 +101,19 @@ pub struct MediumDesc {
     pub phase: PhaseDesc,
     /// How the medium's grids are reconstructed between their samples.
     pub lookup: GridLookup,
+    /// How a GPU stores the medium's grids (a renderer's choice, which the description carries
+    /// so that the kernel chosen for the scene can read it).
+    pub storage: GridStorage,
+}
+
+/// How a GPU stores a medium's grids.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum GridStorage {
+    /// Samples in x-fastest order.
+    #[default]
+    Dense,
+    /// 8^3-sample bricks, each contiguous: fewer bus transactions for volumes read across PCIe.
+    Bricked,
 }
 
 /// How a grid is reconstructed between its samples (Mitsuba 3's `filter_type`).

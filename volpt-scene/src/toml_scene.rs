@@ -563,6 +563,7 @@ fn assemble(
             albedo,
             phase,
             lookup: Default::default(),
+            storage: Default::default(),
         },
         environment: EnvironmentDesc::Constant(radiance),
     })

@@ -122,8 +122,12 @@ impl VolumePlacer {
         values: &[f32],
         res: [u32; 3],
         channels: u32,
+        any_layout: bool,
     ) -> Result<PlacedGrid, ZeroCopyError> {
         let layout = match self.policy.layout {
+            // The scene's kernels read this grid dense only (the factory selects the any-layout
+            // medium when the description asks for bricks).
+            GridLayout::Bricked if !any_layout => GridLayout::Dense,
             GridLayout::Bricked if values_in(GridLayout::Bricked, res, channels).is_none() => {
                 tracing::warn!(
                     ?res,
@@ -296,7 +300,13 @@ impl Uploader for VolumePlacer {
         }
     }
 
-    fn grid(&mut self, values: &[f32], res: [u32; 3], channels: u32) -> PlacedGrid {
+    fn grid(
+        &mut self,
+        values: &[f32],
+        res: [u32; 3],
+        channels: u32,
+        any_layout: bool,
+    ) -> PlacedGrid {
         let failed = PlacedGrid {
             address: 0,
             len: 0,
@@ -305,7 +315,7 @@ impl Uploader for VolumePlacer {
         if self.error.is_some() {
             return failed;
         }
-        match self.place(values, res, channels) {
+        match self.place(values, res, channels, any_layout) {
             Ok(placed) => placed,
             Err(e) => {
                 self.error = Some(e);

@@ -69,6 +69,7 @@ pub(crate) fn medium(el: &Element, ctx: &Ctx<'_>) -> Result<MediumDesc, SceneErr
         albedo,
         phase,
         lookup: Default::default(),
+        storage: Default::default(),
     })
 }
 
