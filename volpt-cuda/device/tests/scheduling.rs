@@ -96,9 +96,23 @@ fn strategy_names_are_the_kernels_prefixes() {
 fn path_indices_divide_the_same_above_and_below_two_to_the_32() {
     let edge = 1u64 << 32;
     for pixels in [1, 3, 160_000, edge - 1, edge, edge + 7] {
-        for index in [0, 1, pixels - 1, pixels, edge - 2, edge - 1, edge, edge + 1, 3 * edge + 5] {
+        for index in [
+            0,
+            1,
+            pixels - 1,
+            pixels,
+            edge - 2,
+            edge - 1,
+            edge,
+            edge + 1,
+            3 * edge + 5,
+        ] {
             let expected = ((index % pixels) as u32, (index / pixels) as u32);
-            assert_eq!(path_of(index, pixels, 0), expected, "index {index} of {pixels} pixels");
+            assert_eq!(
+                path_of(index, pixels, 0),
+                expected,
+                "index {index} of {pixels} pixels"
+            );
         }
     }
 }
