@@ -18,9 +18,6 @@ pub struct LightSample {
 }
 
 pub trait Environment {
-    /// The same radiance in every direction.
-    const UNIFORM: bool = false;
-
     /// Radiance seen when looking along `dir` (arriving along `-dir`).
     fn radiance(&self, dir: Vec3) -> Spectrum;
     /// A look direction with density roughly proportional to the radiance, or `None` when there is
@@ -34,8 +31,6 @@ pub trait Environment {
 pub struct ConstantEnvironment(pub Spectrum);
 
 impl Environment for ConstantEnvironment {
-    const UNIFORM: bool = true;
-
     #[inline]
     fn radiance(&self, _dir: Vec3) -> Spectrum {
         self.0

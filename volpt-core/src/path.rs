@@ -32,7 +32,7 @@ use crate::medium::Medium;
 use crate::phase::PhaseFunction;
 use crate::rng::Rng;
 use crate::scene::Scene;
-use crate::tracking::{absorption_tracking, delta_tracking, ratio_tracking, FreeFlight};
+use crate::tracking::{delta_tracking, ratio_tracking, FreeFlight};
 use crate::{Ray, Spectrum, Vec3};
 
 /// The integrator's limits.
@@ -225,9 +225,6 @@ pub fn step<S: Scene>(scene: &S, path: &mut PathState) {
     }
     if path.inside {
         let exit = scene.bounds().exit(&path.ray);
-        if PathState::uses_next_event(scene) && S::Environment::UNIFORM {
-            return next_flight_in_uniform_light(scene, path, exit);
-        }
         let collision = delta_tracking(
             scene.medium(),
             &path.ray,
@@ -304,9 +301,7 @@ fn scatter<S: Scene>(scene: &S, path: &mut PathState, p: Vec3) {
         path.alive = false;
         return;
     }
-    // Under a uniform environment the light is gathered along the flights instead
-    // (`next_flight_in_uniform_light`): phase sampling, no shadow rays.
-    let next_event = PathState::uses_next_event(scene) && !S::Environment::UNIFORM;
+    let next_event = PathState::uses_next_event(scene);
     if next_event && !next_event_estimate(scene, path, p) {
         return;
     }
@@ -348,41 +343,6 @@ fn next_event_estimate<S: Scene>(scene: &S, path: &mut PathState, p: Vec3) -> bo
     let weight = power_heuristic(light.pdf, phase) * phase * transmittance / light.pdf;
     path.radiance += path.throughput * light.radiance * weight;
     true
-}
-
-/// One free flight inside the box under a uniform environment with next-event estimation: path
-/// tracing plus a control variate of zero mean that cancels most of its noise.
-///
-/// Energy conservation makes a uniform environment of radiance `L` behind an index-matched boundary
-/// a white furnace up to absorption: a path's escape `L beta_end` telescopes into
-/// `L (beta_entry - sum over collisions of beta (1 - albedo))`, so path tracing's noise is the
-/// noise of its collision estimate of the absorbed light. Each flight adds
-/// `L beta (c - e)`, where `c` is that collision estimate (`1 - albedo` at the real collision, else
-/// 0) and `e` its expected value along the whole flight, estimated by ratio tracking over the same
-/// tentative collisions ([`absorption_tracking`]): the collision terms cancel and each flight's
-/// absorption is counted by its expected value (an expected-value estimator, Spanier & Gelbard
-/// 1969, used as a control variate, Kalos & Whitlock 2008). Given the
-/// flight's origin and direction `E[c] = E[e]`, so the estimator stays unbiased whatever the
-/// environment, roulette or depth limit; it is exact (zero variance) in a white furnace. Phase
-/// sampling stays the only direction sampling: under a uniform environment it is already
-/// proportional to the light's integrand, `phase * T`.
-#[inline(always)]
-fn next_flight_in_uniform_light<S: Scene>(scene: &S, path: &mut PathState, exit: BoxHit) {
-    let tracked = absorption_tracking(
-        scene.medium(),
-        &path.ray,
-        exit.t,
-        &mut path.rng,
-        &mut path.tracking_steps,
-        scene.settings().max_tracking_steps,
-    );
-    let deviation = tracked.collision_absorption - tracked.expected_absorption;
-    path.radiance += path.throughput * scene.background(path.ray.dir) * deviation;
-    match tracked.flight {
-        FreeFlight::Collision(t) => scatter(scene, path, path.ray.at(t)),
-        FreeFlight::Escaped => interact_with_boundary(scene, path, exit),
-        FreeFlight::OutOfSteps => path.truncate(Truncation::TrackingSteps),
-    }
 }
 
 /// Veach's power heuristic with exponent 2: the weight of a strategy of density `a` against one of

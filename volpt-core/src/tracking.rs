@@ -5,7 +5,7 @@ use crate::majorant::Dda;
 use crate::math::{exp, ln};
 use crate::medium::Medium;
 use crate::rng::Rng;
-use crate::{Ray, Spectrum};
+use crate::Ray;
 
 /// How a free flight ends.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -167,101 +167,5 @@ pub fn ratio_tracking<M: Medium>(
         FreeFlight::OutOfSteps => None,
         FreeFlight::Collision(_) => Some(0.0),
         FreeFlight::Escaped => Some(transmittance),
-    }
-}
-
-/// A free flight sampled by delta tracking, together with two estimates of the light the medium
-/// absorbs along it (per unit throughput): see [`absorption_tracking`].
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct AbsorbingFlight {
-    pub flight: FreeFlight,
-    /// The collision estimate: `1 - albedo` at the real collision, 0 if the flight escaped.
-    pub collision_absorption: Spectrum,
-    /// The expected-value estimate of the same quantity over the whole flight,
-    /// `int_0^t_max sigma_a(t) T(0, t) dt` with `sigma_a = sigma_t (1 - albedo)`.
-    pub expected_absorption: Spectrum,
-}
-
-/// Delta tracking to the next real collision before `t_max` (the same free-flight distribution as
-/// [`delta_tracking`]), plus an unbiased expected-value estimate of the fraction of the light the
-/// flight absorbs, `int_0^t_max sigma_a(t) T(0, t) dt`: the expectation of the collision
-/// estimate `(1 - albedo) 1[collision]`.
-///
-/// The estimate walks the majorants' tentative collisions `t_i` to `t_max` (past the real
-/// collision too) and sums `T_i sigma_a(t_i) / majorant(t_i)`, where `T_i` is ratio tracking's
-/// product over the tentative collisions before `t_i` (Cramer 1978; Novák et al. 2014), with ratio
-/// tracking's Russian roulette below 1/8. By the Poisson process's Mecke (Campbell) formula the sum
-/// has the expectation of the integral; with a constant albedo it equals `(1 - albedo)(1 - T)` of
-/// the whole flight's ratio-tracking estimate `T`. The delta-tracking decision at each tentative
-/// collision draws one extra random number; the walk is shared, so the extra cost is the tail from
-/// the real collision to `t_max`. A homogeneous medium needs no estimate:
-/// `(1 - albedo)(1 - exp(-sigma_t t_max))`.
-#[inline(always)]
-pub fn absorption_tracking<M: Medium>(
-    medium: &M,
-    ray: &Ray,
-    t_max: f32,
-    rng: &mut Rng,
-    steps: &mut u32,
-    max_steps: u32,
-) -> AbsorbingFlight {
-    if M::HOMOGENEOUS {
-        let flight = delta_tracking(medium, ray, t_max, rng, steps, max_steps);
-        let absorption = Spectrum::ONE - medium.albedo(ray.origin);
-        let collision_absorption = match flight {
-            FreeFlight::Collision(_) => absorption,
-            _ => Spectrum::ZERO,
-        };
-        return AbsorbingFlight {
-            flight,
-            collision_absorption,
-            expected_absorption: absorption * (1.0 - exp(-medium.majorant() * t_max)),
-        };
-    }
-    let mut transmittance = 1.0f32;
-    let mut expected_absorption = Spectrum::ZERO;
-    let mut collision: Option<(f32, Spectrum)> = None;
-    let walk = walk_majorants(
-        medium,
-        ray,
-        t_max,
-        rng,
-        steps,
-        max_steps,
-        |rng, t, majorant| {
-            let p = ray.at(t);
-            let real = medium.sigma_t(p) / majorant;
-            let absorption = Spectrum::ONE - medium.albedo(p);
-            expected_absorption += absorption * (transmittance * real);
-            let accepted = rng.next_f32() < real;
-            if collision.is_some() {
-                if accepted {
-                    transmittance = 0.0;
-                }
-                return transmittance <= 0.0;
-            }
-            if accepted {
-                collision = Some((t, absorption));
-            }
-            transmittance *= 1.0 - real;
-            if transmittance < 0.125 {
-                if rng.next_f32() < 0.5 {
-                    transmittance *= 2.0;
-                } else {
-                    transmittance = 0.0;
-                }
-            }
-            transmittance <= 0.0 && collision.is_some()
-        },
-    );
-    let flight = match (walk, collision) {
-        (FreeFlight::OutOfSteps, _) => FreeFlight::OutOfSteps,
-        (_, Some((t, _))) => FreeFlight::Collision(t),
-        (_, None) => FreeFlight::Escaped,
-    };
-    AbsorbingFlight {
-        flight,
-        collision_absorption: collision.map_or(Spectrum::ZERO, |(_, a)| a),
-        expected_absorption,
     }
 }
