@@ -10,7 +10,8 @@
 #    algorithm (--tracking global --estimator pt);
 # 2. `volpt bench --json` (regeneration-sk) at 400x400, 100 spp (bucky 300): smoke, bucky, ad and
 #    cgg-logo with global majorant vs majorant grids of 8, 16, 32, 64 cells (path tracing), pt vs
-#    nee with the default grid, and pt vs nee on envmap-cube with an index-matched boundary;
+#    nee with a grid of 32, the factory's default majorants (global or a grid, by the rule that
+#    `volpt info` prints), and pt vs nee on envmap-cube with an index-matched boundary;
 #    summary.csv has time, tracking steps and segments per path. Efficiency (1 / (MSE x time)) of
 #    nee vs pt: `volpt converge --backend cuda --setting estimator=pt,nee` (docs/heterogeneous.md).
 set -uo pipefail
@@ -47,8 +48,8 @@ SCENES=(
 # The variants of the identity check: name : flags
 VARIANTS=(
     "global-pt:--tracking global --estimator pt"
-    "grid-pt:--estimator pt"
-    "grid-nee:--estimator nee"
+    "grid-pt:--tracking grid --estimator pt"
+    "grid-nee:--tracking grid --estimator nee"
     "global-nee:--tracking global --estimator nee"
 )
 
@@ -103,7 +104,11 @@ for entry in "${SCENES[@]}"; do
     for r in $RESOLUTIONS; do
         bench "$name" "grid$r-pt" "$file" "$params" --spp $spp --majorant-resolution "$r" --estimator pt
     done
-    bench "$name" grid-nee "$file" "$params" --spp $spp --estimator nee
+    bench "$name" grid-nee "$file" "$params" --spp $spp --tracking grid --estimator nee
+    # The factory's own choice (`volpt info`'s "default:" line says which and why).
+    bench "$name" default-pt "$file" "$params" --spp $spp --estimator pt
+    # shellcheck disable=SC2086
+    "$VOLPT" info "$file" $params 2>/dev/null | grep -A1 '^tracking' >>"$OUT/summary.txt"
 done
 # NEE where its default applies: envmap-cube's sun through an index-matched boundary.
 file=scenes/envmap-cube/index-matched.xml

@@ -5,7 +5,8 @@ use std::path::Path;
 
 use volpt_core::{Estimator, PathSettings};
 use volpt_render::factory::{
-    majorant_ratio, BoundaryKind, Derived, Effects, EnvironmentKind, MediumKind, Parts,
+    default_majorants, tracking_cost, BoundaryKind, Derived, Effects, EnvironmentKind,
+    MajorantChoice, MajorantRule, MediumKind, Parts,
 };
 use volpt_scene::{
     AlbedoDesc, BsdfDesc, DensityDesc, EnvironmentDesc, GridDesc, PhaseDesc, SceneDescription,
@@ -133,12 +134,54 @@ fn tracking(desc: &SceneDescription, parts: &Parts<'_>, settings: &PathSettings)
         }
         None => "one global majorant".to_owned(),
     };
-    match majorant_ratio(desc, *settings) {
-        Some((ratio, global)) => format!(
-            "{how}; majorant / extinction along camera rays {ratio:.2} (global majorant {global:.2})"
+    let cost = match tracking_cost(desc, *settings) {
+        Some(c) => format!(
+            "{how}; majorant / extinction along camera rays {:.2} (global majorant {:.2}), cells \
+             crossed per real collision {:.2}",
+            c.majorant_ratio, c.global_ratio, c.crossings_ratio
         ),
         None => format!("{how}; camera rays see no extinction"),
-    }
+    };
+    format!(
+        "{cost}\n           default: {}",
+        majorant_rule(&default_majorants(desc))
+    )
+}
+
+/// The factory's choice of majorants, the rule that fired and its input.
+fn majorant_rule(choice: &MajorantChoice) -> String {
+    let margin = MajorantChoice::GRID_MARGIN;
+    let rule = match choice.rule {
+        MajorantRule::Homogeneous => return "the extinction is one value: no grid".to_owned(),
+        MajorantRule::NoExtinction => {
+            return "the global majorant (camera rays see no extinction to weigh a grid with)"
+                .to_owned()
+        }
+        MajorantRule::NoTighterGrid => {
+            "the global majorant: no grid has a cell below its bound".to_owned()
+        }
+        MajorantRule::GridSavesEnough => format!(
+            "a grid of {} cells: the least work per real collision, at most 1/{margin} of the \
+             global majorant's",
+            choice.resolution
+        ),
+        MajorantRule::GridSavesTooLittle => format!(
+            "the global majorant: no grid does less than 1/{margin} of its work per real collision"
+        ),
+    };
+    let costs: Vec<String> = choice
+        .costs
+        .iter()
+        .map(|(r, c)| match r {
+            1 => format!("global {c:.2}"),
+            r => format!("{r} cells {c:.2}"),
+        })
+        .collect();
+    format!(
+        "{rule} (tentative collisions + cell crossings per real collision: {}; \
+         --tracking, --majorant-resolution override)",
+        costs.join(", ")
+    )
 }
 
 /// The estimator the paths use, and why.

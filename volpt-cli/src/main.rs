@@ -114,7 +114,9 @@ struct SceneArgs {
     /// map) instead of the one specialised to the scene's effects: what specialisation saves.
     #[arg(long)]
     general: bool,
-    /// Delta and ratio tracking under one global majorant or a majorant grid (default: a grid of 32 cells along the longest axis).
+    /// Delta and ratio tracking under one global majorant or a majorant grid (default: chosen per
+    /// scene by the tracking work along camera rays, `volpt info` says which and why; `grid`
+    /// without --majorant-resolution: the scene's grid, else 32 cells along the longest axis).
     #[arg(long, value_enum)]
     tracking: Option<Tracking>,
     /// Cells of the majorant grid along the box's longest axis (1 is the global majorant).
@@ -210,7 +212,10 @@ impl SceneArgs {
             ),
             (Some(Tracking::Global), _) => 1,
             (_, Some(r)) => r,
-            (_, None) => PathSettings::DEFAULT_MAJORANT_RESOLUTION,
+            (Some(Tracking::Grid), None) if settings.majorant_resolution <= 1 => {
+                PathSettings::DEFAULT_MAJORANT_RESOLUTION
+            }
+            (_, None) => settings.majorant_resolution,
         };
         if let Some(roulette) = self.roulette {
             settings.roulette = roulette.into();

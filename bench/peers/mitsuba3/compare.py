@@ -39,8 +39,10 @@ import mi3scene  # noqa: E402
 import stats  # noqa: E402
 
 MD_HEADER = ("| scene | machine | peer variant | volpt backend | res | spp | Mitsuba 3 s | volpt s | speed-up "
+             "| MSE Mitsuba 3 | MSE volpt | efficiency volpt / Mitsuba 3 "
              "| rel. mean diff | global z (R,G,B) | worst block \\|z\\| | blocks \\|z\\|>3 | z of 1% bias | agree |\n"
-             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- "
+             "| --- |")
 
 
 def scene_name(path):
@@ -100,6 +102,19 @@ def volpt_render(volpt, scene, params, spp, seed, out, backend, threads, extra):
         raise RuntimeError(f"cannot find the render time in volpt's output:\n{p.stdout}")
     truncated = re.search(r"warning: (\d+) paths reached the segment bound", p.stdout)
     return float(m.group(2)), wall, m.group(1), int(truncated.group(1)) if truncated else 0, " ".join(cmd)
+
+
+def mse_of_one_render(a, b):
+    """The mean squared error of one render, per pixel channel, from two renders of independent
+    seeds and without a reference: for unbiased renders E[(a - b)^2] / 2 is the variance of one,
+    which is its MSE. Only meaningful where the agreement test passes (a bias would not show)."""
+    if stats.np is not None:
+        return float(((a - b) ** 2).mean() / 2)
+    return sum((x - y) ** 2 for x, y in zip(a, b)) / (2 * len(a))
+
+
+def fmt_ratio(x):
+    return "n/a" if x is None else f"{x:.2f}x"
 
 
 def fmt(x, nd=3):
@@ -199,11 +214,18 @@ def run_scene(args, mit, path):
     tp, tv = (statistics.median(res[who]["times_s"][1:]) for who in ("peer", "volpt"))
     res["peer"]["time_s"], res["volpt"]["time_s"] = tp, tv
     res["speedup"] = tp / tv if tv > 0 else None
+    # Efficiency 1 / (MSE x time): the speed-up at equal error, where the two estimators' variances
+    # per sample differ (Mitsuba 3 samples the emitter at every scattering event, volpt by default
+    # only under a lat-long map; docs/heterogeneous.md).
+    mse_v, mse_p = mse_of_one_render(imgs[0][0], imgs[1][0]), mse_of_one_render(imgs[2][0], imgs[3][0])
+    res["volpt"]["mse"], res["peer"]["mse"] = mse_v, mse_p
+    res["efficiency_ratio"] = (mse_p * tp) / (mse_v * tv) if mse_v > 0 and tv > 0 else None
     with open(os.path.join(args.out, f"{name}.json"), "w") as f:
         json.dump(res, f, indent=2)
     a = agreement
     row = (f"| {name} | {res['machine']} | {mit.variant} | {args.backend} | {h}x{w} | {spp} | {tp:.3f} | "
-           f"{tv:.3f} | {res['speedup']:.2f}x | {100 * a['relative_mean_difference']:+.3f}% | "
+           f"{tv:.3f} | {res['speedup']:.2f}x | {mse_p:.3e} | {mse_v:.3e} | "
+           f"{fmt_ratio(res['efficiency_ratio'])} | {100 * a['relative_mean_difference']:+.3f}% | "
            f"{', '.join(f'{z:+.2f}' for z in a['global_z_rgb'])} | {a['worst_abs_z']:.2f} | "
            f"{100 * a['fraction_abs_z_above_3']:.2f}% | {min(a['z_of_1pct_bias']):.1f} | "
            f"{'yes' if a['agree'] else '**no**'} |")
