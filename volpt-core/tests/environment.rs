@@ -393,3 +393,40 @@ fn constant_environment_samples_the_sphere_uniformly() {
     let ks = ks_test(&z, |z| (0.5 * (z + 1.0)).clamp(0.0, 1.0));
     assert!(ks.p_value > ALPHA, "z of the samples: {ks:?}");
 }
+
+/// The sampler's numbers include 0 exactly (the renderer's `next_f32` returns it once in 2^24),
+/// which lands on a pole, where the solid-angle density has no finite value: such a sample must be
+/// refused (`None`), never returned with a density of 0 or infinity (next-event estimation divides
+/// by it, and one NaN spoils a pixel).
+#[test]
+fn lat_long_samples_on_the_edges_of_the_unit_square_have_positive_densities() {
+    let last = 1.0 - f32::EPSILON / 2.0;
+    for (rgb, width, height, rows) in cases() {
+        // A map lit at both poles, so that the edge rows have weight.
+        let mut rgb = rgb;
+        let lit: Vec<f32> = (0..3 * width).map(|k| 0.5 + (k % 3) as f32).collect();
+        rgb[..3 * width as usize].copy_from_slice(&lit);
+        let n = rgb.len();
+        rgb[n - 3 * width as usize..].copy_from_slice(&lit);
+        let map = map(&rgb, width, height, rows);
+        let distribution = distribution(&map);
+        let map = LatLongEnvironment {
+            distribution: &distribution,
+            ..map
+        };
+        let mut refused = 0;
+        for x in [0.0, 0.3, 0.5, last] {
+            for y in [0.0, 0.3, 0.5, last] {
+                match map.sample(Vec2::new(x, y)) {
+                    Some(sample) => assert!(
+                        sample.pdf.is_finite() && sample.pdf > 0.0,
+                        "{width}x{height}: u = ({x}, {y}) gives density {}",
+                        sample.pdf
+                    ),
+                    None => refused += 1,
+                }
+            }
+        }
+        assert!(refused <= 8, "{width}x{height}: {refused} of 16 refused");
+    }
+}
