@@ -430,3 +430,36 @@ fn lat_long_samples_on_the_edges_of_the_unit_square_have_positive_densities() {
         assert!(refused <= 8, "{width}x{height}: {refused} of 16 refused");
     }
 }
+
+/// `pdf` is asked about any direction an escaping path takes, including those that round onto the
+/// edges of the `(u, v)` square: a direction a hair below `u = 0` gives `u = 1 - 1e-31`, which is
+/// 1.0 in f32, and the south pole gives `v >= 1`. Both must read the last cell (or density 0 at the
+/// pole), never the next row's values or past the table.
+#[test]
+fn lat_long_pdf_on_the_seam_and_at_the_poles() {
+    let identity = [Vec3::X, Vec3::Y, Vec3::Z];
+    for (rgb, width, height, rows) in cases() {
+        let map = LatLongEnvironment::new(&rgb, width, height, rows, identity, 1.0);
+        let distribution = distribution(&map);
+        let map = LatLongEnvironment {
+            distribution: &distribution,
+            ..map
+        };
+        // Row 0 is lit (`texels`), so the seam's cells there have weight.
+        for y in [0.9f32, 0.3, -0.4] {
+            let r = (1.0 - y * y).sqrt();
+            let seam = Vec3::new(-1e-30, y, -r);
+            // The same cell, with a polar angle (and so a density) within ~1e-6 of the seam's.
+            let before = Vec3::new(-1e-3, y, -r).normalize();
+            let (got, want) = (map.pdf(seam), map.pdf(before));
+            assert!(
+                (got - want).abs() <= 1e-4 * want && got.is_finite(),
+                "{width}x{height}: pdf on the seam {got}, just before it {want}"
+            );
+        }
+        for pole in [Vec3::Y, Vec3::NEG_Y] {
+            let pdf = map.pdf(pole);
+            assert!(pdf.is_finite() && pdf >= 0.0, "pdf({pole}) = {pdf}");
+        }
+    }
+}
