@@ -6,7 +6,8 @@
 
 use volpt_core::abi::{GridParams, Uploader};
 use volpt_core::{
-    Aabb, Component, Grid, GridLayout, GridMapping, LatLongEnvironment, LatLongRows, Vec3,
+    Aabb, Component, ConstantEnvironment, Grid, GridLayout, GridMapping, LatLongEnvironment,
+    LatLongRows, Vec3,
 };
 
 /// A closure uploader that hands out made-up device addresses and records what it was given.
@@ -58,4 +59,16 @@ fn a_closure_uploads_a_lat_long_map_and_its_distribution() {
         (0x2008, distribution.len() as u64)
     );
     assert_eq!((params.width, params.height, params.scale), (3, 2, 2.0));
+}
+
+#[test]
+fn a_constant_environment_travels_as_its_radiance() {
+    let env = ConstantEnvironment(Vec3::new(0.25, 1.5, 3.0));
+    let mut calls = Vec::new();
+    let params = env.to_params(&mut recording(&mut calls));
+    assert!(calls.is_empty(), "a constant uploads nothing");
+    assert_eq!(params.radiance, [0.25, 1.5, 3.0]);
+    // SAFETY: a constant's parameters hold no address.
+    let decoded = unsafe { ConstantEnvironment::from_params(&params) };
+    assert_eq!(decoded.0, env.0);
 }
