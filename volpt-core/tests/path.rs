@@ -7,24 +7,25 @@
 mod common;
 
 use common::{Moments, Z_MAX};
-use volpt_core::path::{step, trace, Truncation};
+use volpt_core::path::{sample_pixel, step, trace, Truncation};
 use volpt_core::{
     Aabb, ConstantEnvironment, Estimator, HenyeyGreenstein, HomogeneousMedium, NullBoundary,
-    PathCounters, PathSettings, PathState, PerspectiveCamera, Ray, Rng, Roulette, Spectrum, Vec2,
-    Vec3, VolumeScene,
+    PathCounters, PathSettings, PathState, PerspectiveCamera, Ray, Rng, Roulette, SmoothDielectric,
+    Spectrum, Vec2, Vec3, VolumeScene,
 };
 
-type Furnace = VolumeScene<HomogeneousMedium, NullBoundary, HenyeyGreenstein, ConstantEnvironment>;
+type Furnace<B = NullBoundary> =
+    VolumeScene<HomogeneousMedium, B, HenyeyGreenstein, ConstantEnvironment>;
 
 /// A camera 4 units in front of the box `[-1, 1]^3`, looking at it along +z; the box fills the
-/// central part of the `8 x 6` film.
+/// central part of the `8 x 6` film, and the rays of its corner pixels miss it.
 fn camera() -> PerspectiveCamera {
     PerspectiveCamera {
         origin: Vec3::new(0.0, 0.0, -4.0),
         axis_x: Vec3::new(-1.0, 0.0, 0.0),
         axis_y: Vec3::Y,
         axis_z: Vec3::Z,
-        tan_half_fov: Vec2::new(0.3, 0.225),
+        tan_half_fov: Vec2::new(0.6, 0.45),
         width: 8,
         height: 6,
     }
@@ -33,6 +34,11 @@ fn camera() -> PerspectiveCamera {
 /// A white furnace: albedo 1 inside an index-matched box under a constant environment of radiance
 /// 1, so every pixel's value is exactly 1. Optical depth 3 across the box, forward scattering.
 fn furnace(settings: PathSettings) -> Furnace {
+    furnace_behind(NullBoundary, settings)
+}
+
+/// The furnace behind `boundary`: a boundary that neither absorbs nor emits keeps every pixel at 1.
+fn furnace_behind<B>(boundary: B, settings: PathSettings) -> Furnace<B> {
     VolumeScene {
         camera: camera(),
         bounds: Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0)),
@@ -40,19 +46,52 @@ fn furnace(settings: PathSettings) -> Furnace {
             sigma_t: 1.5,
             albedo: Spectrum::ONE,
         },
-        boundary: NullBoundary,
+        boundary,
         phase: HenyeyGreenstein { g: 0.6 },
         environment: ConstantEnvironment(Spectrum::ONE),
         settings,
     }
 }
 
+/// The mean of every pixel's paths, asserted to be 1 within `Z_MAX` standard errors; the most
+/// interactions a path had.
+fn assert_furnace_mean_is_one<B: volpt_core::Bsdf>(
+    scene: &Furnace<B>,
+    spp: u32,
+    what: &str,
+) -> u32 {
+    let mut moments = Moments::default();
+    let mut longest = 0;
+    for py in 0..scene.camera.height {
+        for px in 0..scene.camera.width {
+            for sample in 0..spp {
+                let mut path = PathState::from_camera(scene, px, py, sample, 7);
+                trace(scene, &mut path);
+                assert_eq!(path.truncated, Truncation::None);
+                longest = longest.max(path.depth);
+                for value in path.radiance.to_array() {
+                    assert_eq!(value, path.radiance.x, "a grey furnace stays grey");
+                }
+                moments.push(path.radiance.x as f64);
+            }
+        }
+    }
+    let z = moments.z_score(1.0);
+    assert!(
+        z.abs() <= Z_MAX,
+        "{what}: furnace mean {} +- {} (z = {z:.1})",
+        moments.mean(),
+        moments.std_error()
+    );
+    longest
+}
+
 /// Every `(estimator, roulette)` with roulette from the first interaction on: path tracing, and
 /// next-event estimation whose two strategies are weighted by the power heuristic (the
-/// environment's density `1 / 4 pi` against Henyey-Greenstein's, which differ).
+/// environment's density `1 / 4 pi` against Henyey-Greenstein's, which differ). The film's corner
+/// pixels miss the box: their camera rays see the environment unweighted.
 #[test]
 fn white_furnace_returns_one_with_every_estimator_and_roulette() {
-    const SPP: u32 = 600;
     for estimator in [Estimator::PathTracing, Estimator::NextEvent] {
         for roulette in [Roulette::Mitsuba, Roulette::Throughput] {
             let scene = furnace(PathSettings {
@@ -61,29 +100,128 @@ fn white_furnace_returns_one_with_every_estimator_and_roulette() {
                 roulette,
                 ..PathSettings::default()
             });
-            let mut moments = Moments::default();
-            let mut longest = 0;
-            // Pixel (4, 3) looks at the box's centre.
-            for (px, py) in [(4, 3), (3, 2), (5, 3)] {
-                for sample in 0..SPP {
-                    let mut path = PathState::from_camera(&scene, px, py, sample, 7);
-                    trace(&scene, &mut path);
-                    assert_eq!(path.truncated, Truncation::None);
-                    longest = longest.max(path.depth);
-                    for value in path.radiance.to_array() {
-                        assert_eq!(value, path.radiance.x, "a grey furnace stays grey");
-                    }
-                    moments.push(path.radiance.x as f64);
-                }
-            }
-            let z = moments.z_score(1.0);
+            let what = format!("{estimator:?}, {roulette:?}");
+            let longest = assert_furnace_mean_is_one(&scene, 40, &what);
             assert!(
-                z.abs() <= Z_MAX,
-                "{estimator:?}, {roulette:?}: furnace mean {} +- {} (z = {z:.1})",
-                moments.mean(),
-                moments.std_error()
+                longest > 3,
+                "{what}: paths scattered at most {longest} times"
             );
-            assert!(longest > 3, "paths scattered at most {longest} times");
+        }
+    }
+}
+
+/// Next-event estimation is valid only behind an index-matched boundary (a dielectric bends or
+/// reflects the shadow ray); behind a smooth dielectric the same setting must trace paths only,
+/// and the furnace stays at 1.
+#[test]
+fn white_furnace_behind_a_dielectric_returns_one_with_next_event_selected() {
+    let scene = furnace_behind(
+        SmoothDielectric { eta: 1.5 },
+        PathSettings {
+            estimator: Estimator::NextEvent,
+            ..PathSettings::default()
+        },
+    );
+    assert_furnace_mean_is_one(&scene, 40, "smooth dielectric, NextEvent");
+}
+
+/// Whether a path gathered light at a collision, where only next-event estimation adds any.
+fn gathers_at_collisions<B: volpt_core::Bsdf>(scene: &Furnace<B>) -> bool {
+    (0..50).any(|sample| {
+        let mut path = PathState::from_camera(scene, 4, 3, sample, 2);
+        while path.alive {
+            let depth = path.depth;
+            step(scene, &mut path);
+            // A step that ended in a collision counted one more interaction and stayed inside.
+            if path.depth > depth && path.inside && path.radiance != Spectrum::ZERO {
+                return true;
+            }
+        }
+        false
+    })
+}
+
+/// Next-event estimation runs where it is selected, behind an index-matched boundary, and nowhere
+/// else: path tracing and a dielectric boundary gather light only where a path escapes.
+#[test]
+fn next_event_estimation_runs_exactly_where_selected() {
+    let settings = |estimator| PathSettings {
+        estimator,
+        ..PathSettings::default()
+    };
+    assert!(gathers_at_collisions(&furnace(settings(
+        Estimator::NextEvent
+    ))));
+    assert!(!gathers_at_collisions(&furnace(settings(
+        Estimator::PathTracing
+    ))));
+    let dielectric = SmoothDielectric { eta: 1.5 };
+    assert!(!gathers_at_collisions(&furnace_behind(
+        dielectric,
+        settings(Estimator::NextEvent)
+    )));
+}
+
+/// `sample_pixel`, the CPU renderer's and the naive GPU strategy's loop, adds exactly the radiance
+/// of the paths `from_camera` and `trace` give, in `f64`, and records each path.
+#[test]
+fn sample_pixel_sums_its_paths() {
+    let scene = furnace(PathSettings {
+        estimator: Estimator::NextEvent,
+        ..PathSettings::default()
+    });
+    let mut expected = [0.0f64; 3];
+    let mut expected_counters = PathCounters::default();
+    for sample in 3..40 {
+        let mut path = PathState::from_camera(&scene, 5, 2, sample, 9);
+        trace(&scene, &mut path);
+        expected_counters.record(&path);
+        for (e, r) in expected.iter_mut().zip(path.radiance.to_array()) {
+            *e += r as f64;
+        }
+    }
+    let mut sum = [0.5f64; 3];
+    let mut counters = PathCounters::default();
+    sample_pixel(&scene, (5, 2), 3..40, 9, &mut sum, &mut counters);
+    assert_eq!(sum, expected.map(|e| e + 0.5), "added to what the sum held");
+    assert_eq!(counters, expected_counters);
+    assert!(expected[0] > 10.0, "the paths gathered light");
+}
+
+/// Mitsuba's `max_depth`: a path may see the light after at most `max_depth - 1` interactions, and
+/// `max_depth = 0` renders nothing. In the furnace (path tracing), a path of `max_depth = d`
+/// returns 1 if it escapes after fewer than `d` collisions and 0 if its `d`-th collision ends it.
+#[test]
+fn max_depth_counts_interactions() {
+    for max_depth in [0, 1, 2, 3] {
+        let scene = furnace(PathSettings {
+            max_depth,
+            ..PathSettings::default()
+        });
+        let (mut lit, mut cut) = (0, 0);
+        for sample in 0..400 {
+            let mut path = PathState::from_camera(&scene, 4, 3, sample, 5);
+            trace(&scene, &mut path);
+            if path.radiance == Spectrum::ONE {
+                assert!(
+                    path.depth < max_depth,
+                    "lit after {} collisions",
+                    path.depth
+                );
+                lit += 1;
+            } else {
+                assert_eq!(path.radiance, Spectrum::ZERO);
+                assert_eq!(path.depth, max_depth, "a path ended early");
+                cut += 1;
+            }
+        }
+        if max_depth == 0 {
+            assert_eq!(lit, 0, "max_depth 0 is black");
+        } else {
+            assert!(
+                lit > 0 && cut > 0,
+                "max_depth {max_depth}: {lit} lit, {cut} cut"
+            );
         }
     }
 }
