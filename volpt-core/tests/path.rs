@@ -1,8 +1,10 @@
 //! The path step on a scene built by hand, without the render factory: the white furnace (every
-//! estimator and roulette rule must return exactly 1 on average), the safety bounds, the random
-//! streams of pixels and samples, and the path counters. Cheap (well under a second): the
-//! whole-renderer tests check the same paths against independent references, but only with
-//! `max_depth = 2`, where roulette never runs, and they never reach the safety bounds.
+//! estimator and roulette rule must return exactly the environment's radiance on average, also
+//! behind a dielectric), where next-event estimation runs, `max_depth`, the albedo's weight, the
+//! safety bounds, the random streams of pixels and samples, `sample_pixel` and the path counters.
+//! Cheap (well under a second): the whole-renderer tests check the same paths against independent
+//! references, but only with `max_depth = 2`, where roulette never runs, and they never reach the
+//! safety bounds.
 
 mod common;
 
@@ -31,13 +33,18 @@ fn camera() -> PerspectiveCamera {
     }
 }
 
+/// The furnace's environment radiance: not 1, so that a throughput divided by the light instead of
+/// multiplied shows.
+const LIGHT: f32 = 2.0;
+
 /// A white furnace: albedo 1 inside an index-matched box under a constant environment of radiance
-/// 1, so every pixel's value is exactly 1. Optical depth 3 across the box, forward scattering.
+/// `LIGHT`, so every pixel's value is exactly `LIGHT`. Optical depth 3 across the box, forward
+/// scattering.
 fn furnace(settings: PathSettings) -> Furnace {
     furnace_behind(NullBoundary, settings)
 }
 
-/// The furnace behind `boundary`: a boundary that neither absorbs nor emits keeps every pixel at 1.
+/// The furnace behind `boundary`: a boundary that neither absorbs nor emits keeps every pixel at `LIGHT`.
 fn furnace_behind<B>(boundary: B, settings: PathSettings) -> Furnace<B> {
     VolumeScene {
         camera: camera(),
@@ -48,14 +55,15 @@ fn furnace_behind<B>(boundary: B, settings: PathSettings) -> Furnace<B> {
         },
         boundary,
         phase: HenyeyGreenstein { g: 0.6 },
-        environment: ConstantEnvironment(Spectrum::ONE),
+        environment: ConstantEnvironment(Spectrum::splat(LIGHT)),
         settings,
     }
 }
 
-/// The mean of every pixel's paths, asserted to be 1 within `Z_MAX` standard errors; the most
-/// interactions a path had.
-fn assert_furnace_mean_is_one<B: volpt_core::Bsdf>(
+/// The mean of every pixel's paths, asserted to be `LIGHT` within `Z_MAX` standard errors, and
+/// every path's radiance non-negative (MIS weights lie in [0, 1]); the most interactions a path
+/// had.
+fn assert_furnace_mean_is_the_light<B: volpt_core::Bsdf>(
     scene: &Furnace<B>,
     spp: u32,
     what: &str,
@@ -72,11 +80,12 @@ fn assert_furnace_mean_is_one<B: volpt_core::Bsdf>(
                 for value in path.radiance.to_array() {
                     assert_eq!(value, path.radiance.x, "a grey furnace stays grey");
                 }
+                assert!(path.radiance.x >= 0.0, "{what}: radiance {}", path.radiance);
                 moments.push(path.radiance.x as f64);
             }
         }
     }
-    let z = moments.z_score(1.0);
+    let z = moments.z_score(LIGHT as f64);
     assert!(
         z.abs() <= Z_MAX,
         "{what}: furnace mean {} +- {} (z = {z:.1})",
@@ -91,7 +100,7 @@ fn assert_furnace_mean_is_one<B: volpt_core::Bsdf>(
 /// environment's density `1 / 4 pi` against Henyey-Greenstein's, which differ). The film's corner
 /// pixels miss the box: their camera rays see the environment unweighted.
 #[test]
-fn white_furnace_returns_one_with_every_estimator_and_roulette() {
+fn white_furnace_returns_the_light_with_every_estimator_and_roulette() {
     for estimator in [Estimator::PathTracing, Estimator::NextEvent] {
         for roulette in [Roulette::Mitsuba, Roulette::Throughput] {
             let scene = furnace(PathSettings {
@@ -101,7 +110,7 @@ fn white_furnace_returns_one_with_every_estimator_and_roulette() {
                 ..PathSettings::default()
             });
             let what = format!("{estimator:?}, {roulette:?}");
-            let longest = assert_furnace_mean_is_one(&scene, 40, &what);
+            let longest = assert_furnace_mean_is_the_light(&scene, 40, &what);
             assert!(
                 longest > 3,
                 "{what}: paths scattered at most {longest} times"
@@ -112,9 +121,9 @@ fn white_furnace_returns_one_with_every_estimator_and_roulette() {
 
 /// Next-event estimation is valid only behind an index-matched boundary (a dielectric bends or
 /// reflects the shadow ray); behind a smooth dielectric the same setting must trace paths only,
-/// and the furnace stays at 1.
+/// and the furnace stays at `LIGHT`.
 #[test]
-fn white_furnace_behind_a_dielectric_returns_one_with_next_event_selected() {
+fn white_furnace_behind_a_dielectric_returns_the_light_with_next_event_selected() {
     let scene = furnace_behind(
         SmoothDielectric { eta: 1.5 },
         PathSettings {
@@ -122,7 +131,7 @@ fn white_furnace_behind_a_dielectric_returns_one_with_next_event_selected() {
             ..PathSettings::default()
         },
     );
-    assert_furnace_mean_is_one(&scene, 40, "smooth dielectric, NextEvent");
+    assert_furnace_mean_is_the_light(&scene, 40, "smooth dielectric, NextEvent");
 }
 
 /// Whether a path gathered light at a collision, where only next-event estimation adds any.
@@ -190,7 +199,8 @@ fn sample_pixel_sums_its_paths() {
 
 /// Mitsuba's `max_depth`: a path may see the light after at most `max_depth - 1` interactions, and
 /// `max_depth = 0` renders nothing. In the furnace (path tracing), a path of `max_depth = d`
-/// returns 1 if it escapes after fewer than `d` collisions and 0 if its `d`-th collision ends it.
+/// returns `LIGHT` if it escapes after fewer than `d` collisions and 0 if its `d`-th collision ends
+/// it.
 #[test]
 fn max_depth_counts_interactions() {
     for max_depth in [0, 1, 2, 3] {
@@ -202,7 +212,7 @@ fn max_depth_counts_interactions() {
         for sample in 0..400 {
             let mut path = PathState::from_camera(&scene, 4, 3, sample, 5);
             trace(&scene, &mut path);
-            if path.radiance == Spectrum::ONE {
+            if path.radiance == Spectrum::splat(LIGHT) {
                 assert!(
                     path.depth < max_depth,
                     "lit after {} collisions",
@@ -224,6 +234,33 @@ fn max_depth_counts_interactions() {
             );
         }
     }
+}
+
+/// With path tracing and no roulette, a path that escapes after `k` collisions returns exactly
+/// `albedo^k` times the light: the collision estimator's weight is the albedo.
+#[test]
+fn each_collision_weighs_the_throughput_by_the_albedo() {
+    let mut scene = furnace(PathSettings {
+        rr_depth: PathSettings::UNLIMITED,
+        ..PathSettings::default()
+    });
+    let albedo = Spectrum::new(0.9, 0.7, 0.5);
+    scene.medium.albedo = albedo;
+    let mut deepest = 0;
+    for sample in 0..200 {
+        let mut path = PathState::from_camera(&scene, 4, 3, sample, 8);
+        trace(&scene, &mut path);
+        let expected = albedo.powf(path.depth as f32) * LIGHT;
+        let error = (path.radiance - expected).abs().max_element();
+        assert!(
+            error <= 1e-5 * LIGHT,
+            "after {} collisions: {} instead of {expected}",
+            path.depth,
+            path.radiance
+        );
+        deepest = deepest.max(path.depth);
+    }
+    assert!(deepest >= 3, "paths collided at most {deepest} times");
 }
 
 /// Past `max_segments` free flights a path ends, contributes nothing (even light it had gathered)
