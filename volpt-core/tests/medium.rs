@@ -54,6 +54,7 @@ fn medium<A>(f: &Fields, albedo: A) -> GridMedium<'_, A> {
         majorant: 2.5 * 5.5,
         majorants: Some(MajorantGrid::new(&f.majorants, [2, 1, 1], bounds())),
         albedo,
+        reads: volpt_core::DenseTrilinear,
     }
 }
 
@@ -64,7 +65,7 @@ fn grid_media_are_scale_times_density_with_either_albedo() {
     let albedo_grid = Grid::<3>::new(&f.albedo, RES, GridMapping::cell_centred(bounds(), RES));
     let constant = Spectrum::new(0.3, 0.6, 0.9);
     let with_constant = medium(&f, ConstantAlbedo(constant));
-    let with_grid = medium(&f, GridAlbedo(albedo_grid));
+    let with_grid = medium(&f, GridAlbedo(albedo_grid, volpt_core::DenseTrilinear));
     let mut varied = false;
     for p in points() {
         let sigma_t = 2.5 * density.lookup(p)[0];
@@ -123,7 +124,7 @@ fn media_survive_the_device_encoding() {
     let m = medium(&f, constant);
     // SAFETY: every address is a slice of `f`, alive for the whole test.
     let decoded = unsafe { GridMedium::<ConstantAlbedo>::from_params(&m.to_params(&mut InPlace)) };
-    let m2 = medium(&f, GridAlbedo(albedo_grid));
+    let m2 = medium(&f, GridAlbedo(albedo_grid, volpt_core::DenseTrilinear));
     // SAFETY: as above.
     let decoded2 = unsafe { GridMedium::<GridAlbedo>::from_params(&m2.to_params(&mut InPlace)) };
     for p in points() {
