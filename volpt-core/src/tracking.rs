@@ -65,6 +65,7 @@ pub fn walk_majorants<M: Medium>(
         if majorant <= 0.0 {
             return FreeFlight::Escaped;
         }
+        let majorant = normal_majorant(majorant);
         let inv_majorant = 1.0 / majorant;
         let mut t = 0.0;
         loop {
@@ -87,6 +88,7 @@ pub fn walk_majorants<M: Medium>(
         let (majorant, cell_end) = dda.segment(grid);
         let end = cell_end.min(t_max);
         if majorant > 0.0 {
+            let majorant = normal_majorant(majorant);
             let inv_majorant = 1.0 / majorant;
             let mut t = start;
             loop {
@@ -109,6 +111,22 @@ pub fn walk_majorants<M: Medium>(
         }
         start = start.max(end);
         dda.advance(grid, ray.dir);
+    }
+}
+
+/// `majorant` (positive, or NaN), raised to at least `f32::MIN_POSITIVE`. The reciprocal of a
+/// subnormal majorant overflows to infinity, and a step drawn from `u = 0` is then `0 * inf`: a NaN
+/// `t` that no comparison ends, so the walk spun to the step budget (smoke's grid has subnormal
+/// voxels: one path in ~80 million took 2^26 steps, 20 s of one GPU thread). A larger majorant is
+/// still a majorant, so tracking stays exact (a homogeneous medium, which accepts every tentative
+/// collision, then collides at rate 1.2e-38 instead of its subnormal `sigma_t`: no f32 image can
+/// show the difference); a NaN stays NaN (the budget catches it).
+#[inline(always)]
+fn normal_majorant(majorant: f32) -> f32 {
+    if majorant < f32::MIN_POSITIVE {
+        f32::MIN_POSITIVE
+    } else {
+        majorant
     }
 }
 
