@@ -27,6 +27,8 @@ REFSPP=${REFSPP:-4096}
 # BACKEND=cpu STRATEGIES= tries the script without a GPU (the math knob then reports itself skipped
 # or refused, and the CPU has no strategies).
 BACKEND=${BACKEND:-cuda}
+# ONLY (a regex of scene names, default all) renders some of the scenes.
+ONLY=${ONLY:-.}
 strategies=()
 [ -n "$STRATEGIES" ] && strategies=(--setting "strategy=$STRATEGIES")
 mkdir -p "$OUT" "$WORK/runs" "$WORK/references"
@@ -44,6 +46,7 @@ KNOBS=(
 )
 for entry in "${SCENES[@]}"; do
     IFS=: read -r name file params <<<"$entry"
+    [[ $name =~ $ONLY ]] || continue
     ref="$WORK/references/$name"
     mkdir -p "$ref"
     for knob in "${KNOBS[@]}"; do
