@@ -4,6 +4,7 @@
 //! CPU) lives on the device for the whole render, and only the final sums come back. The kernel is
 //! the scene type's own ([`entry_name`]), so the GPU simulates exactly the effects the CPU would.
 
+use std::cell::Cell;
 use std::collections::HashMap;
 use std::ops::Range;
 use std::sync::{Arc, Mutex};
@@ -16,7 +17,7 @@ use cudarc::driver::{
 use cudarc::nvrtc::Ptx;
 use volpt_core::abi::SceneAbi;
 use volpt_core::path::PathCounters;
-use volpt_device::launch::{BLOCK_SIZE, COUNTERS};
+use volpt_device::launch::{next_launch_paths, BLOCK_SIZE, COUNTERS, FIRST_LAUNCH_PATHS};
 use volpt_device::{LaunchParams, Math, Strategy};
 use volpt_film::{Film, Image, RenderOptions, RenderStats};
 use volpt_zerocopy::{VolumePlacer, VolumePolicy};
@@ -222,7 +223,10 @@ impl CudaRenderer {
         let total = pixels * samples.len() as u64;
         stream.synchronize().doing("copying the scene")?;
         let start = Instant::now();
-        for (first, count) in strategy.launches(pixels, samples.len() as u32) {
+        // The first launch's budget, then what the measured rate traces in `LAUNCH_SECONDS`.
+        let budget = Cell::new(FIRST_LAUNCH_PATHS);
+        for (first, count) in strategy.launches(pixels, samples.len() as u32, || budget.get()) {
+            let launched = Instant::now();
             params.first_sample = samples.start + first;
             params.samples = count;
             params.total_paths = pixels * count as u64;
@@ -240,6 +244,10 @@ impl CudaRenderer {
             }
             .doing("launching the kernel")?;
             stream.synchronize().doing("running the kernel")?;
+            budget.set(next_launch_paths(
+                params.total_paths,
+                launched.elapsed().as_secs_f64(),
+            ));
             progress(pixels * (first + count) as u64, total);
         }
         let elapsed = start.elapsed();

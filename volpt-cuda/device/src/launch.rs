@@ -20,9 +20,24 @@ pub const BLOCK_SIZE: u32 = 128;
 /// of those the paths cut by the tracking-step bound.
 pub const COUNTERS: usize = 5;
 
-/// Paths one regenerationSK launch aims at: enough to hide the tail of the last paths, few enough
-/// that progress is reported a few times a second.
-const PATHS_PER_REGENERATION_LAUNCH: u64 = 1 << 22;
+/// Paths of a persistent strategy's first launch. Every launch ends in a tail: as its last paths
+/// finish, lanes go idle until the longest path in flight ends. On an H100 (2026-11-23,
+/// `bench/device/kernel-times.sh`) that tail cost ~25 ms a launch on cgg-logo: 100 spp at 400x400
+/// in four launches of 2^22 paths took 182 ms of kernel time where one launch of 16 spp took 41.
+/// So a render of up to 2^24 paths (100 spp at 400x400) is one launch; later launches are sized
+/// by [`next_launch_paths`].
+pub const FIRST_LAUNCH_PATHS: u64 = 1 << 24;
+
+/// Seconds a launch after the first aims at: long enough that the tail is a few percent of it,
+/// short enough for progress reports and for an interrupt to be answered within a second.
+pub const LAUNCH_SECONDS: f64 = 0.5;
+
+/// The path budget of the launch after one that traced `paths` paths in `seconds`: what that rate
+/// traces in [`LAUNCH_SECONDS`], between 2^20 and 2^28 paths.
+pub fn next_launch_paths(paths: u64, seconds: f64) -> u64 {
+    let rate = paths as f64 / seconds.max(1e-6);
+    (rate * LAUNCH_SECONDS).clamp((1u64 << 20) as f64, (1u64 << 28) as f64) as u64
+}
 
 /// One launch: the scene's parameters `P` (a [`SceneAbi::Params`]), the sampling, and the device
 /// buffers the kernel writes.
@@ -93,25 +108,31 @@ pub fn pixel_xy(pixel: u32, width: u32) -> (u32, u32) {
 
 impl Strategy {
     /// Samples per pixel that one launch traces, out of the `remaining` samples of a render over
-    /// `pixels` pixels.
-    pub fn samples_per_launch(self, pixels: u64, remaining: u32) -> u32 {
+    /// `pixels` pixels, for a persistent strategy within a budget of `paths` paths (one sample at
+    /// least).
+    pub fn samples_per_launch(self, pixels: u64, remaining: u32, paths: u64) -> u32 {
         match self {
             // One thread per pixel: several samples per launch would only lengthen the warp's
             // longest path, so each launch is one sample, and progress is reported per sample.
             Strategy::NaiveSk => remaining.min(1),
             _ => {
-                let fit = (PATHS_PER_REGENERATION_LAUNCH / pixels.max(1)).max(1);
+                let fit = (paths / pixels.max(1)).max(1);
                 remaining.min(u32::try_from(fit).unwrap_or(u32::MAX))
             }
         }
     }
 
     /// The launches of a render of `spp` samples over `pixels` pixels, as
-    /// `(first_sample, samples)`, in order.
-    pub fn launches(self, pixels: u64, spp: u32) -> impl Iterator<Item = (u32, u32)> {
+    /// `(first_sample, samples)`, in order, each within the path budget `budgets` yields for it.
+    pub fn launches(
+        self,
+        pixels: u64,
+        spp: u32,
+        mut budgets: impl FnMut() -> u64,
+    ) -> impl Iterator<Item = (u32, u32)> {
         let mut first = 0;
         core::iter::from_fn(move || {
-            let samples = self.samples_per_launch(pixels, spp - first);
+            let samples = self.samples_per_launch(pixels, spp - first, budgets());
             (samples > 0).then(|| {
                 let launch = (first, samples);
                 first += samples;

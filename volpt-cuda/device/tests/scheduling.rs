@@ -1,15 +1,19 @@
 //! The scheduling arithmetic every strategy's host loop and kernel share: across a render's launches,
 //! every `(pixel, sample)` is traced exactly once, for odd image sizes and renders of several launches.
 
-use volpt_device::launch::{path_of, pixel_xy, BLOCK_SIZE};
+use volpt_device::launch::{next_launch_paths, path_of, pixel_xy, BLOCK_SIZE, FIRST_LAUNCH_PATHS};
 use volpt_device::Strategy;
 
 /// How often each `(pixel, sample)` of a `pixels` x `spp` render is traced, as the kernels of
-/// `strategy` map their work onto paths.
+/// `strategy` map their work onto paths, with launch budgets that change from launch to launch as
+/// the host's measurements make them.
 fn coverage(strategy: Strategy, pixels: u64, spp: u32) -> Vec<u32> {
     let mut seen = vec![0u32; pixels as usize * spp as usize];
     let mut launches = 0;
-    for (first, samples) in strategy.launches(pixels, spp) {
+    let mut budgets = [1, pixels * 2 + 1, 3, FIRST_LAUNCH_PATHS]
+        .into_iter()
+        .cycle();
+    for (first, samples) in strategy.launches(pixels, spp, || budgets.next().unwrap()) {
         launches += 1;
         match strategy {
             // Thread `i` of the launch renders pixel `i`, all of the launch's samples.
@@ -53,16 +57,41 @@ fn every_path_is_traced_once_across_launches() {
 }
 
 #[test]
-fn regeneration_splits_large_renders_into_several_launches() {
-    let launches: Vec<_> = Strategy::RegenerationSk.launches(160_000, 100).collect();
-    assert_eq!(launches[0], (0, 26));
-    assert_eq!(launches.len(), 4);
-    assert_eq!(launches.last(), Some(&(78, 22)));
+fn regeneration_traces_a_benchmark_in_one_launch_and_later_launches_by_time() {
+    // Every launch pays a tail (its longest path), so 100 spp at 400x400 is one launch.
+    let first = || FIRST_LAUNCH_PATHS;
+    let launches: Vec<_> = Strategy::RegenerationSk
+        .launches(160_000, 100, first)
+        .collect();
+    assert_eq!(launches, [(0, 100)]);
+    // 300 spp: the first launch takes what its budget holds, the rest follows the budgets.
+    let mut budgets = [FIRST_LAUNCH_PATHS, 160_000 * 50].into_iter().cycle();
+    let launches: Vec<_> = Strategy::RegenerationSk
+        .launches(160_000, 300, || budgets.next().unwrap())
+        .collect();
+    assert_eq!(launches, [(0, 104), (104, 50), (154, 104), (258, 42)]);
     // One path per launch at least, even for films larger than a launch's budget.
-    assert_eq!(Strategy::RegenerationSk.samples_per_launch(1 << 30, 100), 1);
-    assert_eq!(Strategy::RegenerationSk.samples_per_launch(1, 7), 7);
-    assert_eq!(Strategy::NaiveSk.launches(5, 3).count(), 3);
-    assert_eq!(Strategy::NaiveSk.launches(5, 0).count(), 0);
+    assert_eq!(
+        Strategy::RegenerationSk.samples_per_launch(1 << 30, 100, 1 << 24),
+        1
+    );
+    assert_eq!(
+        Strategy::RegenerationSk.samples_per_launch(1, 7, 1 << 24),
+        7
+    );
+    assert_eq!(Strategy::NaiveSk.launches(5, 3, first).count(), 3);
+    assert_eq!(Strategy::NaiveSk.launches(5, 0, first).count(), 0);
+}
+
+#[test]
+fn later_launches_aim_at_half_a_second_within_bounds() {
+    // 100 M paths/s: half a second is 50 M paths.
+    assert_eq!(next_launch_paths(100_000_000, 1.0), 50_000_000);
+    // A slow launch (out-of-core grids) still traces 2^20 paths; a fast one at most 2^28.
+    assert_eq!(next_launch_paths(1 << 20, 100.0), 1 << 20);
+    assert_eq!(next_launch_paths(1 << 30, 0.1), 1 << 28);
+    // A launch too short for the clock does not divide by zero.
+    assert_eq!(next_launch_paths(1 << 20, 0.0), 1 << 28);
 }
 
 #[test]
