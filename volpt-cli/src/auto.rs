@@ -55,6 +55,7 @@ impl Choice {
         Some(Schedule {
             strategy,
             max_registers: self.max_registers,
+            refill_at: None,
         })
     }
 
@@ -127,6 +128,7 @@ pub fn calibrate<S: SceneAbi>(
         measurements.push(time(Schedule {
             strategy,
             max_registers: Some(cap),
+            refill_at: None,
         })?);
     }
     let best = fastest(&measurements);
@@ -247,7 +249,8 @@ mod tests {
             c.schedule(),
             Some(Schedule {
                 strategy: Strategy::RegenerationSk,
-                max_registers: Some(96)
+                max_registers: Some(96),
+                refill_at: None,
             })
         );
         let report = c.report();

@@ -75,6 +75,11 @@ pub struct GpuArgs {
     /// per multiprocessor, at the price of spills.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(16..=255))]
     pub max_registers: Option<u32>,
+    /// regeneration-sk: refill a warp's idle lanes with new paths once at least N of them are
+    /// idle (default 8; 1 refills at once, 32 waits for the whole warp): fewer, fuller refills
+    /// against lanes idling in between.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=32))]
+    pub refill_at: Option<u32>,
 }
 
 /// One render: the scene, the integrator's limits and the sampling options.
@@ -118,6 +123,12 @@ impl Backend {
                          none (use --backend cuda, or drop --max-registers)"
                     );
                 }
+                if let Some(n) = gpu.refill_at {
+                    anyhow::bail!(
+                        "--refill-at {n} sets a GPU strategy's refill threshold; the CPU backend \
+                         has no strategies (use --backend cuda, or drop --refill-at)"
+                    );
+                }
                 if let Some(math) = gpu.math {
                     anyhow::bail!(
                         "--math {math} chooses the GPU's kernels; the CPU backend always computes \
@@ -133,6 +144,12 @@ impl Backend {
                     .unwrap_or(StrategyArg::Fixed(Strategy::RegenerationSk))
                 {
                     StrategyArg::Auto => {
+                        if let Some(n) = gpu.refill_at {
+                            anyhow::bail!(
+                                "--refill-at {n} with --strategy auto: name the strategy \
+                                 (--strategy regeneration-sk) to set its refill threshold"
+                            );
+                        }
                         if let Some(n) = gpu.max_registers {
                             anyhow::bail!(
                                 "--max-registers {n} with --strategy auto: auto chooses the \
@@ -141,9 +158,18 @@ impl Backend {
                         }
                         None
                     }
+                    StrategyArg::Fixed(strategy)
+                        if gpu.refill_at.is_some() && strategy != Strategy::RegenerationSk =>
+                    {
+                        anyhow::bail!(
+                            "--refill-at sets regeneration-sk's refill threshold; {strategy} \
+                             schedules paths otherwise (use --strategy regeneration-sk)"
+                        );
+                    }
                     StrategyArg::Fixed(strategy) => Some(Schedule {
                         strategy,
                         max_registers: gpu.max_registers,
+                        refill_at: gpu.refill_at,
                     }),
                 };
                 Ok(Backend::Cuda {

@@ -203,6 +203,13 @@ fn strategy_on_the_cpu_is_a_clear_error() {
 }
 
 #[test]
+fn refill_threshold_on_the_cpu_is_a_clear_error() {
+    let scene = example();
+    let out = volpt(&["render", scene.to_str().unwrap(), "--refill-at", "8"]);
+    assert_clean_error(&out, &["--refill-at 8", "CPU backend has no strategies"]);
+}
+
+#[test]
 fn gpu_math_on_the_cpu_is_a_clear_error() {
     let scene = example();
     let out = volpt(&["render", scene.to_str().unwrap(), "--math", "fast"]);

@@ -17,7 +17,7 @@ pub mod renderer;
 pub mod selftest;
 
 pub use error::CudaError;
-pub use renderer::{CudaRenderer, Schedule};
+pub use renderer::{CudaRenderer, Schedule, DEFAULT_REFILL_AT};
 pub use volpt_device::{Math, Strategy};
 
 /// The kernels' PTX, if `cargo xtask ptx` wrote it before this crate was built.

@@ -31,13 +31,25 @@ pub struct Schedule {
     pub strategy: Strategy,
     /// A cap on the kernel's registers per thread (the JIT's `.maxnreg`), or the compiler's choice.
     pub max_registers: Option<u32>,
+    /// regeneration-sk's refill threshold ([`LaunchParams::refill_at`]), or [`DEFAULT_REFILL_AT`].
+    pub refill_at: Option<u32>,
 }
+
+/// regeneration-sk refills a warp's idle lanes once 8 of them are idle. Measured (H100,
+/// 2026-11-23, `bench/device/refill.sh`, thresholds 1, 4, 8, 16, 24, 32): 8 is the fastest or
+/// within 1% of it on every scene: against refilling at once (1), the index-matched cube 1.17x, the
+/// rough cube 1.40x, cgg-logo 1.24x, smoke and bucky 1.06-1.07x, the thesis's cgg_logo with its
+/// roulette 1.21x. A refill runs the camera ray, the box entry and the RNG's seeding for the lanes
+/// that need them while the others wait; batching eight makes that divergent branch rarer, and
+/// waiting for the whole warp (32, the thesis's warp level) idles lanes for the longest path.
+pub const DEFAULT_REFILL_AT: u32 = 8;
 
 impl From<Strategy> for Schedule {
     fn from(strategy: Strategy) -> Self {
         Self {
             strategy,
             max_registers: None,
+            refill_at: None,
         }
     }
 }
@@ -217,7 +229,7 @@ impl CudaRenderer {
             next_path: next_path.device_ptr(stream).0,
             first_sample: 0,
             samples: 0,
-            padding: 0,
+            refill_at: schedule.refill_at.unwrap_or(DEFAULT_REFILL_AT),
             total_paths: 0,
         };
         let total = pixels * samples.len() as u64;

@@ -49,7 +49,10 @@ pub struct LaunchParams<P> {
     pub first_sample: u32,
     pub samples: u32,
     pub seed: u32,
-    pub padding: u32,
+    /// regeneration-sk refills a warp's idle lanes once at least this many of them are idle (0 and
+    /// 1: at once), or when the whole warp is: fewer refills, each for more lanes at once, at the
+    /// price of lanes idling in between (the host's default: 8).
+    pub refill_at: u32,
     /// `width * height * 3` `f64` sums of the samples' radiance, zeroed before the first launch;
     /// each launch adds its samples.
     pub film: u64,

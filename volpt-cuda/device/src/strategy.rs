@@ -202,7 +202,8 @@ pub unsafe fn block_take_indices(need: bool, next: *mut u64) -> Option<u64> {
 /// levels of regenerationSK).
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Refill {
-    /// Any idle lane refills at once; the warp's idle lanes share one atomic.
+    /// Idle lanes refill once `LaunchParams::refill_at` of them are idle (the host's default: 8),
+    /// or when no lane of the warp is busy; the warp's idle lanes share one atomic.
     Thread,
     /// The warp refills only when all its lanes are idle: one atomic per 32 paths, and a warp's
     /// lanes start (and tend to end) together.
@@ -249,7 +250,12 @@ unsafe fn regeneration<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, refill: Ref
     loop {
         // Refill: the lanes without a path take consecutive indices with one atomic per warp.
         let ready = match refill {
-            Refill::Thread => true,
+            // The threshold is the same for every lane, so every ballot is warp-uniform.
+            Refill::Thread => {
+                lp.refill_at <= 1
+                    || ballot(!active && !exhausted).count_ones() >= lp.refill_at
+                    || ballot(active) == 0
+            }
             Refill::Warp => ballot(active) == 0,
         };
         let need = ready && !active && !exhausted;
