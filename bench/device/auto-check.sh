@@ -28,7 +28,7 @@ bench() { # bench NAME FILE PARAMS SPP LABEL ARGS...: prints "LABEL median_ms"
     shift 5
     # shellcheck disable=SC2086
     if VOLPT_CACHE_DIR=$WORK/cache-$name timeout 90 "$VOLPT" bench "$file" $params --spp "$spp" --backend cuda \
-        --math "$MATH" --trials "$TRIALS" --json "$@" >"$WORK/r.json" 2>"$WORK/$name-$label.log"; then
+        --math "$MATH" --trials "$TRIALS" --json "$@" >"$WORK/r.json" 2>"$WORK/$name-${label//\//-}.log"; then
         python3 -c "import json,sys; r=json.load(open(sys.argv[1])); print(sys.argv[2], r['time_median_s']*1e3)" \
             "$WORK/r.json" "$label"
     else
@@ -51,7 +51,7 @@ bench() { # bench NAME FILE PARAMS SPP LABEL ARGS...: prints "LABEL median_ms"
                 --strategy regeneration-sk --max-registers "$cap" >>"$rows"
         done
         bench "$name" "$file" "$params" "$spp" auto --strategy auto >>"$rows"
-        choice=$(grep -h -m 1 "^auto: " "$WORK/$name-auto.log" | head -c 160)
+        choice=$(grep -h -m 1 "^auto: .* with " "$WORK/$name-auto.log" | head -c 160)
         python3 - "$rows" "$name" "$choice" <<'PY'
 import sys
 rows, name, choice = sys.argv[1], sys.argv[2], sys.argv[3]
