@@ -4,6 +4,10 @@
 //! do not depend on which thread, strategy or backend traces it: every backend traces the same paths.
 //! Each number is SplitMix64's finaliser applied to `key + (i + 1) * golden` (Steele, Lea & Flood 2014,
 //! "Fast splittable pseudorandom number generators"), which passes BigCrush as a counter-based generator.
+//! The stream keeps `key + i * golden` as its state, so each number costs one addition and the
+//! finaliser rather than a 64-bit multiply more (the same numbers; on an H100, 2026-11-23, about
+//! 1-3% faster kernels, compared across two device runs). Taking a 2D sample's two coordinates from one 64-bit number was measured
+//! too and not kept: 3% faster on the cubes and smoke, 5% slower on cgg-logo.
 
 const GOLDEN_GAMMA: u64 = 0x9E37_79B9_7F4A_7C15;
 
@@ -16,7 +20,9 @@ fn mix64(mut z: u64) -> u64 {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Rng {
-    key: u64,
+    /// `key + dimension * golden`: the counter of SplitMix64, whose next number is `mix64` of
+    /// `state + golden`.
+    state: u64,
     dimension: u32,
 }
 
@@ -26,7 +32,10 @@ impl Rng {
     pub fn new(seed: u32, pixel: u32, sample: u32) -> Self {
         let seed_key = mix64((seed as u64).wrapping_add(GOLDEN_GAMMA));
         let key = mix64((((pixel as u64) << 32) | sample as u64) ^ seed_key);
-        Self { key, dimension: 0 }
+        Self {
+            state: key,
+            dimension: 0,
+        }
     }
 
     /// How many numbers this stream has handed out.
@@ -38,10 +47,8 @@ impl Rng {
     #[inline]
     pub fn next_u64(&mut self) -> u64 {
         self.dimension += 1;
-        mix64(
-            self.key
-                .wrapping_add((self.dimension as u64).wrapping_mul(GOLDEN_GAMMA)),
-        )
+        self.state = self.state.wrapping_add(GOLDEN_GAMMA);
+        mix64(self.state)
     }
 
     /// A uniform number in [0, 1): the top 24 bits, so every value is exactly representable.

@@ -79,6 +79,39 @@ fn next_f32_is_uniform_along_a_stream() {
     assert!(chi2.p_value > threshold, "across samples: {chi2:?}");
 }
 
+/// The joint distribution of `next_2d`'s coordinates must be uniform on the unit square (chi-square over 64 x 64 cells), along a stream and across streams.
+#[test]
+fn next_2d_is_uniform_on_the_square() {
+    const N: usize = 2_000_000;
+    const SIDE: usize = 64;
+    let square = |points: &mut dyn Iterator<Item = volpt_core::Vec2>| {
+        let mut observed = vec![0.0; SIDE * SIDE];
+        for v in points {
+            let (i, j) = ((v.x * SIDE as f32) as usize, (v.y * SIDE as f32) as usize);
+            observed[j * SIDE + i] += 1.0;
+        }
+        chi2_test(
+            &observed,
+            &vec![N as f64 / (SIDE * SIDE) as f64; SIDE * SIDE],
+        )
+    };
+    let mut rng = Rng::new(8, 9, 10);
+    let along = square(&mut (0..N).map(|_| rng.next_2d()));
+    assert!(along.p_value > ALPHA / 2.0, "along a stream: {along:?}");
+    let across = square(&mut (0..N as u32).map(|p| Rng::new(8, p, 10).next_2d()));
+    assert!(across.p_value > ALPHA / 2.0, "across pixels: {across:?}");
+    // Power: pairs with a small dependence (y nudged towards x by 2%) fail.
+    let mut rng = Rng::new(8, 9, 11);
+    let biased = square(&mut (0..N).map(|_| {
+        let v = rng.next_2d();
+        volpt_core::Vec2::new(v.x, (0.98 * v.y + 0.02 * v.x).min(0.999_999))
+    }));
+    assert!(
+        biased.p_value < ALPHA,
+        "a dependent pair passed: {biased:?}"
+    );
+}
+
 #[test]
 fn range_and_determinism() {
     let mut a = Rng::new(9, 8, 7);
