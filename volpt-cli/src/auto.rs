@@ -56,6 +56,7 @@ impl Choice {
             strategy,
             max_registers: self.max_registers,
             refill_at: None,
+            tiles: None,
         })
     }
 
@@ -129,6 +130,7 @@ pub fn calibrate<S: SceneAbi>(
             strategy,
             max_registers: Some(cap),
             refill_at: None,
+            tiles: None,
         })?);
     }
     let best = fastest(&measurements);
@@ -251,6 +253,7 @@ mod tests {
                 strategy: Strategy::RegenerationSk,
                 max_registers: Some(96),
                 refill_at: None,
+                tiles: None,
             })
         );
         let report = c.report();

@@ -80,6 +80,32 @@ pub struct GpuArgs {
     /// against lanes idling in between.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=32))]
     pub refill_at: Option<u32>,
+    /// Cut the image into COLUMNS x ROWS tiles, each rendered by its own launches one after the
+    /// other (the thesis's tiling study: smaller launches, more tails; docs/strategies.md).
+    #[arg(long, value_name = "COLUMNS,ROWS")]
+    pub tiles: Option<Tiles>,
+}
+
+/// `--tiles COLUMNS,ROWS`, each from 1 to 4096.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tiles(pub [u32; 2]);
+
+impl std::str::FromStr for Tiles {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        let parse = |v: &str| -> Result<u32, String> {
+            v.trim()
+                .parse::<u32>()
+                .ok()
+                .filter(|n| (1..=4096).contains(n))
+                .ok_or_else(|| format!("expected COLUMNS,ROWS of 1 to 4096 each, found {s:?}"))
+        };
+        match s.split_once(',') {
+            Some((c, r)) => Ok(Tiles([parse(c)?, parse(r)?])),
+            None => Err(format!("expected COLUMNS,ROWS (e.g. 4,4), found {s:?}")),
+        }
+    }
 }
 
 /// One render: the scene, the integrator's limits and the sampling options.
@@ -129,6 +155,12 @@ impl Backend {
                          has no strategies (use --backend cuda, or drop --refill-at)"
                     );
                 }
+                if let Some(Tiles([c, r])) = gpu.tiles {
+                    anyhow::bail!(
+                        "--tiles {c},{r} splits the GPU's launches; the CPU backend has no \
+                         launches (use --backend cuda, or drop --tiles)"
+                    );
+                }
                 if let Some(math) = gpu.math {
                     anyhow::bail!(
                         "--math {math} chooses the GPU's kernels; the CPU backend always computes \
@@ -144,6 +176,12 @@ impl Backend {
                     .unwrap_or(StrategyArg::Fixed(Strategy::RegenerationSk))
                 {
                     StrategyArg::Auto => {
+                        if let Some(Tiles([c, r])) = gpu.tiles {
+                            anyhow::bail!(
+                                "--tiles {c},{r} with --strategy auto: name a strategy to tile \
+                                 its launches"
+                            );
+                        }
                         if let Some(n) = gpu.refill_at {
                             anyhow::bail!(
                                 "--refill-at {n} with --strategy auto: name the strategy \
@@ -170,6 +208,7 @@ impl Backend {
                         strategy,
                         max_registers: gpu.max_registers,
                         refill_at: gpu.refill_at,
+                        tiles: gpu.tiles.map(|t| t.0),
                     }),
                 };
                 Ok(Backend::Cuda {

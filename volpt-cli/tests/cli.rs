@@ -210,6 +210,17 @@ fn refill_threshold_on_the_cpu_is_a_clear_error() {
 }
 
 #[test]
+fn tiles_on_the_cpu_and_malformed_tiles_are_clear_errors() {
+    let scene = example();
+    let out = volpt(&["render", scene.to_str().unwrap(), "--tiles", "4,4"]);
+    assert_clean_error(&out, &["--tiles 4,4", "CPU backend has no launches"]);
+    for bad in ["0,3", "4", "4,x", "5000,1"] {
+        let out = volpt(&["render", scene.to_str().unwrap(), "--tiles", bad]);
+        assert_clean_error(&out, &["--tiles", "COLUMNS,ROWS"]);
+    }
+}
+
+#[test]
 fn gpu_math_on_the_cpu_is_a_clear_error() {
     let scene = example();
     let out = volpt(&["render", scene.to_str().unwrap(), "--math", "fast"]);

@@ -17,7 +17,7 @@ use cudarc::driver::{
 use cudarc::nvrtc::Ptx;
 use volpt_core::abi::SceneAbi;
 use volpt_core::path::PathCounters;
-use volpt_device::launch::{next_launch_paths, BLOCK_SIZE, COUNTERS, FIRST_LAUNCH_PATHS};
+use volpt_device::launch::{next_launch_paths, Tile, BLOCK_SIZE, COUNTERS, FIRST_LAUNCH_PATHS};
 use volpt_device::{LaunchParams, Math, Strategy};
 use volpt_film::{Film, Image, RenderOptions, RenderStats};
 use volpt_zerocopy::{VolumePlacer, VolumePolicy};
@@ -33,6 +33,8 @@ pub struct Schedule {
     pub max_registers: Option<u32>,
     /// regeneration-sk's refill threshold ([`LaunchParams::refill_at`]), or [`DEFAULT_REFILL_AT`].
     pub refill_at: Option<u32>,
+    /// `[columns, rows]`: the film cut into tiles, each rendered by its own launches, or whole.
+    pub tiles: Option<[u32; 2]>,
 }
 
 /// regeneration-sk refills a warp's idle lanes once 8 of them are idle. Measured (H100,
@@ -50,6 +52,7 @@ impl From<Strategy> for Schedule {
             strategy,
             max_registers: None,
             refill_at: None,
+            tiles: None,
         }
     }
 }
@@ -213,13 +216,8 @@ impl CudaRenderer {
         let per_sm = kernel
             .occupancy_max_active_blocks_per_multiprocessor(BLOCK_SIZE, 0, None)
             .doing("querying the kernel's occupancy")?;
-        let blocks = strategy.blocks(pixels, per_sm * self.multiprocessors);
-        let config = LaunchConfig {
-            grid_dim: (blocks, 1, 1),
-            block_dim: (BLOCK_SIZE, 1, 1),
-            shared_mem_bytes: 0,
-        };
-        tracing::info!(kernel = %name, blocks, threads = BLOCK_SIZE, "launching");
+        let [columns, rows] = schedule.tiles.unwrap_or([1, 1]);
+        tracing::info!(kernel = %name, columns, rows, threads = BLOCK_SIZE, "launching");
 
         let mut params = LaunchParams {
             scene: scene_params,
@@ -227,40 +225,56 @@ impl CudaRenderer {
             film: device_film.device_ptr(stream).0,
             counters: counters.device_ptr(stream).0,
             next_path: next_path.device_ptr(stream).0,
-            first_sample: 0,
+            first_sample: samples.start,
             samples: 0,
             refill_at: schedule.refill_at.unwrap_or(DEFAULT_REFILL_AT),
             total_paths: 0,
+            tile: Tile::whole(width, height),
         };
         let total = pixels * samples.len() as u64;
         stream.synchronize().doing("copying the scene")?;
         let start = Instant::now();
         // The first launch's budget, then what the measured rate traces in `LAUNCH_SECONDS`.
         let budget = Cell::new(FIRST_LAUNCH_PATHS);
-        for (first, count) in strategy.launches(pixels, samples.len() as u32, || budget.get()) {
-            let launched = Instant::now();
-            params.first_sample = samples.start + first;
-            params.samples = count;
-            params.total_paths = pixels * count as u64;
-            stream
-                .memset_zeros(&mut next_path)
-                .doing("resetting the path counter")?;
-            // SAFETY: the kernel takes one `LaunchParams` of this scene type by value, whose film,
-            // counters, path counter and grids are the live allocations above, sized for this
-            // launch.
-            unsafe {
+        let mut done = 0;
+        // Tiles one after the other, each with all its samples (the thesis's image tiling).
+        for tile in Tile::grid(width, height, columns, rows) {
+            let tile_pixels = tile.pixels();
+            let blocks = strategy.blocks(tile_pixels, per_sm * self.multiprocessors);
+            let config = LaunchConfig {
+                grid_dim: (blocks, 1, 1),
+                block_dim: (BLOCK_SIZE, 1, 1),
+                shared_mem_bytes: 0,
+            };
+            params.tile = tile;
+            for (_, count) in strategy.launches(tile_pixels, samples.len() as u32, || budget.get())
+            {
+                let launched = Instant::now();
+                params.samples = count;
+                params.total_paths = tile_pixels * count as u64;
                 stream
-                    .launch_builder(&kernel)
-                    .arg(&ByValue(params.checked()))
-                    .launch(config)
+                    .memset_zeros(&mut next_path)
+                    .doing("resetting the path counter")?;
+                // SAFETY: the kernel takes one `LaunchParams` of this scene type by value, whose film,
+                // counters, path counter and grids are the live allocations above, sized for this
+                // launch.
+                unsafe {
+                    stream
+                        .launch_builder(&kernel)
+                        .arg(&ByValue(params.checked()))
+                        .launch(config)
+                }
+                .doing("launching the kernel")?;
+                stream.synchronize().doing("running the kernel")?;
+                budget.set(next_launch_paths(
+                    params.total_paths,
+                    launched.elapsed().as_secs_f64(),
+                ));
+                params.first_sample += count;
+                done += params.total_paths;
+                progress(done, total);
             }
-            .doing("launching the kernel")?;
-            stream.synchronize().doing("running the kernel")?;
-            budget.set(next_launch_paths(
-                params.total_paths,
-                launched.elapsed().as_secs_f64(),
-            ));
-            progress(pixels * (first + count) as u64, total);
+            params.first_sample = samples.start;
         }
         let elapsed = start.elapsed();
 

@@ -61,16 +61,72 @@ pub struct LaunchParams<P> {
     pub counters: u64,
     /// One `u64`, zeroed before the launch: the next path index a persistent thread takes.
     pub next_path: u64,
-    /// Paths to trace in this launch: `width * height * samples`.
+    /// Paths to trace in this launch: `tile.pixels() * samples`.
     pub total_paths: u64,
+    /// The part of the film this launch covers (`--tiles`; the whole film by default).
+    pub tile: Tile,
+}
+
+/// A rectangle of the film: its first column and row, and its size in pixels. A launch traces the
+/// paths of one tile's pixels (the thesis's image tiling: one launch per tile).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct Tile {
+    pub x: u32,
+    pub y: u32,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl Tile {
+    /// The whole `width` x `height` film.
+    pub fn whole(width: u32, height: u32) -> Self {
+        Self {
+            x: 0,
+            y: 0,
+            width,
+            height,
+        }
+    }
+
+    pub fn pixels(&self) -> u64 {
+        self.width as u64 * self.height as u64
+    }
+
+    /// The film position of the tile's pixel `pixel` (row by row within the tile) and its index
+    /// in a film `film_width` pixels wide.
+    #[inline(always)]
+    pub fn film_pixel(&self, pixel: u32, film_width: u32) -> (u32, u32, u32) {
+        let (x, y) = pixel_xy(pixel, self.width);
+        let (x, y) = (self.x + x, self.y + y);
+        (x, y, y * film_width + x)
+    }
+
+    /// A `width` x `height` film cut into `columns` x `rows` tiles, row by row; the tiles' sizes
+    /// differ by one pixel at most, and a film narrower than `columns` has fewer (none empty).
+    pub fn grid(width: u32, height: u32, columns: u32, rows: u32) -> impl Iterator<Item = Tile> {
+        let (columns, rows) = (columns.clamp(1, width.max(1)), rows.clamp(1, height.max(1)));
+        let edge = |i: u32, n: u32, len: u32| (i as u64 * len as u64 / n as u64) as u32;
+        (0..rows).flat_map(move |r| {
+            (0..columns).map(move |c| {
+                let (x, y) = (edge(c, columns, width), edge(r, rows, height));
+                Tile {
+                    x,
+                    y,
+                    width: edge(c + 1, columns, width) - x,
+                    height: edge(r + 1, rows, height) - y,
+                }
+            })
+        })
+    }
 }
 
 impl<P: Pod> LaunchParams<P> {
-    /// The scene parameters are a multiple of 8 bytes (see `volpt_core::abi`), so the 48 bytes that
+    /// The scene parameters are a multiple of 8 bytes (see `volpt_core::abi`), so the 64 bytes that
     /// follow them need no padding.
     pub const LAYOUT: () = assert!(
         core::mem::size_of::<P>().is_multiple_of(8)
-            && core::mem::size_of::<Self>() == core::mem::size_of::<P>() + 48
+            && core::mem::size_of::<Self>() == core::mem::size_of::<P>() + 64
     );
 
     /// The parameters, once `LAYOUT` has been checked: the host ships only values built by this.

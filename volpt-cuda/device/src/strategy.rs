@@ -16,7 +16,7 @@
 use volpt_core::path::{sample_pixel, step, PathCounters, PathState, Truncation};
 use volpt_core::Scene;
 
-use crate::launch::{path_of, pixel_xy, LaunchParams, BLOCK_SIZE};
+use crate::launch::{path_of, LaunchParams, BLOCK_SIZE};
 use crate::nvptx::{
     atomic_add_u64, ballot, block_broadcast_u64, block_exclusive_count, global_thread_index,
     lane_id, lanemask_lt, opaque, red_add_f64, red_add_u64, shared_address, shared_to_generic,
@@ -130,7 +130,7 @@ unsafe fn finish_path(
     }
 }
 
-/// naiveSK: thread `i` renders pixel `i`, adding this launch's samples to its `f64` sum with the
+/// naiveSK: thread `i` renders the tile's pixel `i`, adding this launch's samples to its `f64` sum with the
 /// CPU's own per-pixel loop, so the sums are the CPU's bit for bit.
 ///
 /// # Safety
@@ -138,21 +138,14 @@ unsafe fn finish_path(
 #[inline(always)]
 pub unsafe fn naive_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     let width = scene.camera().width;
-    let pixels = width * scene.camera().height;
     let i = global_thread_index();
     let mut counters = PathCounters::default();
-    if i < pixels {
-        // SAFETY: pixel `i` is inside the film, and no other thread touches it.
-        let sum = unsafe { &mut *(lp.film as *mut [f64; 3]).add(i as usize) };
+    if (i as u64) < lp.tile.pixels() {
+        let (px, py, pixel) = lp.tile.film_pixel(i, width);
+        // SAFETY: `pixel` is inside the film (the tile is), and no other thread touches it.
+        let sum = unsafe { &mut *(lp.film as *mut [f64; 3]).add(pixel as usize) };
         let samples = lp.first_sample..lp.first_sample + lp.samples;
-        sample_pixel(
-            scene,
-            pixel_xy(i, width),
-            samples,
-            lp.seed,
-            sum,
-            &mut counters,
-        );
+        sample_pixel(scene, (px, py), samples, lp.seed, sum, &mut counters);
     }
     // SAFETY: forwarded.
     unsafe { add_counters(&counters, lp) };
@@ -237,7 +230,7 @@ pub unsafe fn regeneration_warp_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>)
 #[inline(always)]
 unsafe fn regeneration<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, refill: Refill) {
     let width = scene.camera().width;
-    let pixels = (width * scene.camera().height) as u64;
+    let pixels = lp.tile.pixels();
     let film = lp.film as *mut f64;
     let next_path = lp.next_path as *mut u64;
     let mut counters = ThreadCounters::default();
@@ -264,8 +257,10 @@ unsafe fn regeneration<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, refill: Ref
             if need {
                 if index < lp.total_paths {
                     let sample;
-                    (pixel, sample) = path_of(index, pixels, lp.first_sample);
-                    let (px, py) = pixel_xy(pixel, width);
+                    let tile_pixel;
+                    (tile_pixel, sample) = path_of(index, pixels, lp.first_sample);
+                    let (px, py);
+                    (px, py, pixel) = lp.tile.film_pixel(tile_pixel, width);
                     path = PathState::from_camera(scene, px, py, sample, lp.seed);
                     active = true;
                 } else {
@@ -297,7 +292,7 @@ unsafe fn regeneration<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, refill: Ref
 #[inline(always)]
 pub unsafe fn regeneration_block_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     let width = scene.camera().width;
-    let pixels = (width * scene.camera().height) as u64;
+    let pixels = lp.tile.pixels();
     let film = lp.film as *mut f64;
     let next_path = lp.next_path as *mut u64;
     let mut counters = ThreadCounters::default();
@@ -313,8 +308,10 @@ pub unsafe fn regeneration_block_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>
             if need {
                 if index < lp.total_paths {
                     let sample;
-                    (pixel, sample) = path_of(index, pixels, lp.first_sample);
-                    let (px, py) = pixel_xy(pixel, width);
+                    let tile_pixel;
+                    (tile_pixel, sample) = path_of(index, pixels, lp.first_sample);
+                    let (px, py);
+                    (px, py, pixel) = lp.tile.film_pixel(tile_pixel, width);
                     path = PathState::from_camera(scene, px, py, sample, lp.seed);
                     active = true;
                 } else {
@@ -363,7 +360,7 @@ core::arch::global_asm!(
 #[inline(always)]
 pub unsafe fn streaming_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     let width = scene.camera().width;
-    let pixels = (width * scene.camera().height) as u64;
+    let pixels = lp.tile.pixels();
     let film = lp.film as *mut f64;
     let next_path = lp.next_path as *mut u64;
     let slots = shared_to_generic(shared_address!("volpt_stream_slots")) as *mut Slot;
@@ -405,8 +402,10 @@ pub unsafe fn streaming_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
             if need {
                 if index < lp.total_paths {
                     let sample;
-                    (slot.pixel, sample) = path_of(index, pixels, lp.first_sample);
-                    let (px, py) = pixel_xy(slot.pixel, width);
+                    let tile_pixel;
+                    (tile_pixel, sample) = path_of(index, pixels, lp.first_sample);
+                    let (px, py);
+                    (px, py, slot.pixel) = lp.tile.film_pixel(tile_pixel, width);
                     slot.path = PathState::from_camera(scene, px, py, sample, lp.seed);
                     active = true;
                 } else {

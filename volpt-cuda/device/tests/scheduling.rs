@@ -1,7 +1,9 @@
 //! The scheduling arithmetic every strategy's host loop and kernel share: across a render's launches,
 //! every `(pixel, sample)` is traced exactly once, for odd image sizes and renders of several launches.
 
-use volpt_device::launch::{next_launch_paths, path_of, pixel_xy, BLOCK_SIZE, FIRST_LAUNCH_PATHS};
+use volpt_device::launch::{
+    next_launch_paths, path_of, pixel_xy, Tile, BLOCK_SIZE, FIRST_LAUNCH_PATHS,
+};
 use volpt_device::Strategy;
 
 /// How often each `(pixel, sample)` of a `pixels` x `spp` render is traced, as the kernels of
@@ -144,4 +146,39 @@ fn path_indices_divide_the_same_above_and_below_two_to_the_32() {
             );
         }
     }
+}
+
+/// `--tiles`: the tiles of a film cover it exactly once, whatever the film's size and the tiles
+/// asked for, and every strategy's launches over the tiles trace every `(pixel, sample)` once.
+#[test]
+fn tiles_cover_the_film_once_and_every_path_is_traced_once() {
+    for (width, height) in [(1, 1), (7, 5), (97, 61), (33, 1), (1, 40)] {
+        for (columns, rows) in [(1, 1), (2, 3), (4, 4), (64, 64), (3, 1)] {
+            let tiles: Vec<Tile> = Tile::grid(width, height, columns, rows).collect();
+            assert!(tiles.iter().all(|t| t.pixels() > 0), "an empty tile");
+            assert!(tiles.len() as u32 <= columns * rows);
+            let spp = 3;
+            for &strategy in Strategy::ALL {
+                let mut seen = vec![0u32; (width * height * spp) as usize];
+                for tile in &tiles {
+                    let pixels = tile.pixels();
+                    for (first, samples) in strategy.launches(pixels, spp, || 2 * pixels + 1) {
+                        for index in 0..pixels * samples as u64 {
+                            let (p, sample) = path_of(index, pixels, first);
+                            let (x, y, film) = tile.film_pixel(p, width);
+                            assert!(x < width && y < height && film == y * width + x);
+                            seen[(sample * width * height + film) as usize] += 1;
+                        }
+                    }
+                }
+                assert!(
+                    seen.iter().all(|&n| n == 1),
+                    "{strategy}: {width}x{height} in {columns}x{rows} tiles"
+                );
+            }
+        }
+    }
+    // The whole film is one tile.
+    let whole: Vec<Tile> = Tile::grid(400, 300, 1, 1).collect();
+    assert_eq!(whole, [Tile::whole(400, 300)]);
 }
