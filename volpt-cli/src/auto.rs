@@ -23,8 +23,11 @@ use volpt_render::{Film, RenderOptions};
 /// Register caps tried on the fastest strategy.
 const CAPS: [u32; 2] = [96, 64];
 
-/// Paths per calibration render: long enough that launch overheads are small against it.
-const CALIBRATION_PATHS: u64 = 1 << 21;
+/// Paths per calibration render: one full first launch (`FIRST_LAUNCH_PATHS`), as a render of the
+/// scene's own size runs. With 2^21 paths (13 spp at 400x400) a launch was mostly its tail (its
+/// longest paths, ~25 ms on cgg-logo on an H100), and auto missed the register cap 64 that made
+/// cgg-logo and the rough cube 5-6% faster (2026-11-23, `bench/device/auto-check.sh`).
+const CALIBRATION_PATHS: u64 = volpt_device::launch::FIRST_LAUNCH_PATHS;
 
 /// Timed renders per candidate; the fastest counts (the first also warms the kernel up).
 const TRIALS: usize = 2;
