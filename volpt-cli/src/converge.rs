@@ -400,6 +400,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         desc.medium.storage = scene_storage;
         backend.place_volumes(&config.sampling.volumes, &mut desc)?;
         desc.medium.lookup = config.lookup.map_or(scene_lookup, Into::into);
+        crate::check_lookup(&desc)?;
         let film = Film::new(w, h).with_accumulation(config.accumulation.into());
         let mut halves = Halves {
             films: [film.clone(), film],
@@ -731,7 +732,7 @@ mod tests {
         );
         assert_eq!(
             parse_setting("lookup=cubic").unwrap_err(),
-            "lookup: expected one of trilinear, nearest, found \"cubic\""
+            "lookup: expected one of trilinear, nearest, texture, texture-f16, found \"cubic\""
         );
 
         let scene = PathSettings::default();

@@ -15,11 +15,12 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use tracing_subscriber::EnvFilter;
+use volpt_core::grid::HALF_MAX;
 use volpt_film::Accumulation;
 use volpt_render::factory::{Effects, Parts};
 use volpt_render::image::preview_path;
 use volpt_render::{path_settings, Image, RenderOptions, RenderStats, Variant};
-use volpt_scene::{Config, GridLookup, SceneAssembler, SceneDescription};
+use volpt_scene::{AlbedoDesc, Config, DensityDesc, GridLookup, SceneAssembler, SceneDescription};
 
 use backend::{Backend, BackendKind, GpuArgs, RenderJob};
 use volpt_core::{Estimator, PathSettings, Roulette};
@@ -175,6 +176,12 @@ enum LookupArg {
     Trilinear,
     /// The nearest sample's value: one read instead of eight.
     Nearest,
+    /// Trilinear filtering by the GPU's texture unit (weights with 8 fractional bits; the CPU
+    /// computes the same filter): one instruction per lookup, an approximation of trilinear.
+    Texture,
+    /// texture, of samples held in half precision (rounded toward zero; at most 65504).
+    #[value(name = "texture-f16")]
+    TextureF16,
 }
 
 impl From<LookupArg> for GridLookup {
@@ -182,8 +189,42 @@ impl From<LookupArg> for GridLookup {
         match lookup {
             LookupArg::Trilinear => GridLookup::Trilinear,
             LookupArg::Nearest => GridLookup::Nearest,
+            LookupArg::Texture => GridLookup::Texture,
+            LookupArg::TextureF16 => GridLookup::TextureHalf,
         }
     }
+}
+
+/// Refuses a lookup the medium's grids cannot take: half-precision texels end at 65504.
+fn check_lookup(desc: &SceneDescription) -> Result<()> {
+    if desc.medium.lookup != GridLookup::TextureHalf {
+        return Ok(());
+    }
+    let largest = [
+        (
+            "density",
+            match &desc.medium.density {
+                DensityDesc::Constant(v) => *v,
+                DensityDesc::Grid(grid) => grid.max_value(),
+            },
+        ),
+        (
+            "albedo",
+            match &desc.medium.albedo {
+                AlbedoDesc::Constant(rgb) => rgb.iter().copied().fold(0.0, f32::max),
+                AlbedoDesc::Grid(grid) => grid.max_value(),
+            },
+        ),
+    ];
+    for (name, largest) in largest {
+        if largest > HALF_MAX {
+            bail!(
+                "--lookup texture-f16: the medium's largest {name} is {largest}, above half \
+                 precision's largest value, {HALF_MAX} (use --lookup texture: f32 texels)"
+            );
+        }
+    }
+    Ok(())
 }
 
 /// The precision a film adds samples in (`volpt converge --setting accumulation=...`).
@@ -424,6 +465,7 @@ fn load(args: &SceneArgs) -> Result<SceneDescription> {
     let mut desc = SceneAssembler::new(args.config()).assemble(builder.as_ref())?;
     if let Some(lookup) = args.lookup {
         desc.medium.lookup = lookup.into();
+        check_lookup(&desc)?;
     }
     Ok(desc)
 }
@@ -642,6 +684,9 @@ fn selftest() -> Result<()> {
     for test in renderer.selftest()? {
         if test.failures.is_empty() {
             println!("PASS {} ({} threads)", test.name, test.threads);
+            if !test.measured.is_empty() {
+                println!("     {}", test.measured);
+            }
         } else {
             failed += 1;
             println!(

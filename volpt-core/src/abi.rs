@@ -18,7 +18,7 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::camera::PerspectiveCamera;
-use crate::grid::{Grid, GridLayout, GridLookup, GridMapping};
+use crate::grid::{Grid, GridLayout, GridLookup, GridMapping, GridPlacement, TexelFormat};
 use crate::path::{Estimator, PathSettings, Roulette};
 use crate::scene::{Scene, VolumeScene};
 use crate::{Aabb, Vec2, Vec3};
@@ -30,21 +30,25 @@ pub trait Uploader {
     /// Places `values`, in their order, and returns their device address.
     fn values(&mut self, values: &[f32]) -> u64;
 
-    /// Places the samples of a dense grid of `res` samples of `channels` channels, in a layout of
-    /// the uploader's choice (by default dense, through [`Uploader::values`]); dense unless
-    /// `any_layout` (the medium's [`crate::GridReads::ANY_LAYOUT`]: its kernels read bricks).
+    /// Places the samples of a dense grid of `res` samples of `channels` channels where
+    /// `placement` (the medium's [`crate::GridReads::PLACEMENT`]) says: in a layout of the
+    /// uploader's choice if any layout, else dense; in a texture of `texel`s if the uploader has
+    /// textures, else (the CPU's uploaders) dense, where the CPU's filter reads them. By default
+    /// dense, through [`Uploader::values`].
     fn grid(
         &mut self,
         values: &[f32],
         res: [u32; 3],
         channels: u32,
-        any_layout: bool,
+        placement: GridPlacement,
+        texel: TexelFormat,
     ) -> PlacedGrid {
-        let _ = (res, channels, any_layout);
+        let _ = (res, channels, placement, texel);
         PlacedGrid {
             address: self.values(values),
             len: values.len() as u64,
             layout: GridLayout::Dense,
+            texture: 0,
         }
     }
 }
@@ -56,12 +60,13 @@ impl<F: FnMut(&[f32]) -> u64> Uploader for F {
 }
 
 /// Where an [`Uploader`] put a grid: `len` `f32` values at device address `address`, ordered as
-/// `layout` says.
+/// `layout` says, and/or texture object `texture` (0: none; `len` 0: only the texture).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PlacedGrid {
     pub address: u64,
     pub len: u64,
     pub layout: GridLayout,
+    pub texture: u64,
 }
 
 /// What the components' `to_params` receive.
@@ -207,6 +212,11 @@ pub struct GridParams {
     pub layout: u32,
     /// [`GridLookup`]: 0 trilinear, 1 nearest.
     pub lookup: u32,
+    /// The texture object of a grid in a texture ([`GridPlacement::Texture`]), else 0.
+    pub texture: u64,
+    /// [`TexelFormat`], as [`TexelFormat::to_u32`] writes it.
+    pub texel: u32,
+    pub padding: u32,
 }
 
 impl GridLookup {
@@ -230,20 +240,22 @@ impl GridLookup {
 }
 
 impl GridParams {
-    /// The parameters of `grid`, whose values `upload` copies to the device.
-    /// `grid` must be dense (the host's grids are; the uploader picks the device's layout, dense
-    /// unless `any_layout` says the kernels read any).
+    /// The parameters of `grid`, whose values `upload` places on the device as `placement` (the
+    /// reading medium's) says. `grid` must be dense (the host's grids are).
     pub fn new<const C: usize>(
         grid: &Grid<'_, C>,
         upload: &mut Upload<'_>,
-        any_layout: bool,
+        placement: GridPlacement,
     ) -> Self {
         debug_assert_eq!(grid.layout, GridLayout::Dense);
-        let placed = upload.grid(grid.data, grid.res, C as u32, any_layout);
-        debug_assert!(any_layout || placed.layout == GridLayout::Dense);
+        let placed = upload.grid(grid.data, grid.res, C as u32, placement, grid.texel);
+        debug_assert!(placement == GridPlacement::AnyLayout || placed.layout == GridLayout::Dense);
         Self {
             data: placed.address,
             len: placed.len,
+            texture: placed.texture,
+            texel: grid.texel.to_u32(),
+            padding: 0,
             layout: placed.layout.to_u32(),
             res: grid.res,
             channels: C as u32,
@@ -259,18 +271,22 @@ impl GridParams {
     ///
     /// # Safety
     /// `data` must point to `len` initialised `f32` values that stay valid and unchanged for `'a`,
-    /// and `len` must equal `GridLayout::values(res, C)` of the layout.
+    /// and `len` must equal `GridLayout::values(res, C)` of the layout, or be 0 for a grid only
+    /// in a texture (which must stay valid for `'a`).
     #[inline]
     pub unsafe fn grid<'a, const C: usize>(&self) -> Grid<'a, C> {
         let bounds = Aabb::new(
             Vec3::from_array(self.bounds_min),
             Vec3::from_array(self.bounds_max),
         );
-        Grid {
+        let data = if self.len == 0 {
+            &[]
+        } else {
             // SAFETY: the caller guarantees the address range.
-            data: unsafe {
-                core::slice::from_raw_parts(self.data as *const f32, self.len as usize)
-            },
+            unsafe { core::slice::from_raw_parts(self.data as *const f32, self.len as usize) }
+        };
+        Grid {
+            data,
             res: self.res,
             mapping: GridMapping::from_parts(
                 bounds,
@@ -279,6 +295,8 @@ impl GridParams {
             ),
             layout: GridLayout::from_u32(self.layout),
             lookup: GridLookup::from_code(self.lookup),
+            texture: self.texture,
+            texel: TexelFormat::from_u32(self.texel),
         }
     }
 }

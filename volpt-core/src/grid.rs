@@ -154,6 +154,11 @@ pub struct Grid<'a, const C: usize> {
     pub mapping: GridMapping,
     pub layout: GridLayout,
     pub lookup: GridLookup,
+    /// A CUDA texture object holding the same samples, read by [`TextureTrilinear`] on a GPU
+    /// (0 elsewhere: the CPU filters `data` as the texture unit would).
+    pub texture: u64,
+    /// What such a texture holds per sample.
+    pub texel: TexelFormat,
 }
 
 impl<'a, const C: usize> Grid<'a, C> {
@@ -185,7 +190,14 @@ impl<'a, const C: usize> Grid<'a, C> {
             mapping,
             layout,
             lookup: GridLookup::Trilinear,
+            texture: 0,
+            texel: TexelFormat::F32,
         }
+    }
+
+    /// The same grid, in a texture of `texel`s when read by [`TextureTrilinear`].
+    pub fn with_texel(self, texel: TexelFormat) -> Self {
+        Self { texel, ..self }
     }
 
     /// The value at `p`, reconstructed as [`Grid::lookup`] says: zero outside the grid's box, and
@@ -252,13 +264,80 @@ impl<'a, const C: usize> Grid<'a, C> {
 /// interpolation at every read (8-9% of the time of cgg-logo and bucky on an H100,
 /// `docs/strategies.md`).
 pub trait GridReads: Copy + Default + core::fmt::Debug {
-    /// Whether grids read this way may be stored bricked or reconstructed by nearest sample; the
-    /// uploader keeps the grids of a medium that cannot read bricks dense.
-    const ANY_LAYOUT: bool;
     /// The kernel-entry name of a grid medium that reads this way, if not its albedo's.
     const MEDIUM_NAME: Option<&'static str>;
 
+    /// Where the uploader must put a grid read this way.
+    const PLACEMENT: GridPlacement;
+
     fn lookup<const C: usize>(grid: &Grid<'_, C>, p: Vec3) -> [f32; C];
+}
+
+/// Where a device keeps a grid, as the kernels that read it need.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GridPlacement {
+    /// Dense samples in memory.
+    Dense,
+    /// Samples in memory in a layout of the uploader's choice (dense or bricked).
+    AnyLayout,
+    /// A 3D texture of the grid's [`Grid::texel`]s, filtered by the texture unit.
+    Texture,
+}
+
+/// What a grid texture holds per sample.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TexelFormat {
+    #[default]
+    F32,
+    /// IEEE half precision, each sample rounded toward zero ([`half_toward_zero`]): half the
+    /// memory and bandwidth of `F32`, and never above the sample, so every majorant of the
+    /// samples bounds the texels too.
+    F16,
+}
+
+impl TexelFormat {
+    /// The format's number in [`crate::abi::GridParams`] (any unknown number reads as `F32`).
+    pub fn to_u32(self) -> u32 {
+        match self {
+            TexelFormat::F32 => 0,
+            TexelFormat::F16 => 1,
+        }
+    }
+
+    pub fn from_u32(n: u32) -> Self {
+        match n {
+            1 => TexelFormat::F16,
+            _ => TexelFormat::F32,
+        }
+    }
+
+    /// A sample as a texel of this format holds it.
+    #[inline]
+    pub fn texel(self, x: f32) -> f32 {
+        match self {
+            TexelFormat::F32 => x,
+            TexelFormat::F16 => half_toward_zero(x),
+        }
+    }
+}
+
+/// The largest finite half-precision value.
+pub const HALF_MAX: f32 = 65504.0;
+
+/// `x` (finite, non-negative) rounded toward zero to a half-precision value, saturating at
+/// [`HALF_MAX`]: the result converts to `f16` exactly. Half has 10 fraction bits to f32's 23 and
+/// subnormals below 2^-14, spaced 2^-24.
+pub fn half_toward_zero(x: f32) -> f32 {
+    const HALF_MIN_NORMAL: f32 = 1.0 / 16384.0;
+    const SUBNORMAL_STEPS: f32 = 16_777_216.0;
+    if x >= HALF_MAX {
+        HALF_MAX
+    } else if x >= HALF_MIN_NORMAL {
+        f32::from_bits(x.to_bits() & !((1 << 13) - 1))
+    } else {
+        // Exact: scaling by a power of two and truncating lose nothing in this range.
+        libm::truncf(x * SUBNORMAL_STEPS) / SUBNORMAL_STEPS
+    }
 }
 
 /// Dense samples, trilinear reconstruction: every scene's grids unless the description asks for
@@ -267,8 +346,8 @@ pub trait GridReads: Copy + Default + core::fmt::Debug {
 pub struct DenseTrilinear;
 
 impl GridReads for DenseTrilinear {
-    const ANY_LAYOUT: bool = false;
     const MEDIUM_NAME: Option<&'static str> = None;
+    const PLACEMENT: GridPlacement = GridPlacement::Dense;
 
     #[inline(always)]
     fn lookup<const C: usize>(grid: &Grid<'_, C>, p: Vec3) -> [f32; C] {
@@ -281,13 +360,120 @@ impl GridReads for DenseTrilinear {
 pub struct AnyLayout;
 
 impl GridReads for AnyLayout {
-    const ANY_LAYOUT: bool = true;
     const MEDIUM_NAME: Option<&'static str> = Some("grid_any_layout");
+    const PLACEMENT: GridPlacement = GridPlacement::AnyLayout;
 
     #[inline(always)]
     fn lookup<const C: usize>(grid: &Grid<'_, C>, p: Vec3) -> [f32; C] {
         grid.lookup(p)
     }
+}
+
+/// Dense samples in a 3D texture, filtered trilinearly by the GPU's texture unit: one `tex`
+/// instruction instead of eight loads and seven interpolations. The unit's weights have 8
+/// fractional bits (CUDA C++ Programming Guide, "Texture Fetching", linear filtering), so a
+/// lookup differs from [`DenseTrilinear`]'s by up to 1/512 of the span of a cell's samples per
+/// axis: an accuracy/time knob (`docs/heterogeneous.md`), never the default. The CPU computes
+/// the same filter from the samples ([`Grid::lookup_texture_filter`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TextureTrilinear;
+
+impl GridReads for TextureTrilinear {
+    const MEDIUM_NAME: Option<&'static str> = Some("grid_texture");
+    const PLACEMENT: GridPlacement = GridPlacement::Texture;
+
+    #[inline(always)]
+    fn lookup<const C: usize>(grid: &Grid<'_, C>, p: Vec3) -> [f32; C] {
+        #[cfg(target_arch = "nvptx64")]
+        {
+            if !grid.mapping.bounds.contains(p) {
+                return [0.0; C];
+            }
+            // Texel `i` covers texture coordinates [i, i + 1): its sample sits at i + 0.5.
+            let t = texture_fetch(grid.texture, grid.mapping.to_index_space(p) + 0.5);
+            let mut v = [0.0; C];
+            v.copy_from_slice(&t[..C]);
+            v
+        }
+        #[cfg(not(target_arch = "nvptx64"))]
+        {
+            grid.lookup_texture_filter(p)
+        }
+    }
+}
+
+/// `tex.3d.v4.f32.f32` of texture object `texture` at unnormalised coordinates `u`.
+#[cfg(target_arch = "nvptx64")]
+#[inline(always)]
+fn texture_fetch(texture: u64, u: Vec3) -> [f32; 4] {
+    let (r, g, b, a): (f32, f32, f32, f32);
+    // SAFETY: reads through a texture object the host created for this grid and keeps alive
+    // for the launch ([`crate::abi::Uploader::grid`]); no memory is written.
+    unsafe {
+        core::arch::asm!(
+            "tex.3d.v4.f32.f32 {{{r}, {g}, {b}, {a}}}, [{t}, {{{x}, {y}, {z}, {z}}}];",
+            r = out(reg32) r, g = out(reg32) g, b = out(reg32) b, a = out(reg32) a,
+            t = in(reg64) texture, x = in(reg32) u.x, y = in(reg32) u.y, z = in(reg32) u.z,
+            options(pure, readonly, nostack)
+        );
+    }
+    [r, g, b, a]
+}
+
+impl<const C: usize> Grid<'_, C> {
+    /// [`TextureTrilinear`]'s lookup as the texture unit computes it, from the dense samples as
+    /// [`Grid::texel`]s: each weight rounded to 8 fractional bits, the edge samples repeated
+    /// beyond the outermost ones (clamp addressing), zero outside the box.
+    pub fn lookup_texture_filter(&self, p: Vec3) -> [f32; C] {
+        debug_assert!(self.layout == GridLayout::Dense);
+        if !self.mapping.bounds.contains(p) {
+            return [0.0; C];
+        }
+        let q = self.mapping.to_index_space(p);
+        let max_index = Vec3::new(
+            (self.res[0] - 1) as f32,
+            (self.res[1] - 1) as f32,
+            (self.res[2] - 1) as f32,
+        );
+        let base = q.floor();
+        let f = ((q - base) * TEXTURE_WEIGHT_STEPS).round() / TEXTURE_WEIGHT_STEPS;
+        let at = |x: f32, y: f32, z: f32| {
+            let clamped = Vec3::new(x, y, z).max(Vec3::ZERO).min(max_index);
+            let i = dense_index(
+                self.res,
+                clamped.x as u32,
+                clamped.y as u32,
+                clamped.z as u32,
+            ) as usize
+                * C;
+            let mut v = [0.0; C];
+            for (v, &sample) in v.iter_mut().zip(&self.data[i..i + C]) {
+                *v = self.texel.texel(sample);
+            }
+            v
+        };
+        let (x0, y0, z0) = (base.x, base.y, base.z);
+        let (x1, y1, z1) = (x0 + 1.0, y0 + 1.0, z0 + 1.0);
+        let c00 = lerp(at(x0, y0, z0), at(x1, y0, z0), f.x);
+        let c10 = lerp(at(x0, y1, z0), at(x1, y1, z0), f.x);
+        let c01 = lerp(at(x0, y0, z1), at(x1, y0, z1), f.x);
+        let c11 = lerp(at(x0, y1, z1), at(x1, y1, z1), f.x);
+        lerp(lerp(c00, c10, f.y), lerp(c01, c11, f.y), f.z)
+    }
+}
+
+/// The texture unit's filter weights are multiples of 1/256.
+const TEXTURE_WEIGHT_STEPS: f32 = 256.0;
+
+/// `a + (b - a) t` per channel, clamped to `max(a, b)` (rounding can carry it one ulp above:
+/// no lookup may exceed the largest sample, which the majorant of delta tracking relies on).
+#[inline(always)]
+fn lerp<const C: usize>(a: [f32; C], b: [f32; C], t: f32) -> [f32; C] {
+    let mut r = [0.0; C];
+    for c in 0..C {
+        r[c] = (a[c] + (b[c] - a[c]) * t).min(a[c].max(b[c]));
+    }
+    r
 }
 
 /// Trilinear interpolation around index-space `q`, which lies in `[0, max_index]`, of the samples
@@ -305,20 +491,11 @@ fn trilinear<const C: usize>(
     let x1 = (x0 + 1).min(res[0] - 1);
     let y1 = (y0 + 1).min(res[1] - 1);
     let z1 = (z0 + 1).min(res[2] - 1);
-    // Rounding can carry `a + (b - a) * t` one ulp above `max(a, b)`; clamped, no lookup ever
-    // exceeds the largest sample, which the majorant of delta tracking relies on.
-    let lerp_c = |a: [f32; C], b: [f32; C], t: f32| {
-        let mut r = [0.0; C];
-        for c in 0..C {
-            r[c] = (a[c] + (b[c] - a[c]) * t).min(a[c].max(b[c]));
-        }
-        r
-    };
-    let c00 = lerp_c(at(x0, y0, z0), at(x1, y0, z0), f.x);
-    let c10 = lerp_c(at(x0, y1, z0), at(x1, y1, z0), f.x);
-    let c01 = lerp_c(at(x0, y0, z1), at(x1, y0, z1), f.x);
-    let c11 = lerp_c(at(x0, y1, z1), at(x1, y1, z1), f.x);
-    lerp_c(lerp_c(c00, c10, f.y), lerp_c(c01, c11, f.y), f.z)
+    let c00 = lerp(at(x0, y0, z0), at(x1, y0, z0), f.x);
+    let c10 = lerp(at(x0, y1, z0), at(x1, y1, z0), f.x);
+    let c01 = lerp(at(x0, y0, z1), at(x1, y0, z1), f.x);
+    let c11 = lerp(at(x0, y1, z1), at(x1, y1, z1), f.x);
+    lerp(lerp(c00, c10, f.y), lerp(c01, c11, f.y), f.z)
 }
 
 #[cfg(test)]

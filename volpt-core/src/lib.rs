@@ -33,7 +33,10 @@ pub use bsdf::{Bsdf, BsdfSample, NullBoundary, RoughDielectric, SmoothDielectric
 pub use camera::PerspectiveCamera;
 pub use environment::{ConstantEnvironment, Environment, LatLongEnvironment, LatLongRows};
 pub use geometry::{Aabb, Ray};
-pub use grid::{AnyLayout, DenseTrilinear, Grid, GridLayout, GridLookup, GridMapping, GridReads};
+pub use grid::{
+    AnyLayout, DenseTrilinear, Grid, GridLayout, GridLookup, GridMapping, GridPlacement, GridReads,
+    TexelFormat, TextureTrilinear,
+};
 pub use majorant::MajorantGrid;
 pub use medium::{AlbedoField, ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium, Medium};
 pub use path::{Estimator, PathCounters, PathSettings, PathState, Roulette};

@@ -178,7 +178,7 @@ impl<R: GridReads> Component for GridAlbedo<'_, R> {
     type Params = GridParams;
 
     fn to_params(&self, upload: &mut Upload<'_>) -> GridParams {
-        GridParams::new(&self.0, upload, R::ANY_LAYOUT)
+        GridParams::new(&self.0, upload, R::PLACEMENT)
     }
     #[inline]
     unsafe fn from_params(p: &GridParams) -> Self {
@@ -226,7 +226,7 @@ impl<A: AlbedoField + Component, R: GridReads> Component for GridMedium<'_, A, R
         #[allow(clippy::let_unit_value)]
         let () = GridMediumParams::<A::Params>::LAYOUT;
         GridMediumParams {
-            density: GridParams::new(&self.density, upload, R::ANY_LAYOUT),
+            density: GridParams::new(&self.density, upload, R::PLACEMENT),
             scale: self.scale,
             majorant: self.majorant,
             majorants: MajorantGridParams::new(self.majorants.as_ref(), upload),

@@ -44,6 +44,8 @@ macro_rules! variants {
                         $crate::GridMedium<$lt, $crate::GridAlbedo<$lt>>)
                     (GridAnyLayout, grid_any_layout, $crate::GridMedium<$lt,
                         $crate::GridAlbedo<$lt, $crate::AnyLayout>, $crate::AnyLayout>)
+                    (GridTexture, grid_texture, $crate::GridMedium<$lt,
+                        $crate::GridAlbedo<$lt, $crate::TextureTrilinear>, $crate::TextureTrilinear>)
                 ]
                 boundary [
                     (IndexMatched, index_matched, $crate::NullBoundary)
@@ -88,7 +90,7 @@ mod tests {
     /// `(registry name, Component::NAME)` of every part of every variant.
     macro_rules! registry_facts {
         (axes $axes:tt variants [$([$(($camel:ident, $snake:ident, $ty:ty))*])*]) => {
-            fn facts() -> [[(&'static str, &'static str); 4]; 48] {
+            fn facts() -> [[(&'static str, &'static str); 4]; 60] {
                 [$([$((stringify!($snake), <$ty as Component>::NAME)),*]),*]
             }
         };

@@ -7,9 +7,9 @@
 use volpt_core::abi::{GridParams, SettingsParams, Uploader};
 use volpt_core::{
     Aabb, Component, ConstantEnvironment, Estimator, Grid, GridAlbedo, GridLayout, GridLookup,
-    GridMapping, GridMedium, HenyeyGreenstein, HomogeneousMedium, Isotropic, LatLongEnvironment,
-    LatLongRows, NullBoundary, PathSettings, PerspectiveCamera, RoughDielectric, Roulette,
-    SceneAbi, Vec2, Vec3, VolumeScene,
+    GridMapping, GridMedium, GridPlacement, HenyeyGreenstein, HomogeneousMedium, Isotropic,
+    LatLongEnvironment, LatLongRows, NullBoundary, PathSettings, PerspectiveCamera,
+    RoughDielectric, Roulette, SceneAbi, Vec2, Vec3, VolumeScene,
 };
 
 /// A closure uploader that hands out made-up device addresses and records what it was given.
@@ -30,7 +30,7 @@ fn a_closure_uploads_a_dense_grid_and_its_address_is_kept() {
     let params = {
         let mut upload = recording(&mut calls);
         assert_eq!(Uploader::values(&mut upload, &[1.0, 2.0]), 0x1008);
-        GridParams::new(&grid, &mut upload, false)
+        GridParams::new(&grid, &mut upload, GridPlacement::Dense)
     };
     assert_eq!(calls, vec![vec![1.0, 2.0], data.clone()]);
     assert_eq!(params.data, 0x2008, "the address the closure returned");
@@ -221,7 +221,7 @@ fn a_grid_survives_the_device_encoding() {
         for lookup in [GridLookup::Trilinear, GridLookup::Nearest] {
             let grid: Grid<'_, 1> = Grid::new(&data, res, mapping).with_lookup(lookup);
             let mut in_place = |values: &[f32]| values.as_ptr() as u64;
-            let params = GridParams::new(&grid, &mut in_place, true);
+            let params = GridParams::new(&grid, &mut in_place, GridPlacement::AnyLayout);
             assert_eq!(params.lookup, lookup.code());
             // SAFETY: `data` outlives `decoded` and holds `params.len` values.
             let decoded: Grid<'_, 1> = unsafe { params.grid() };

@@ -1,10 +1,14 @@
 //! The strategies' collective building blocks on the GPU against plain CPU implementations, on
 //! random inputs with the corner cases (every, no, one and only the last thread of a block
 //! active): the block-wide exclusive count of streaming's compaction and the warp and block index
-//! takers of regeneration (`volpt_device::selftest`).
+//! takers of regeneration (`volpt_device::selftest`); and grid lookups through textures against
+//! the CPU's reproduction of the texture unit's filter.
 
 use cudarc::driver::{CudaSlice, LaunchConfig, PushKernelArg};
+use volpt_core::abi::GridParams;
+use volpt_core::{Aabb, Grid, GridMapping, GridPlacement, TexelFormat, Vec3};
 use volpt_device::launch::BLOCK_SIZE;
+use volpt_zerocopy::{VolumePlacer, VolumePolicy};
 
 use crate::error::{CudaError, Doing};
 use crate::CudaRenderer;
@@ -12,12 +16,14 @@ use crate::CudaRenderer;
 /// Blocks per test launch.
 const BLOCKS: usize = 96;
 
-/// One building block's result: how many inputs, and what differed from the CPU.
+/// One building block's result: how many inputs, what differed from the CPU, and what was
+/// measured on the way (empty if nothing).
 #[derive(Debug)]
 pub struct SelfTest {
     pub name: &'static str,
     pub threads: usize,
     pub failures: Vec<String>,
+    pub measured: String,
 }
 
 /// One flag per thread: block `b` is all set, none, one at random, only the last thread, or random
@@ -135,6 +141,7 @@ impl CudaRenderer {
                 name: "block exclusive count",
                 threads,
                 failures,
+                measured: String::new(),
             });
 
             for (name, entry, group) in [
@@ -172,11 +179,120 @@ impl CudaRenderer {
                     name,
                     threads,
                     failures,
+                    measured: String::new(),
                 });
             }
         }
+        for texel in [TexelFormat::F32, TexelFormat::F16] {
+            results.push(self.texture_lookups::<1>(texel)?);
+            results.push(self.texture_lookups::<3>(texel)?);
+        }
         Ok(results)
     }
+
+    /// Looks up a random `C`-channel grid in a texture of `texel`s at random points (inside the
+    /// box, on its faces and outside) on the GPU and compares with the CPU's filter
+    /// (`Grid::lookup_texture_filter`). A difference of up to one weight step (1/256 of the
+    /// samples' range) is the texture unit's own rounding; a mapping off by half a texel or a
+    /// channel out of place differs by far more. No lookup may exceed the largest texel (the
+    /// majorant of delta tracking relies on it).
+    fn texture_lookups<const C: usize>(&self, texel: TexelFormat) -> Result<SelfTest, CudaError> {
+        const POINTS: usize = 1 << 16;
+        let stream = self.stream();
+        let res = [7, 5, 6];
+        let data: Vec<f32> = (0..res.iter().product::<u32>() * C as u32)
+            .map(|i| 4.0 * unit(u64::from(i) + 1000))
+            .collect();
+        let bounds = Aabb::new(Vec3::new(-1.0, 0.5, 2.0), Vec3::new(3.0, 1.5, 2.5));
+        let grid: Grid<'_, C> =
+            Grid::new(&data, res, GridMapping::cell_centred(bounds, res)).with_texel(texel);
+        let points: Vec<f32> = (0..3 * POINTS as u64)
+            .map(|i| {
+                let axis = (i % 3) as usize;
+                let u = 1.2 * unit(i) - 0.1;
+                bounds.min[axis] + u * (bounds.max[axis] - bounds.min[axis])
+            })
+            .collect();
+        // SAFETY: `data` outlives the placer, which is dropped at the end of this function.
+        let mut placer = unsafe { VolumePlacer::new(stream.clone(), VolumePolicy::default()) }?;
+        let params = GridParams::new(&grid, &mut placer, GridPlacement::Texture);
+        placer.check()?;
+        let params = stream
+            .clone_htod(bytemuck::bytes_of(&params))
+            .doing("copying test input")?;
+        let points_device = stream.clone_htod(&points).doing("copying test input")?;
+        let mut out: CudaSlice<f32> = stream
+            .alloc_zeros(C * POINTS)
+            .doing("allocating test output")?;
+        let entry = if C == 1 {
+            "selftest__texture_lookups_1"
+        } else {
+            "selftest__texture_lookups_3"
+        };
+        let kernel = self.kernel(entry, None)?;
+        let config = LaunchConfig {
+            grid_dim: ((POINTS as u32).div_ceil(BLOCK_SIZE), 1, 1),
+            block_dim: (BLOCK_SIZE, 1, 1),
+            shared_mem_bytes: 0,
+        };
+        // SAFETY: one grid's parameters, 3 coordinates and C outputs per point, for the launch.
+        unsafe {
+            stream
+                .launch_builder(&kernel)
+                .arg(&params)
+                .arg(&points_device)
+                .arg(&mut out)
+                .arg(&(POINTS as u32))
+                .launch(config)
+        }
+        .doing("launching a selftest")?;
+        let got = stream.clone_dtoh(&out).doing("reading test output")?;
+        let texels: Vec<f32> = data.iter().map(|&v| texel.texel(v)).collect();
+        let largest = texels.iter().copied().fold(0.0, f32::max);
+        let smallest = texels.iter().copied().fold(f32::INFINITY, f32::min);
+        let step = (largest - smallest) / 256.0;
+        let (mut failures, mut worst, mut identical) = (Vec::new(), 0.0f32, 0);
+        for (i, got) in got.chunks(C).enumerate() {
+            let p = Vec3::new(points[3 * i], points[3 * i + 1], points[3 * i + 2]);
+            let expected = grid.lookup_texture_filter(p);
+            for c in 0..C {
+                let error = (got[c] - expected[c]).abs();
+                worst = worst.max(error);
+                identical += usize::from(got[c].to_bits() == expected[c].to_bits());
+                if error > step || got[c] > largest {
+                    failures.push(format!(
+                        "{p:?} channel {c}: {}, the CPU's filter {}",
+                        got[c], expected[c]
+                    ));
+                }
+            }
+        }
+        Ok(SelfTest {
+            name: match (texel, C) {
+                (TexelFormat::F32, 1) => "texture lookup (f32, 1 channel)",
+                (TexelFormat::F32, _) => "texture lookup (f32, 3 channels)",
+                (TexelFormat::F16, 1) => "texture lookup (f16, 1 channel)",
+                (TexelFormat::F16, _) => "texture lookup (f16, 3 channels)",
+            },
+            threads: POINTS,
+            failures,
+            measured: format!(
+                "largest difference from the CPU's filter {:.3e} ({:.4} of a weight step), \
+                 {:.1}% bit-identical",
+                worst,
+                worst / step,
+                100.0 * identical as f64 / (C * POINTS) as f64
+            ),
+        })
+    }
+}
+
+/// A uniform number in [0, 1) from a counter (SplitMix64's finaliser).
+fn unit(i: u64) -> f32 {
+    let mut z = i.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
 }
 
 #[cfg(test)]

@@ -20,7 +20,10 @@
 use std::fmt;
 
 use volpt_core::abi::SceneAbi;
-use volpt_core::grid::{AnyLayout, DenseTrilinear, Grid, GridLookup, GridMapping, GridReads};
+use volpt_core::grid::{
+    AnyLayout, DenseTrilinear, Grid, GridLookup, GridMapping, GridReads, TexelFormat,
+    TextureTrilinear,
+};
 use volpt_core::majorant::{build_majorants, MajorantGrid};
 use volpt_core::math::tan;
 use volpt_core::microfacet::Ggx;
@@ -317,6 +320,7 @@ impl Derived {
             MediumPart::GridDensity(m) => Some((m.density, m.scale)),
             MediumPart::GridDensityAlbedo(m) => Some((m.density, m.scale)),
             MediumPart::GridAnyLayout(m) => Some((m.density, m.scale)),
+            MediumPart::GridTexture(m) => Some((m.density, m.scale)),
         };
         let majorants = density
             .filter(|_| settings.majorant_resolution > 1)
@@ -366,6 +370,7 @@ impl<'a> Parts<'a> {
             MediumPart::GridDensity(m) => m.majorants = grid,
             MediumPart::GridDensityAlbedo(m) => m.majorants = grid,
             MediumPart::GridAnyLayout(m) => m.majorants = grid,
+            MediumPart::GridTexture(m) => m.majorants = grid,
         }
         if let EnvironmentPart::LatLong(map) = &mut self.environment {
             map.distribution = &derived.distribution;
@@ -409,6 +414,11 @@ fn medium<'a>(desc: &'a SceneDescription, fired: &mut dyn FnMut(Simplification))
         AlbedoDesc::Constant(rgb) => Albedo::Constant(rgb),
     };
     let any_layout = any_layout(medium);
+    let texture = texel(medium.lookup).is_some();
+    let albedo_grid = |albedo: Albedo<'a>| match albedo {
+        Albedo::Grid(albedo) => grid::<3>(albedo, medium.lookup),
+        Albedo::Constant(rgb) => one_voxel(desc, rgb),
+    };
     match (density, albedo) {
         (Density::Constant(density), Albedo::Constant(albedo)) => {
             MediumPart::Homogeneous(HomogeneousMedium {
@@ -416,13 +426,18 @@ fn medium<'a>(desc: &'a SceneDescription, fired: &mut dyn FnMut(Simplification))
                 albedo: Spectrum::new(albedo[0], albedo[1], albedo[2]),
             })
         }
-        (density, albedo) if any_layout => {
-            let albedo = match albedo {
-                Albedo::Grid(albedo) => grid::<3>(albedo, medium.lookup),
-                Albedo::Constant(rgb) => one_voxel(desc, rgb),
-            };
-            MediumPart::GridAnyLayout(grid_medium(desc, density, GridAlbedo(albedo, AnyLayout)))
-        }
+        // A constant albedo becomes a one-voxel texture: the kernels read it only at real
+        // collisions, a few per path.
+        (density, albedo) if texture => MediumPart::GridTexture(grid_medium(
+            desc,
+            density,
+            GridAlbedo(albedo_grid(albedo), TextureTrilinear),
+        )),
+        (density, albedo) if any_layout => MediumPart::GridAnyLayout(grid_medium(
+            desc,
+            density,
+            GridAlbedo(albedo_grid(albedo), AnyLayout),
+        )),
         (Density::Grid(density), Albedo::Constant(albedo)) => MediumPart::GridDensity(GridMedium {
             density: grid::<1>(density, medium.lookup),
             scale: medium.scale,
@@ -443,7 +458,17 @@ fn medium<'a>(desc: &'a SceneDescription, fired: &mut dyn FnMut(Simplification))
 /// or bricked storage on a GPU. Every other grid is read dense and trilinear, with only that code
 /// in the kernel.
 fn any_layout(medium: &MediumDesc) -> bool {
-    medium.lookup != GridLookupDesc::Trilinear || medium.storage != GridStorage::Dense
+    medium.lookup == GridLookupDesc::Nearest || medium.storage != GridStorage::Dense
+}
+
+/// What a texture holds per sample, if the lookup reads grids through textures
+/// ([`TextureTrilinear`]).
+fn texel(lookup: GridLookupDesc) -> Option<TexelFormat> {
+    match lookup {
+        GridLookupDesc::Texture => Some(TexelFormat::F32),
+        GridLookupDesc::TextureHalf => Some(TexelFormat::F16),
+        GridLookupDesc::Trilinear | GridLookupDesc::Nearest => None,
+    }
 }
 
 /// The medium as grids of density and albedo, whatever the description holds: constants become
@@ -458,7 +483,13 @@ fn general_medium(desc: &SceneDescription) -> MediumPart<'_> {
         AlbedoDesc::Grid(albedo) => grid::<3>(albedo, medium.lookup),
         AlbedoDesc::Constant(_) => one_voxel_albedo(desc),
     };
-    if any_layout(medium) {
+    if texel(medium.lookup).is_some() {
+        MediumPart::GridTexture(grid_medium(
+            desc,
+            density,
+            GridAlbedo(albedo, TextureTrilinear),
+        ))
+    } else if any_layout(medium) {
         MediumPart::GridAnyLayout(grid_medium(desc, density, GridAlbedo(albedo, AnyLayout)))
     } else {
         MediumPart::GridDensityAlbedo(grid_medium(
@@ -518,6 +549,7 @@ fn one_voxel<'a, const C: usize>(desc: &SceneDescription, value: &'a [f32]) -> G
         [1, 1, 1],
         GridMapping::cell_centred(bounds, [1, 1, 1]),
     )
+    .with_texel(texel(desc.medium.lookup).unwrap_or_default())
 }
 
 fn boundary(desc: &SceneDescription, fired: &mut dyn FnMut(Simplification)) -> BoundaryPart {
@@ -594,11 +626,13 @@ fn grid<const C: usize>(g: &GridDesc, lookup: GridLookupDesc) -> Grid<'_, C> {
         GridConvention::Vertex => GridMapping::vertex_centred(bounds, g.resolution),
         GridConvention::Cell => GridMapping::cell_centred(bounds, g.resolution),
     };
-    let lookup = match lookup {
-        GridLookupDesc::Trilinear => GridLookup::Trilinear,
-        GridLookupDesc::Nearest => GridLookup::Nearest,
-    };
-    Grid::new(&g.data, g.resolution, mapping).with_lookup(lookup)
+    let grid =
+        Grid::new(&g.data, g.resolution, mapping).with_texel(texel(lookup).unwrap_or_default());
+    if lookup == GridLookupDesc::Nearest {
+        grid.with_lookup(GridLookup::Nearest)
+    } else {
+        grid
+    }
 }
 
 /// Mitsuba's perspective camera: the field of view spans `fov_axis`, the other axis follows from the

@@ -124,6 +124,11 @@ pub enum GridLookup {
     Trilinear,
     /// The value of the nearest sample.
     Nearest,
+    /// Trilinear filtering by a GPU's texture unit, whose weights have 8 fractional bits (the CPU
+    /// computes the same filter): an approximation of `Trilinear`, one instruction per lookup.
+    Texture,
+    /// `Texture` of samples held in half precision (rounded toward zero; at most 65504).
+    TextureHalf,
 }
 
 #[derive(Clone, Debug, PartialEq)]

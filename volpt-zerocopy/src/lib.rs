@@ -19,8 +19,10 @@ pub mod layout;
 pub mod memory;
 pub mod placer;
 pub mod policy;
+pub mod texture;
 
 pub use error::ZeroCopyError;
 pub use memory::{HostRegistration, ManagedBuffer, PinnedBuffer};
 pub use placer::{Placed, VolumePlacer};
 pub use policy::{Placement, VolumeMemory, VolumePolicy};
+pub use texture::GridTexture;

@@ -7,12 +7,13 @@ use std::sync::Arc;
 use cudarc::driver::{CudaContext, CudaStream, DevicePtr, DriverError};
 use rayon::prelude::*;
 use volpt_core::abi::{PlacedGrid, Uploader};
-use volpt_core::GridLayout;
+use volpt_core::{GridLayout, GridPlacement, TexelFormat};
 
 use crate::error::ZeroCopyError;
 use crate::layout::{brick_into, bricked, values_in};
 use crate::memory::{HostRegistration, ManagedBuffer, PinnedBuffer};
 use crate::policy::{decide, human_bytes, Placement, VolumeMemory, VolumePolicy};
+use crate::texture::{texture_bytes, GridTexture};
 
 /// Memory a render's scene is read from, kept only to be freed when the render ends.
 type Held = Box<dyn Send>;
@@ -35,6 +36,8 @@ pub enum PlacedIn {
     Managed {
         device_bytes: u64,
     },
+    /// A 3D array read through a texture object, of texels of this format.
+    Texture(TexelFormat),
 }
 
 impl fmt::Display for Placed {
@@ -43,6 +46,17 @@ impl fmt::Display for Placed {
             GridLayout::Dense => "dense",
             GridLayout::Bricked => "bricked",
         };
+        if let PlacedIn::Texture(texel) = self.memory {
+            let texel = match texel {
+                TexelFormat::F32 => "f32",
+                TexelFormat::F16 => "f16",
+            };
+            return write!(
+                f,
+                "{} grid in a texture of {texel} texels",
+                human_bytes(self.bytes)
+            );
+        }
         write!(f, "{} {layout} grid in ", human_bytes(self.bytes))?;
         match self.memory {
             PlacedIn::Device => write!(f, "device memory"),
@@ -53,6 +67,7 @@ impl fmt::Display for Placed {
                 "managed memory, {} of it prefetched to the device",
                 human_bytes(device_bytes)
             ),
+            PlacedIn::Texture(_) => unreachable!("written above"),
         }
     }
 }
@@ -191,6 +206,44 @@ impl VolumePlacer {
             address,
             len: len as u64,
             layout,
+            texture: 0,
+        })
+    }
+
+    /// A texture of the grid: always in device memory (a texture cannot read the host's).
+    fn texture(
+        &mut self,
+        values: &[f32],
+        res: [u32; 3],
+        channels: u32,
+        texel: TexelFormat,
+    ) -> Result<PlacedGrid, ZeroCopyError> {
+        let bytes = texture_bytes(res, channels, texel);
+        if let Placement::OverBudget { left, budget } =
+            decide(&self.policy, bytes, self.used, self.free_device)
+        {
+            return Err(ZeroCopyError::OverBudget {
+                bytes,
+                left,
+                budget,
+            });
+        }
+        let texture = GridTexture::new(&self.ctx, values, res, channels, texel)?;
+        self.used += bytes;
+        let address = texture.object();
+        self.held.push(Box::new(texture));
+        let placed = Placed {
+            bytes,
+            layout: GridLayout::Dense,
+            memory: PlacedIn::Texture(texel),
+        };
+        tracing::info!("volume: {placed}");
+        self.placed.push(placed);
+        Ok(PlacedGrid {
+            address: 0,
+            len: 0,
+            layout: GridLayout::Dense,
+            texture: address,
         })
     }
 
@@ -305,17 +358,24 @@ impl Uploader for VolumePlacer {
         values: &[f32],
         res: [u32; 3],
         channels: u32,
-        any_layout: bool,
+        placement: GridPlacement,
+        texel: TexelFormat,
     ) -> PlacedGrid {
         let failed = PlacedGrid {
             address: 0,
             len: 0,
             layout: GridLayout::Dense,
+            texture: 0,
         };
         if self.error.is_some() {
             return failed;
         }
-        match self.place(values, res, channels, any_layout) {
+        let placed = match placement {
+            GridPlacement::Texture => self.texture(values, res, channels, texel),
+            GridPlacement::AnyLayout => self.place(values, res, channels, true),
+            GridPlacement::Dense => self.place(values, res, channels, false),
+        };
+        match placed {
             Ok(placed) => placed,
             Err(e) => {
                 self.error = Some(e);

@@ -1,14 +1,17 @@
 //! Kernels that test the strategies' collective building blocks against plain CPU code
 //! (`volpt selftest --backend cuda`, `volpt_cuda::selftest`): the block-wide exclusive count of
-//! streaming's compaction, and the warp and block index takers of regeneration. Each thread reads
-//! its input, runs the building block, and writes what it got.
+//! streaming's compaction, the warp and block index takers of regeneration, and grid lookups
+//! through textures (against the CPU's filter). Each thread reads its input, runs the building
+//! block, and writes what it got.
 
 /// The selftest kernels' entry points, as [`export_selftests!`](crate::export_selftests) exports
 /// them.
-pub const ENTRIES: [&str; 3] = [
+pub const ENTRIES: [&str; 5] = [
     "selftest__block_exclusive_count",
     "selftest__warp_take_indices",
     "selftest__block_take_indices",
+    "selftest__texture_lookups_1",
+    "selftest__texture_lookups_3",
 ];
 
 /// Exports the selftest kernels (the workspace's kernels crate invokes it once).
@@ -47,6 +50,30 @@ macro_rules! export_selftests {
             ) {
                 // SAFETY: forwarded.
                 unsafe { $crate::selftest::take_indices(needs, next, out, true) }
+            }
+            /// # Safety
+            /// As [`volpt_device::selftest::texture_lookups`].
+            #[export_name = "selftest__texture_lookups_1"]
+            pub unsafe extern "ptx-kernel" fn texture_lookups_1(
+                grid: *const volpt_core::abi::GridParams,
+                points: *const f32,
+                out: *mut f32,
+                n: u32,
+            ) {
+                // SAFETY: forwarded.
+                unsafe { $crate::selftest::texture_lookups::<1>(grid, points, out, n) }
+            }
+            /// # Safety
+            /// As [`volpt_device::selftest::texture_lookups`].
+            #[export_name = "selftest__texture_lookups_3"]
+            pub unsafe extern "ptx-kernel" fn texture_lookups_3(
+                grid: *const volpt_core::abi::GridParams,
+                points: *const f32,
+                out: *mut f32,
+                n: u32,
+            ) {
+                // SAFETY: forwarded.
+                unsafe { $crate::selftest::texture_lookups::<3>(grid, points, out, n) }
             }
         };
     };
@@ -100,4 +127,42 @@ pub unsafe fn take_indices(needs: *const u32, next: *mut u64, out: *mut u64, blo
     };
     // SAFETY: the caller's contract.
     unsafe { *out.add(i) = index };
+}
+
+/// Thread `i < n` looks up the `C`-channel grid `grid` (in a texture) at point `i` (`points[3i..]`)
+/// with [`volpt_core::TextureTrilinear`] and writes the `C` values to `out[C i..]`.
+///
+/// # Safety
+/// `grid` must hold the parameters of a grid in a texture that lives for the launch, `points`
+/// `3 n` values and `out` `C n`.
+#[cfg(target_arch = "nvptx64")]
+#[inline(always)]
+pub unsafe fn texture_lookups<const C: usize>(
+    grid: *const volpt_core::abi::GridParams,
+    points: *const f32,
+    out: *mut f32,
+    n: u32,
+) {
+    use volpt_core::{GridReads, TextureTrilinear, Vec3};
+
+    use crate::nvptx::global_thread_index;
+    let i = global_thread_index() as usize;
+    if i >= n as usize {
+        return;
+    }
+    // SAFETY: the caller's contract.
+    let (grid, p) = unsafe {
+        let grid = (*grid).grid::<C>();
+        let p = Vec3::new(
+            *points.add(3 * i),
+            *points.add(3 * i + 1),
+            *points.add(3 * i + 2),
+        );
+        (grid, p)
+    };
+    let v = TextureTrilinear::lookup(&grid, p);
+    for (c, v) in v.into_iter().enumerate() {
+        // SAFETY: the caller's contract.
+        unsafe { *out.add(C * i + c) = v };
+    }
 }
