@@ -114,23 +114,41 @@ impl GridTexture {
             object: 0,
         };
         let row_bytes = res[0] as usize * (host.len() / texels);
-        // SAFETY: zeroed is a valid bit pattern for this plain C struct.
-        let mut copy: sys::CUDA_MEMCPY3D = unsafe { std::mem::zeroed() };
-        copy.srcMemoryType = sys::CUmemorytype::CU_MEMORYTYPE_HOST;
-        copy.srcHost = host.as_ptr().cast();
-        copy.srcPitch = row_bytes;
-        copy.srcHeight = res[1] as usize;
-        copy.dstMemoryType = sys::CUmemorytype::CU_MEMORYTYPE_ARRAY;
-        copy.dstArray = array;
-        copy.WidthInBytes = row_bytes;
-        copy.Height = res[1] as usize;
-        copy.Depth = res[2] as usize;
+        // Every field written: `mem::zeroed` is invalid here (the memory types have no 0).
+        let copy = sys::CUDA_MEMCPY3D {
+            srcXInBytes: 0,
+            srcY: 0,
+            srcZ: 0,
+            srcLOD: 0,
+            srcMemoryType: sys::CUmemorytype::CU_MEMORYTYPE_HOST,
+            srcHost: host.as_ptr().cast(),
+            srcDevice: 0,
+            srcArray: ptr::null_mut(),
+            reserved0: ptr::null_mut(),
+            srcPitch: row_bytes,
+            srcHeight: res[1] as usize,
+            dstXInBytes: 0,
+            dstY: 0,
+            dstZ: 0,
+            dstLOD: 0,
+            dstMemoryType: sys::CUmemorytype::CU_MEMORYTYPE_ARRAY,
+            dstHost: ptr::null_mut(),
+            dstDevice: 0,
+            dstArray: array,
+            reserved1: ptr::null_mut(),
+            dstPitch: 0,
+            dstHeight: 0,
+            WidthInBytes: row_bytes,
+            Height: res[1] as usize,
+            Depth: res[2] as usize,
+        };
         // SAFETY: the source holds `Depth` planes of `Height` rows of `WidthInBytes` bytes, the
         // array's extent; the copy is synchronous.
         unsafe { sys::cuMemcpy3D_v2(&copy) }
             .result()
             .map_err(driver("copying a grid into its texture"))?;
-        // SAFETY: zeroed is a valid bit pattern for these plain C structs.
+        // SAFETY: zeroed is valid for these C structs (their enums' first values are 0): the
+        // resource is an array (0), unused fields zero.
         let mut resource: sys::CUDA_RESOURCE_DESC = unsafe { std::mem::zeroed() };
         resource.resType = sys::CUresourcetype::CU_RESOURCE_TYPE_ARRAY;
         resource.res.array.hArray = array;
