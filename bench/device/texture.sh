@@ -1,16 +1,18 @@
 #!/usr/bin/env bash
 # Grids read through 3D textures (`--lookup texture|texture-f16`, issue 10; docs/heterogeneous.md)
 # against dense f32 grids with software trilinear lookups (`--lookup trilinear`, the default):
-# 1. `volpt selftest --backend cuda`: the GPU's texture lookups against the CPU's filter;
-# 2. the same estimate: GPU texture renders against CPU texture renders (other seeds) and against
-#    GPU trilinear renders, `volpt compare --independent` (a significant mean difference fails);
+# 1. `volpt selftest`: the GPU's texture lookups against the CPU's filter;
+# 2. the same estimate: GPU texture renders against CPU texture renders and against GPU trilinear
+#    renders, each of its own seed, `volpt compare --independent` (a significant mean difference
+#    fails);
 # 3. time: `volpt bench`, regeneration-sk, SPP (bucky 3x), TRIALS after a warm-up, MATH;
 # 4. accuracy against time: `volpt converge --setting lookup=trilinear,texture,texture-f16`, TIME
 #    seconds per setting against a REFSPP reference (which uses the scene's trilinear lookups);
 # 5. registers: `ptxas -v` of the regeneration-sk kernels of the texture and dense media, if the
 #    bundle has the PTX.
 #   bash bundle/texture.sh   -> $OUT/texture.txt, $OUT/converge-*.md
-# Knobs: SPP (100), TRIALS (5), MATH (fast), TIME (1.0), REFSPP (2048), ONLY (a scene regex).
+# Knobs: SPP (100), TRIALS (5), MATH (fast), TIME (1.0), REFSPP (2048), ONLY (a scene regex),
+# PARTS (the parts to run, default "1 2 3 4 5").
 set -uo pipefail
 cd "$(dirname "$0")"
 OUT=${OUT:-$PWD/out}
@@ -22,6 +24,8 @@ MATH=${MATH:-fast}
 TIME=${TIME:-1.0}
 REFSPP=${REFSPP:-2048}
 ONLY=${ONLY:-.}
+PARTS=${PARTS:-1 2 3 4 5}
+part() { [[ " $PARTS " == *" $1 "* ]]; }
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/texture.XXXXXX")
 export RUST_BACKTRACE=0 RUST_LIB_BACKTRACE=0
 # The first error line of a log, on one line.
@@ -43,18 +47,23 @@ done
 LOOKUPS="trilinear texture texture-f16"
 {
     echo "# $(date -u +%Y-%m-%dT%H:%MZ) $(nvidia-smi --query-gpu=name,driver_version,clocks.max.sm --format=csv,noheader)"
+    part 1 && {
     echo "## 1. selftest"
-    "$VOLPT" selftest --backend cuda >"$WORK/selftest.txt" 2>&1 || echo "FAIL selftest: $(first_error "$WORK/selftest.txt")"
+    "$VOLPT" selftest >"$WORK/selftest.txt" 2>&1 || echo "FAIL selftest: $(first_error "$WORK/selftest.txt")"
     grep -iE "texture|difference|passed|FAIL" "$WORK/selftest.txt"
+    }
+    part 2 && {
     echo "## 2. the same estimate (64x64, 256 spp, exact math, naive-sk on the GPU)"
     for entry in "${selected[@]}"; do
         IFS=: read -r name file params <<<"$entry"
         common=(--resolution 64x64 --spp 256)
         # shellcheck disable=SC2086
         "$VOLPT" render "$file" $params "${common[@]}" --lookup texture --seed 1 -o "$WORK/$name-cpu.exr" >/dev/null 2>&1
+        seed=1
         for lookup in texture texture-f16 trilinear; do
+            seed=$((seed + 1))
             # shellcheck disable=SC2086
-            timeout 120 "$VOLPT" render "$file" $params "${common[@]}" --lookup "$lookup" --seed 2 \
+            timeout 120 "$VOLPT" render "$file" $params "${common[@]}" --lookup "$lookup" --seed "$seed" \
                 --backend cuda --strategy naive-sk --math exact -o "$WORK/$name-$lookup.exr" >/dev/null 2>"$WORK/r.log" \
                 || { echo "FAIL $name $lookup: $(first_error "$WORK/r.log")"; continue; }
         done
@@ -67,6 +76,8 @@ LOOKUPS="trilinear texture texture-f16"
             fi
         done
     done
+    }
+    part 3 && {
     echo "## 3. time (regeneration-sk, $SPP spp (bucky 3x), $TRIALS trials, math $MATH; medians)"
     for entry in "${selected[@]}"; do
         IFS=: read -r name file params <<<"$entry"
@@ -81,8 +92,10 @@ LOOKUPS="trilinear texture texture-f16"
                 "$WORK/b.json" "$name" "$lookup"
         done
     done
+    }
 } 2>&1 | tee "$OUT/texture.txt"
 {
+    part 4 && {
     echo "## 4. accuracy against time (converge, $TIME s per setting, reference $REFSPP spp)"
     for entry in "${selected[@]}"; do
         IFS=: read -r name file params <<<"$entry"
@@ -98,6 +111,8 @@ LOOKUPS="trilinear texture texture-f16"
             echo "FAIL converge $name: $(first_error "$WORK/conv.log")"
         fi
     done
+    }
+    part 5 && {
     echo "## 5. registers (ptxas -v, sm_90)"
     ptx=volpt_kernels_fast.ptx
     [ "$MATH" = exact ] && ptx=volpt_kernels.ptx
@@ -110,4 +125,5 @@ LOOKUPS="trilinear texture texture-f16"
     else
         echo "(no $ptx in the bundle)"
     fi
+    }
 } 2>&1 | tee -a "$OUT/texture.txt"

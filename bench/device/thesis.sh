@@ -24,8 +24,12 @@
 # wall-clock means of the timed trials (the thesis: host clock around render(); volpt: `volpt bench`).
 # Image means (thesis: its .hdr, RGBE decoded at the bin centres; volpt: bench's image_mean) show
 # that both render the same scene.
+# volpt reads its grids as each of LOOKUPS says (default "trilinear texture": software trilinear
+# lookups of f32 grids, and the texture unit's filter, as the thesis reads its grids); a lookup
+# other than trilinear is named in the strategy column (regeneration-sk/texture).
 # Knobs: TRIALS (5), T (seconds per command, 60), DEADLINE (seconds after which runs are skipped,
-# 210), BACKEND (cuda; cpu tests the volpt side without a GPU), RES (400), SPP (100), SCENES.
+# 210), BACKEND (cuda; cpu tests the volpt side without a GPU), RES (400), SPP (100), SCENES,
+# LOOKUPS.
 set -uo pipefail
 cd "$(dirname "$0")"
 OUT=${OUT:-$PWD/out}
@@ -39,6 +43,7 @@ BACKEND=${BACKEND:-cuda}
 RES=${RES:-400}
 SPP=${SPP:-100}
 SCENES=${SCENES:-cgg_logo ad}
+LOOKUPS=${LOOKUPS:-trilinear texture}
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/thesis.XXXXXX")
 RESULTS=$OUT/thesis-runs.tsv
 LOGS=$WORK/logs
@@ -137,15 +142,18 @@ PY
     fi
 }
 
-run_volpt() { # run_volpt SCENE ESTIMATOR STRATEGY MATH VOLPT-ARGS...
-    local scene=$1 est=$2 strategy=$3 math=$4 tmo name gpu=()
+run_volpt() { # run_volpt SCENE ESTIMATOR STRATEGY MATH VOLPT-ARGS..., grids read as $LOOKUP says
+    local scene=$1 est=$2 strategy=$3 math=$4 tmo name label gpu=()
     shift 4
-    name=volpt-$scene-$est-$strategy-$math
+    label=$strategy
+    [ "${LOOKUP:-trilinear}" = trilinear ] || label=$strategy/$LOOKUP
+    name=volpt-$scene-$est-${label//\//-}-$math
     tmo=$(limit) || { log "SKIP $name (deadline)"; return; }
     [ "$BACKEND" = cuda ] && gpu=(--strategy "$strategy" --math "$math")
     if timeout "$tmo" "$VOLPT" bench "$WORK/scenes/$scene/volpath_bsdf.xml" --backend "$BACKEND" "${gpu[@]}" "$@" \
-        --resolution "${RES}x$RES" --spp "$SPP" --trials "$TRIALS" --json >"$LOGS/$name.json" 2>"$LOGS/$name.err" \
-        && python3 - "$LOGS/$name.json" "$scene" "$est" "$strategy" "$math" >>"$RESULTS" <<'PY'
+        --lookup "${LOOKUP:-trilinear}" --resolution "${RES}x$RES" --spp "$SPP" --trials "$TRIALS" --json \
+        >"$LOGS/$name.json" 2>"$LOGS/$name.err" \
+        && python3 - "$LOGS/$name.json" "$scene" "$est" "$label" "$math" >>"$RESULTS" <<'PY'
 import json, sys
 path, scene, est, strategy, math = sys.argv[1:]
 r = json.load(open(path))
@@ -165,11 +173,13 @@ thesis_runs() { # thesis_runs STRATEGY KERNEL ROULETTE-BINARY NO-ROULETTE-BINARY
         run_thesis "$scene" thesis-roulette "$1" "$3" "$2"
     done
 }
-volpt_runs() { # volpt_runs STRATEGY, for every scene and math
+volpt_runs() { # volpt_runs STRATEGY, for every scene, math and lookup
     for scene in $SCENES; do
-        for math in exact fast; do
-            run_volpt "$scene" no-roulette "$1" "$math" --rr-depth -1
-            run_volpt "$scene" thesis-roulette "$1" "$math" --roulette throughput --rr-depth 0
+        for LOOKUP in $LOOKUPS; do
+            for math in exact fast; do
+                run_volpt "$scene" no-roulette "$1" "$math" --rr-depth -1
+                run_volpt "$scene" thesis-roulette "$1" "$math" --roulette throughput --rr-depth 0
+            done
         done
     done
 }
@@ -180,6 +190,7 @@ thesis_runs regenerationSK-block regenerationSK block_stats norr_block_stats
 volpt_runs regeneration-block-sk
 thesis_runs streamingSK-compaction streamingSK compact_stats norr_compact_stats
 volpt_runs streaming-sk
+LOOKUP=trilinear
 for scene in $SCENES; do
     run_thesis "$scene" thesis-roulette regenerationSK-warp warp_stats regenerationSK
     run_volpt "$scene" mitsuba-roulette-5 regeneration-sk exact --roulette mitsuba --rr-depth 5

@@ -684,9 +684,6 @@ fn selftest() -> Result<()> {
     for test in renderer.selftest()? {
         if test.failures.is_empty() {
             println!("PASS {} ({} threads)", test.name, test.threads);
-            if !test.measured.is_empty() {
-                println!("     {}", test.measured);
-            }
         } else {
             failed += 1;
             println!(
@@ -695,6 +692,9 @@ fn selftest() -> Result<()> {
                 test.failures.len(),
                 &test.failures[..test.failures.len().min(5)]
             );
+        }
+        if !test.measured.is_empty() {
+            println!("     {}", test.measured);
         }
     }
     if failed > 0 {

@@ -374,7 +374,8 @@ impl GridReads for AnyLayout {
 /// fractional bits (CUDA C++ Programming Guide, "Texture Fetching", linear filtering), so a
 /// lookup differs from [`DenseTrilinear`]'s by up to 1/512 of the span of a cell's samples per
 /// axis: an accuracy/time knob (`docs/heterogeneous.md`), never the default. The CPU computes
-/// the same filter from the samples ([`Grid::lookup_texture_filter`]).
+/// the documented filter from the samples ([`Grid::lookup_texture_filter`]); the GPU's differs
+/// from it by about a weight step at most (not bit for bit), measured by `volpt selftest`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct TextureTrilinear;
 
@@ -429,14 +430,27 @@ impl<const C: usize> Grid<'_, C> {
         if !self.mapping.bounds.contains(p) {
             return [0.0; C];
         }
-        let q = self.mapping.to_index_space(p);
+        // The coordinate the kernel hands the texture unit; the unit takes the half texel off
+        // again in its own fixed point (f64 holds the difference exactly). The unit's weights
+        // are not all rounded as here: `volpt selftest` measures how far its lookups are from
+        // this filter (docs/heterogeneous.md).
+        let u = self.mapping.to_index_space(p) + 0.5;
         let max_index = Vec3::new(
             (self.res[0] - 1) as f32,
             (self.res[1] - 1) as f32,
             (self.res[2] - 1) as f32,
         );
-        let base = q.floor();
-        let f = ((q - base) * TEXTURE_WEIGHT_STEPS).round() / TEXTURE_WEIGHT_STEPS;
+        let split = |u: f32| {
+            let x = f64::from(u) - 0.5;
+            let base = libm::floor(x);
+            let steps = f64::from(TEXTURE_WEIGHT_STEPS);
+            (
+                base as f32,
+                (libm::round((x - base) * steps) / steps) as f32,
+            )
+        };
+        let ((bx, fx), (by, fy), (bz, fz)) = (split(u.x), split(u.y), split(u.z));
+        let (base, f) = (Vec3::new(bx, by, bz), Vec3::new(fx, fy, fz));
         let at = |x: f32, y: f32, z: f32| {
             let clamped = Vec3::new(x, y, z).max(Vec3::ZERO).min(max_index);
             let i = dense_index(
