@@ -90,7 +90,7 @@ run_thesis() { # run_thesis SCENE ESTIMATOR STRATEGY BINARY KERNEL
         -r "$RES" "$RES" -i "$SPP" --trials $((TRIALS + 1)) -o "$WORK/img/$name" >"$LOGS/$name.log" 2>&1 \
         && python3 - "$LOGS/$name.log" "$WORK/img/$name.hdr" "$scene" "$est" "$strategy" >>"$RESULTS" <<'PY'
 import re, sys
-import numpy as np
+from rgbe import read_rgbe
 log, hdr, scene, est, strategy = sys.argv[1:]
 text = open(log, errors="replace").read()
 # "[spike] wall mean time 0.1220 sec, paths per sec 1.3e7, mean rays 9.6e8, Mrays per sec (wall) 7900.1"
@@ -99,39 +99,6 @@ m = re.search(r"\[spike\] wall mean time ([\d.]+) sec, paths per sec ([\d.]+), m
 if m is None:
     sys.exit(f"{log}: no '[spike] wall mean time ... Mrays per sec (wall)' line")
 t, paths_s, rays, mrays_s = (float(g) for g in m.groups())
-
-def read_rgbe(path):
-    """Radiance .hdr, flat or new-style run-length scanlines (what stb_image_write writes)."""
-    data = open(path, "rb").read()
-    start = data.index(b"\n\n") + 2
-    nl = data.index(b"\n", start)
-    dims = data[start:nl].split()
-    if len(dims) != 4 or dims[0] != b"-Y" or dims[2] != b"+X":
-        sys.exit(f"{path}: resolution line {data[start:nl]!r}, expected '-Y H +X W'")
-    h, w = int(dims[1]), int(dims[3])
-    buf, pos = np.frombuffer(data, np.uint8), nl + 1
-    rgbe = np.empty((h, w, 4), np.uint8)
-    for y in range(h):
-        if 8 <= w < 32768 and buf[pos] == 2 and buf[pos + 1] == 2 and not buf[pos + 2] & 0x80:
-            pos += 4
-            for c in range(4):
-                x = 0
-                while x < w:
-                    n = int(buf[pos])
-                    if n > 128:
-                        rgbe[y, x:x + n - 128, c] = buf[pos + 1]
-                        x, pos = x + n - 128, pos + 2
-                    else:
-                        rgbe[y, x:x + n, c] = buf[pos + 1:pos + 1 + n]
-                        x, pos = x + n, pos + 1 + n
-        else:
-            rgbe[y] = buf[pos:pos + 4 * w].reshape(w, 4)
-            pos += 4 * w
-    # stb_image_write truncates the mantissa: decoding at the bin centre (+0.5) removes the
-    # ~0.5% downward bias that stb_image's own decoder keeps.
-    e = rgbe[..., 3].astype(np.int32)
-    scale = np.where(e > 0, np.ldexp(1.0, e - 136), 0.0)
-    return (rgbe[..., :3] + 0.5) * scale[..., None]
 
 mean = read_rgbe(hdr).reshape(-1, 3).mean(0)
 print("\t".join([scene, "thesis", est, strategy, "-", f"{t:.6g}", f"{mrays_s * 1e6:.6g}", f"{paths_s:.6g}",

@@ -132,7 +132,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     let mut identical = 0usize;
     let mut max_abs = 0.0f64;
     let mut max_rel = 0.0f64;
-    let (mut sum_a, mut sum_b) = (0.0f64, 0.0f64);
+    let (mut sum_a, mut sum_b, mut sum_squared) = (0.0f64, 0.0f64, 0.0f64);
     for (pa, pb) in a.pixels.iter().zip(&b.pixels) {
         if pa.map(f32::to_bits) == pb.map(f32::to_bits) {
             identical += 1;
@@ -142,6 +142,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
             sum_a += x;
             sum_b += y;
             let diff = (x - y).abs();
+            sum_squared += diff * diff;
             max_abs = max_abs.max(diff);
             max_rel = max_rel.max(diff / x.abs().max(y.abs()).max(1e-3));
         }
@@ -149,10 +150,11 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     let n = a.pixels.len();
     println!(
         "{n} pixels: {identical} bit-identical ({:.4}%), max |a-b| {max_abs:.3e}, \
-         max relative {max_rel:.3e}, mean a {:.6}, mean b {:.6}",
+         max relative {max_rel:.3e}, mean a {:.6}, mean b {:.6}, mse {:.6e}",
         100.0 * identical as f64 / n as f64,
         sum_a / (3 * n) as f64,
         sum_b / (3 * n) as f64,
+        sum_squared / (3 * n) as f64,
     );
     if args.identical && identical != n {
         bail!("{} pixels differ", n - identical);
