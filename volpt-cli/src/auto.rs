@@ -32,6 +32,27 @@ const CALIBRATION_PATHS: u64 = volpt_device::launch::FIRST_LAUNCH_PATHS;
 /// Timed renders per candidate; the fastest counts (the first also warms the kernel up).
 const TRIALS: usize = 2;
 
+/// The strategy of a render without `--strategy` that is too short to repay a calibration: the
+/// best fixed choice on most scenes (docs/strategies.md).
+pub const DEFAULT: Strategy = Strategy::RegenerationSk;
+
+/// Candidates a calibration times: every strategy but naive-sk, then two register caps.
+const CANDIDATES: u64 = Strategy::ALL.len() as u64 - 1 + CAPS.len() as u64;
+
+/// The most a calibration has saved against [`DEFAULT`] (auto-check.sh on an H100, 2026-11-23:
+/// up to 16% with a register cap, on bucky), as a fraction of the render's time.
+const LARGEST_SAVING: f64 = 0.16;
+
+/// Whether a render of `paths` paths is long enough to repay a calibration: the calibration
+/// renders `TRIALS` x `CALIBRATION_PATHS` per candidate, a render saves at most
+/// [`LARGEST_SAVING`] of its own time. So a render without `--strategy` calibrates from about 75
+/// calibration renders' worth of paths on (1.26e9 paths: 400x400 at 7900 spp), and below that
+/// uses [`DEFAULT`] unless a choice is cached.
+pub fn repays_calibration(paths: u64) -> bool {
+    let calibration = (TRIALS as u64 * CANDIDATES * CALIBRATION_PATHS) as f64;
+    paths as f64 * LARGEST_SAVING >= calibration
+}
+
 /// One candidate's calibration time.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Measurement {
@@ -245,6 +266,15 @@ mod tests {
                 },
             ],
         }
+    }
+
+    #[test]
+    fn only_long_renders_repay_a_calibration() {
+        // 400x400 at 100 spp: a calibration of 12 renders of 2^24 paths would cost 10x the render.
+        assert!(!repays_calibration(400 * 400 * 100));
+        assert!(!repays_calibration(400 * 400 * 7000));
+        assert!(repays_calibration(400 * 400 * 8000));
+        assert!(repays_calibration(1920 * 1080 * 1024));
     }
 
     #[test]

@@ -63,8 +63,9 @@ impl std::fmt::Display for StrategyArg {
 /// The flags that only the GPU backend takes: how it schedules and computes.
 #[derive(Clone, Copy, Debug, Default, clap::Args)]
 pub struct GpuArgs {
-    /// GPU scheduling strategy (default: regeneration-sk); `auto` picks the fastest for the scene
-    /// by a short calibration, cached per scene and GPU.
+    /// GPU scheduling strategy; `auto` picks the fastest for the scene by calibration renders,
+    /// cached per scene and GPU (default: auto's cached choice, a calibration for a render long
+    /// enough to repay it, else regeneration-sk).
     #[arg(long, value_enum)]
     pub strategy: Option<StrategyArg>,
     /// GPU arithmetic: `exact` is bit-identical to the CPU (default), `fast` uses the GPU's
@@ -127,6 +128,8 @@ pub enum Backend {
         renderer: CudaRenderer,
         /// A fixed schedule, or `None` for `auto`.
         schedule: Option<Schedule>,
+        /// `auto` by default (no `--strategy`): calibrates only a render that repays it.
+        implicit_auto: bool,
         math: Math,
         auto: AutoCache,
     },
@@ -171,10 +174,16 @@ impl Backend {
             }
             BackendKind::Cuda => {
                 let math = gpu.math.unwrap_or_default();
-                let schedule = match gpu
-                    .strategy
-                    .unwrap_or(StrategyArg::Fixed(Strategy::RegenerationSk))
-                {
+                // A flag that sets one strategy's knob names that strategy's default.
+                let knobs =
+                    gpu.tiles.is_some() || gpu.refill_at.is_some() || gpu.max_registers.is_some();
+                let implicit_auto = gpu.strategy.is_none() && !knobs;
+                let default = if knobs {
+                    StrategyArg::Fixed(Strategy::RegenerationSk)
+                } else {
+                    StrategyArg::Auto
+                };
+                let schedule = match gpu.strategy.unwrap_or(default) {
                     StrategyArg::Auto => {
                         if let Some(Tiles([c, r])) = gpu.tiles {
                             anyhow::bail!(
@@ -214,6 +223,7 @@ impl Backend {
                 Ok(Backend::Cuda {
                     renderer: CudaRenderer::new(0, math)?,
                     schedule,
+                    implicit_auto,
                     math,
                     auto: AutoCache::open(),
                 })
@@ -330,12 +340,21 @@ impl SceneVisitor for Render<'_> {
             Backend::Cuda {
                 renderer,
                 schedule,
+                implicit_auto,
                 auto,
                 ..
             } => {
+                let paths = render_paths(scene, &samples);
                 let schedule = match schedule {
                     Some(schedule) => *schedule,
-                    None => auto_schedule(renderer, auto, &self.auto_key, scene, options)?,
+                    None => auto_schedule(
+                        renderer,
+                        auto,
+                        &self.auto_key,
+                        scene,
+                        options,
+                        *implicit_auto && !auto::repays_calibration(paths),
+                    )?,
                 };
                 renderer.render_samples(scene, schedule, film, samples, options, &report)?
             }
@@ -345,17 +364,33 @@ impl SceneVisitor for Render<'_> {
     }
 }
 
-/// The cached `auto` choice for `key`, or a new calibration (printed and cached).
+/// Paths a render of `samples` of `scene`'s film traces.
+fn render_paths<S: RenderScene>(scene: &S, samples: &Range<u32>) -> u64 {
+    let camera = scene.camera();
+    u64::from(camera.width) * u64::from(camera.height) * u64::from(samples.len() as u32)
+}
+
+/// The cached `auto` choice for `key`, or a new calibration (printed and cached); without a
+/// cached choice and with `skip_calibration`, regeneration-sk (`auto::DEFAULT`).
 fn auto_schedule<S: RenderScene>(
     renderer: &CudaRenderer,
     cache: &AutoCache,
     key: &str,
     scene: &S,
     options: &RenderOptions,
+    skip_calibration: bool,
 ) -> Result<Schedule> {
     if let Some((choice, schedule)) = cache.get(key).and_then(|c| c.schedule().map(|s| (c, s))) {
         eprint!("(cached) {}", choice.report());
         return Ok(schedule);
+    }
+    if skip_calibration {
+        tracing::debug!(
+            "strategy {}: this render is too short to repay auto's calibration (--strategy auto \
+             calibrates anyway)",
+            auto::DEFAULT.name()
+        );
+        return Ok(auto::DEFAULT.into());
     }
     eprintln!("auto: calibrating the GPU strategies on this scene (cached afterwards)");
     let choice = auto::calibrate(renderer, scene, options)?;
