@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 mod common;
-use common::{assert_clean_error, example, stderr, volpt};
+use common::{assert_clean_error, assert_success, example, stderr, volpt};
 
 use volpt_scene::vol::{write_vol, VolGrid};
 use volpt_scene::Bounds;
@@ -129,6 +129,24 @@ fn nan_and_negative_densities_are_clear_errors() {
         let out = volpt(&["info", scene.to_str().unwrap()]);
         assert_clean_error(&out, &[name.as_str()]);
     }
+}
+
+/// Half-precision texels end at 65504: `--lookup texture-f16` refuses a grid beyond that, naming
+/// the largest value and the alternative; `--lookup texture` (f32 texels) takes it.
+#[test]
+fn half_texels_refuse_a_grid_beyond_their_range() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut values = vec![1.0; 8];
+    values[3] = 1e5;
+    write_vol(&dir.path().join("big.vol"), &grid(values)).unwrap();
+    let scene = grid_scene(dir.path(), "big.vol");
+    let scene = scene.to_str().unwrap();
+    let out = volpt(&["info", scene, "--lookup", "texture-f16"]);
+    assert_clean_error(&out, &["texture-f16", "100000", "65504", "--lookup texture"]);
+    let out = volpt(&["info", scene, "--lookup", "texture"]);
+    assert_success(&out);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("grid_texture/"), "{stdout}");
 }
 
 #[test]

@@ -50,6 +50,32 @@ pub enum ZeroCopyError {
         crate::policy::human_bytes(*.bytes)
     )]
     OutOfHostMemory { bytes: u64 },
+    #[error(
+        "a grid texture of {} does not fit in device memory ({} left of a budget of {}): \
+         textures cannot be read from host memory; use --lookup trilinear (with --volume-memory \
+         auto, zerocopy or managed for volumes larger than the GPU) or a larger \
+         --device-memory-budget",
+        crate::policy::human_bytes(*.bytes),
+        crate::policy::human_bytes(*.left),
+        crate::policy::human_bytes(*.budget)
+    )]
+    TextureOverBudget { bytes: u64, left: u64, budget: u64 },
+    #[error(
+        "the GPU has no room for a grid texture of {}: textures cannot be read from host memory; \
+         use --lookup trilinear (with --volume-memory auto, zerocopy or managed for volumes \
+         larger than the GPU)",
+        crate::policy::human_bytes(*.bytes)
+    )]
+    TextureOutOfMemory {
+        bytes: u64,
+        #[source]
+        source: DriverError,
+    },
+    #[error(
+        "--lookup texture keeps grids in device memory, but --volume-memory {memory} asks for host \
+         memory: drop one of them"
+    )]
+    TextureInHostMemory { memory: crate::policy::VolumeMemory },
     #[error(transparent)]
     Load(#[from] volpt_scene::SceneError),
     #[error("CUDA driver call failed while {doing} ({} volume): {source}", crate::policy::human_bytes(*.bytes))]

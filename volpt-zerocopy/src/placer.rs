@@ -219,10 +219,17 @@ impl VolumePlacer {
         texel: TexelFormat,
     ) -> Result<PlacedGrid, ZeroCopyError> {
         let bytes = texture_bytes(res, channels, texel);
+        if let memory @ (VolumeMemory::ZeroCopy | VolumeMemory::Managed) = self.policy.memory {
+            return Err(ZeroCopyError::TextureInHostMemory { memory });
+        }
+        let device = VolumePolicy {
+            memory: VolumeMemory::Device,
+            ..self.policy
+        };
         if let Placement::OverBudget { left, budget } =
-            decide(&self.policy, bytes, self.used, self.free_device)
+            decide(&device, bytes, self.used, self.free_device)
         {
-            return Err(ZeroCopyError::OverBudget {
+            return Err(ZeroCopyError::TextureOverBudget {
                 bytes,
                 left,
                 budget,

@@ -59,7 +59,7 @@ impl GridTexture {
         let driver = |doing: &'static str| {
             move |source: DriverError| {
                 if ZeroCopyError::is_out_of_memory(&source) {
-                    ZeroCopyError::OutOfDeviceMemory { bytes, source }
+                    ZeroCopyError::TextureOutOfMemory { bytes, source }
                 } else {
                     ZeroCopyError::Driver {
                         doing,
