@@ -142,7 +142,10 @@ fn half_texels_refuse_a_grid_beyond_their_range() {
     let scene = grid_scene(dir.path(), "big.vol");
     let scene = scene.to_str().unwrap();
     let out = volpt(&["info", scene, "--lookup", "texture-f16"]);
-    assert_clean_error(&out, &["texture-f16", "100000", "65504", "--lookup texture"]);
+    assert_clean_error(
+        &out,
+        &["texture-f16", "100000", "65504", "--lookup texture"],
+    );
     let out = volpt(&["info", scene, "--lookup", "texture"]);
     assert_success(&out);
     let stdout = String::from_utf8_lossy(&out.stdout);
