@@ -20,8 +20,8 @@ const LIGHT: f32 = 2.0;
 /// A white furnace (albedo 1, optical depth 3 across the box) behind a rough dielectric, seen by a
 /// camera whose film the box fills but for its corners; roulette off, so that every path's
 /// throughput on escape is exactly the product of the boundary's weights.
-fn rough_furnace() -> VolumeScene<HomogeneousMedium, RoughDielectric, HenyeyGreenstein, ConstantEnvironment>
-{
+fn rough_furnace(
+) -> VolumeScene<HomogeneousMedium, RoughDielectric, HenyeyGreenstein, ConstantEnvironment> {
     VolumeScene {
         camera: PerspectiveCamera {
             origin: Vec3::new(0.0, 0.0, -4.0),
