@@ -225,6 +225,16 @@ impl<'a, const C: usize> Grid<'a, C> {
         self.interpolate(p, dense_index, GridLookup::Trilinear)
     }
 
+    /// The index-space coordinates of the last sample along each axis.
+    #[inline(always)]
+    fn max_index(&self) -> Vec3 {
+        Vec3::new(
+            (self.res[0] - 1) as f32,
+            (self.res[1] - 1) as f32,
+            (self.res[2] - 1) as f32,
+        )
+    }
+
     #[inline(always)]
     fn interpolate<I>(&self, p: Vec3, index: I, lookup: GridLookup) -> [f32; C]
     where
@@ -239,11 +249,7 @@ impl<'a, const C: usize> Grid<'a, C> {
             v.copy_from_slice(&self.data[i..i + C]);
             v
         };
-        let max_index = Vec3::new(
-            (self.res[0] - 1) as f32,
-            (self.res[1] - 1) as f32,
-            (self.res[2] - 1) as f32,
-        );
+        let max_index = self.max_index();
         let q = self
             .mapping
             .to_index_space(p)
@@ -435,11 +441,7 @@ impl<const C: usize> Grid<'_, C> {
         // are not all rounded as here: `volpt selftest` measures how far its lookups are from
         // this filter (docs/heterogeneous.md).
         let u = self.mapping.to_index_space(p) + 0.5;
-        let max_index = Vec3::new(
-            (self.res[0] - 1) as f32,
-            (self.res[1] - 1) as f32,
-            (self.res[2] - 1) as f32,
-        );
+        let max_index = self.max_index();
         let split = |u: f32| {
             let x = f64::from(u) - 0.5;
             let base = libm::floor(x);
@@ -466,13 +468,7 @@ impl<const C: usize> Grid<'_, C> {
             }
             v
         };
-        let (x0, y0, z0) = (base.x, base.y, base.z);
-        let (x1, y1, z1) = (x0 + 1.0, y0 + 1.0, z0 + 1.0);
-        let c00 = lerp(at(x0, y0, z0), at(x1, y0, z0), f.x);
-        let c10 = lerp(at(x0, y1, z0), at(x1, y1, z0), f.x);
-        let c01 = lerp(at(x0, y0, z1), at(x1, y0, z1), f.x);
-        let c11 = lerp(at(x0, y1, z1), at(x1, y1, z1), f.x);
-        lerp(lerp(c00, c10, f.y), lerp(c01, c11, f.y), f.z)
+        blend_corners(base.to_array(), (base + Vec3::ONE).to_array(), f, at)
     }
 }
 
@@ -505,6 +501,18 @@ fn trilinear<const C: usize>(
     let x1 = (x0 + 1).min(res[0] - 1);
     let y1 = (y0 + 1).min(res[1] - 1);
     let z1 = (z0 + 1).min(res[2] - 1);
+    blend_corners([x0, y0, z0], [x1, y1, z1], f, at)
+}
+
+/// The samples `at` the eight corners `lo`/`hi` of a cell, blended with weights `f` per axis:
+/// along x, then y, then z (the one order every backend and both filters use).
+#[inline(always)]
+fn blend_corners<T: Copy, const C: usize>(
+    [x0, y0, z0]: [T; 3],
+    [x1, y1, z1]: [T; 3],
+    f: Vec3,
+    at: impl Fn(T, T, T) -> [f32; C],
+) -> [f32; C] {
     let c00 = lerp(at(x0, y0, z0), at(x1, y0, z0), f.x);
     let c10 = lerp(at(x0, y1, z0), at(x1, y1, z0), f.x);
     let c01 = lerp(at(x0, y0, z1), at(x1, y0, z1), f.x);
