@@ -413,12 +413,7 @@ fn medium<'a>(desc: &'a SceneDescription, fired: &mut dyn FnMut(Simplification))
         },
         AlbedoDesc::Constant(rgb) => Albedo::Constant(rgb),
     };
-    let any_layout = any_layout(medium);
-    let texture = texel(medium.lookup).is_some();
-    let albedo_grid = |albedo: Albedo<'a>| match albedo {
-        Albedo::Grid(albedo) => grid::<3>(albedo, medium.lookup),
-        Albedo::Constant(rgb) => one_voxel(desc, rgb),
-    };
+    let dense_trilinear = texel(medium.lookup).is_none() && !any_layout(medium);
     match (density, albedo) {
         (Density::Constant(density), Albedo::Constant(albedo)) => {
             MediumPart::Homogeneous(HomogeneousMedium {
@@ -426,31 +421,25 @@ fn medium<'a>(desc: &'a SceneDescription, fired: &mut dyn FnMut(Simplification))
                 albedo: Spectrum::new(albedo[0], albedo[1], albedo[2]),
             })
         }
-        // A constant albedo becomes a one-voxel texture: the kernels read it only at real
-        // collisions, a few per path.
-        (density, albedo) if texture => MediumPart::GridTexture(grid_medium(
-            desc,
-            density,
-            GridAlbedo(albedo_grid(albedo), TextureTrilinear),
-        )),
-        (density, albedo) if any_layout => MediumPart::GridAnyLayout(grid_medium(
-            desc,
-            density,
-            GridAlbedo(albedo_grid(albedo), AnyLayout),
-        )),
-        (Density::Grid(density), Albedo::Constant(albedo)) => MediumPart::GridDensity(GridMedium {
-            density: grid::<1>(density, medium.lookup),
-            scale: medium.scale,
-            majorant: medium.scale * density.max_value(),
-            majorants: None,
-            albedo: ConstantAlbedo(Spectrum::new(albedo[0], albedo[1], albedo[2])),
-            reads: DenseTrilinear,
-        }),
-        (density, Albedo::Grid(albedo)) => MediumPart::GridDensityAlbedo(grid_medium(
-            desc,
-            density,
-            GridAlbedo(grid::<3>(albedo, medium.lookup), DenseTrilinear),
-        )),
+        (Density::Grid(density), Albedo::Constant(albedo)) if dense_trilinear => {
+            MediumPart::GridDensity(GridMedium {
+                density: grid::<1>(density, medium.lookup),
+                scale: medium.scale,
+                majorant: medium.scale * density.max_value(),
+                majorants: None,
+                albedo: ConstantAlbedo(Spectrum::new(albedo[0], albedo[1], albedo[2])),
+                reads: DenseTrilinear,
+            })
+        }
+        // Textures and the any-layout reads take a constant albedo as a one-voxel grid (the
+        // kernels read it only at real collisions, a few per path).
+        (density, albedo) => {
+            let albedo = match albedo {
+                Albedo::Grid(albedo) => grid::<3>(albedo, medium.lookup),
+                Albedo::Constant(rgb) => one_voxel(desc, rgb),
+            };
+            albedo_grid_medium(desc, density, albedo)
+        }
     }
 }
 
@@ -483,13 +472,23 @@ fn general_medium(desc: &SceneDescription) -> MediumPart<'_> {
         AlbedoDesc::Grid(albedo) => grid::<3>(albedo, medium.lookup),
         AlbedoDesc::Constant(_) => one_voxel_albedo(desc),
     };
-    if texel(medium.lookup).is_some() {
+    albedo_grid_medium(desc, density, albedo)
+}
+
+/// A grid medium of `density` and an albedo grid, reading its grids as the description's lookup
+/// and storage ask: through textures, in any layout, or dense and trilinear.
+fn albedo_grid_medium<'a>(
+    desc: &'a SceneDescription,
+    density: Density<'a>,
+    albedo: Grid<'a, 3>,
+) -> MediumPart<'a> {
+    if texel(desc.medium.lookup).is_some() {
         MediumPart::GridTexture(grid_medium(
             desc,
             density,
             GridAlbedo(albedo, TextureTrilinear),
         ))
-    } else if any_layout(medium) {
+    } else if any_layout(&desc.medium) {
         MediumPart::GridAnyLayout(grid_medium(desc, density, GridAlbedo(albedo, AnyLayout)))
     } else {
         MediumPart::GridDensityAlbedo(grid_medium(
