@@ -195,19 +195,23 @@ impl VolumePlacer {
                 (address, PlacedIn::Managed { device_bytes })
             }
         };
-        let placed = Placed {
+        self.record(Placed {
             bytes,
             layout,
             memory,
-        };
-        tracing::info!("volume: {placed}");
-        self.placed.push(placed);
+        });
         Ok(PlacedGrid {
             address,
             len: len as u64,
             layout,
             texture: 0,
         })
+    }
+
+    /// Logs where a grid went and keeps it for the render's report.
+    fn record(&mut self, placed: Placed) {
+        tracing::info!("volume: {placed}");
+        self.placed.push(placed);
     }
 
     /// A texture of the grid: always in device memory (a texture cannot read the host's).
@@ -239,13 +243,11 @@ impl VolumePlacer {
         self.used += bytes;
         let address = texture.object();
         self.held.push(Box::new(texture));
-        let placed = Placed {
+        self.record(Placed {
             bytes,
             layout: GridLayout::Dense,
             memory: PlacedIn::Texture(texel),
-        };
-        tracing::info!("volume: {placed}");
-        self.placed.push(placed);
+        });
         Ok(PlacedGrid {
             address: 0,
             len: 0,
