@@ -2,7 +2,7 @@
 //!
 //! The thesis's central finding is that the best strategy depends on the scene; so instead of a
 //! rule, short calibration renders of the actual scene time the candidates and the fastest wins:
-//! every strategy but naive-sk with the compiler's registers, then the fastest of them under two
+//! every strategy but the naive ones with the compiler's registers, then the fastest of them under two
 //! register caps (the caps' effect hardly depends on the strategy, and each candidate costs a JIT
 //! compilation). The
 //! choice and the measurements behind it are printed, and cached per scene, GPU and math in
@@ -36,8 +36,17 @@ const TRIALS: usize = 2;
 /// best fixed choice on most scenes (docs/strategies.md).
 pub const DEFAULT: Strategy = Strategy::RegenerationSk;
 
-/// Candidates a calibration times: every strategy but naive-sk, then two register caps.
-const CANDIDATES: u64 = Strategy::ALL.len() as u64 - 1 + CAPS.len() as u64;
+/// The strategies a calibration times: every one but the naive baselines (naive-sk, naive-mk),
+/// which trace a batch of one sample per pixel to its longest path before the next starts.
+fn timed_strategies() -> impl Iterator<Item = Strategy> {
+    Strategy::ALL
+        .iter()
+        .copied()
+        .filter(|s| !matches!(s, Strategy::NaiveSk | Strategy::NaiveMk))
+}
+
+/// Candidates a calibration times: the timed strategies, then two register caps.
+const CANDIDATES: u64 = Strategy::ALL.len() as u64 - 2 + CAPS.len() as u64;
 
 /// The most a calibration has saved against [`DEFAULT`] (auto-check.sh on an H100, 2026-11-23:
 /// up to 16% with a register cap, on bucky), as a fraction of the render's time.
@@ -138,10 +147,8 @@ pub fn calibrate<S: SceneAbi>(
         })
     };
     let mut measurements = Vec::new();
-    for &strategy in Strategy::ALL {
-        if strategy != Strategy::NaiveSk {
-            measurements.push(time(strategy.into())?);
-        }
+    for strategy in timed_strategies() {
+        measurements.push(time(strategy.into())?);
     }
     let winner = fastest(&measurements).strategy.clone();
     let strategy = Strategy::ALL

@@ -13,6 +13,9 @@ use crate::{Spectrum, Vec3};
 pub trait Medium {
     /// The extinction is the same everywhere: delta tracking needs no rejection step.
     const HOMOGENEOUS: bool;
+    /// The albedo is the same everywhere and reads no memory: a strategy that orders albedo reads
+    /// (sorting-sk) has nothing to order.
+    const CONSTANT_ALBEDO: bool = false;
 
     /// An upper bound of `sigma_t` over the medium (the majorant of delta tracking).
     fn majorant(&self) -> f32;
@@ -34,6 +37,7 @@ pub struct HomogeneousMedium {
 
 impl Medium for HomogeneousMedium {
     const HOMOGENEOUS: bool = true;
+    const CONSTANT_ALBEDO: bool = true;
 
     #[inline]
     fn majorant(&self) -> f32 {
@@ -55,6 +59,8 @@ impl Medium for HomogeneousMedium {
 pub trait AlbedoField {
     /// The name of a [`GridMedium`] with this albedo, in kernel entry points.
     const GRID_MEDIUM_NAME: &'static str;
+    /// See [`Medium::CONSTANT_ALBEDO`].
+    const CONSTANT: bool;
 
     fn albedo(&self, p: Vec3) -> Spectrum;
 }
@@ -64,6 +70,7 @@ pub struct ConstantAlbedo(pub Spectrum);
 
 impl AlbedoField for ConstantAlbedo {
     const GRID_MEDIUM_NAME: &'static str = "grid_density";
+    const CONSTANT: bool = true;
 
     #[inline]
     fn albedo(&self, _p: Vec3) -> Spectrum {
@@ -77,6 +84,7 @@ pub struct GridAlbedo<'a, R = DenseTrilinear>(pub Grid<'a, 3>, pub R);
 
 impl<R: GridReads> AlbedoField for GridAlbedo<'_, R> {
     const GRID_MEDIUM_NAME: &'static str = "grid_density_albedo";
+    const CONSTANT: bool = false;
 
     #[inline(always)]
     fn albedo(&self, p: Vec3) -> Spectrum {
@@ -99,6 +107,7 @@ pub struct GridMedium<'a, A, R = DenseTrilinear> {
 
 impl<A: AlbedoField, R: GridReads> Medium for GridMedium<'_, A, R> {
     const HOMOGENEOUS: bool = false;
+    const CONSTANT_ALBEDO: bool = A::CONSTANT;
 
     #[inline]
     fn majorant(&self) -> f32 {

@@ -213,15 +213,26 @@ impl PathState {
 /// Advances `path` by one free flight and the event that ends it.
 #[inline(always)]
 pub fn step<S: Scene>(scene: &S, path: &mut PathState) {
+    if let Some(p) = fly(scene, path) {
+        scatter(scene, path, p, None);
+    }
+}
+
+/// [`step`] up to a real collision: one free flight and the event that ends it, unless that event
+/// is scattering in the medium, whose point it returns for [`scatter`]. The split lets a strategy
+/// fetch the albedo of many paths' collisions together (sorting-sk reads them in Morton order);
+/// the albedo draws no random number, so the path is the same either way.
+#[inline(always)]
+pub fn fly<S: Scene>(scene: &S, path: &mut PathState) -> Option<Vec3> {
     // Mitsuba's max_depth 0 allows no segment at all: the image is black.
     if scene.settings().max_depth == 0 {
         path.alive = false;
-        return;
+        return None;
     }
     path.segments += 1;
     if path.segments > scene.settings().max_segments {
         path.truncate(Truncation::Segments);
-        return;
+        return None;
     }
     if path.inside {
         let exit = scene.bounds().exit(&path.ray);
@@ -234,7 +245,7 @@ pub fn step<S: Scene>(scene: &S, path: &mut PathState) {
             scene.settings().max_tracking_steps,
         );
         match collision {
-            FreeFlight::Collision(t) => scatter(scene, path, path.ray.at(t)),
+            FreeFlight::Collision(t) => return Some(path.ray.at(t)),
             FreeFlight::Escaped => interact_with_boundary(scene, path, exit),
             FreeFlight::OutOfSteps => path.truncate(Truncation::TrackingSteps),
         }
@@ -252,6 +263,7 @@ pub fn step<S: Scene>(scene: &S, path: &mut PathState) {
             }
         }
     }
+    None
 }
 
 /// Runs `path` to its end.
@@ -286,16 +298,20 @@ pub fn sample_pixel<S: Scene>(
     }
 }
 
-/// A real collision at `p`: the albedo scales the throughput (the scattering/extinction ratio of the
-/// collision estimator) and the phase function, sampled exactly, gives the new direction.
+/// A real collision at `p`: the albedo (`albedo` if the caller has read it, else read here, only
+/// if the path goes on) scales the throughput (the scattering/extinction ratio of the collision
+/// estimator) and the phase function, sampled exactly, gives the new direction.
 /// Always inlined: a GPU call taking the scene by address moves it into local memory.
 #[inline(always)]
-fn scatter<S: Scene>(scene: &S, path: &mut PathState, p: Vec3) {
+pub fn scatter<S: Scene>(scene: &S, path: &mut PathState, p: Vec3, albedo: Option<Spectrum>) {
     let settings = scene.settings();
     if !path.begin_interaction(settings) {
         return;
     }
-    path.throughput *= scene.medium().albedo(p);
+    path.throughput *= match albedo {
+        Some(albedo) => albedo,
+        None => scene.medium().albedo(p),
+    };
     if path.throughput == Spectrum::ZERO {
         // A black albedo absorbs the path: nothing it could gather would count.
         path.alive = false;

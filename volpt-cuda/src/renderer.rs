@@ -17,7 +17,10 @@ use cudarc::driver::{
 use cudarc::nvrtc::Ptx;
 use volpt_core::abi::SceneAbi;
 use volpt_core::path::PathCounters;
-use volpt_device::launch::{next_launch_paths, Tile, BLOCK_SIZE, COUNTERS, FIRST_LAUNCH_PATHS};
+use volpt_device::launch::{
+    next_launch_paths, Scheduling, Stage, Tile, Wavefront, BLOCK_SIZE, COUNTERS,
+    FIRST_LAUNCH_PATHS, SLOT_BYTES,
+};
 use volpt_device::{LaunchParams, Math, Strategy};
 use volpt_film::{Film, Image, RenderOptions, RenderStats};
 use volpt_zerocopy::{VolumePlacer, VolumePolicy};
@@ -45,6 +48,10 @@ pub struct Schedule {
 /// that need them while the others wait; batching eight makes that divergent branch rarer, and
 /// waiting for the whole warp (32, the thesis's warp level) idles lanes for the longest path.
 pub const DEFAULT_REFILL_AT: u32 = 8;
+
+/// Iterations a multi-kernel strategy queues between looks at its counters: a look waits for
+/// the GPU, and the iterations queued beyond the last path's end cost a few microseconds each.
+const WAVEFRONT_BATCH: u32 = 16;
 
 impl From<Strategy> for Schedule {
     fn from(strategy: Strategy) -> Self {
@@ -218,6 +225,28 @@ impl CudaRenderer {
             .doing("querying the kernel's occupancy")?;
         let [columns, rows] = schedule.tiles.unwrap_or([1, 1]);
         tracing::info!(kernel = %name, columns, rows, threads = BLOCK_SIZE, "launching");
+        let resident_blocks = per_sm * self.multiprocessors;
+
+        // A multi-kernel strategy's queues, sized for the largest tile, and their counters.
+        let wavefront = matches!(strategy.scheduling(), Scheduling::Wavefront(_));
+        let capacity = Tile::grid(width, height, columns, rows)
+            .map(|tile| {
+                strategy
+                    .wavefront_capacity(tile.pixels(), resident_blocks as u64 * BLOCK_SIZE as u64)
+            })
+            .max()
+            .unwrap_or(1);
+        let queue_bytes = if wavefront {
+            2 * capacity as usize * SLOT_BYTES
+        } else {
+            0
+        };
+        let queues: CudaSlice<u8> = stream
+            .alloc_zeros(queue_bytes.max(1))
+            .doing("allocating the path queues")?;
+        let mut queue_state: CudaSlice<u64> = stream
+            .alloc_zeros(size_of::<Wavefront>() / 8)
+            .doing("allocating the queue counters")?;
 
         let mut params = LaunchParams {
             scene: scene_params,
@@ -228,7 +257,11 @@ impl CudaRenderer {
             first_sample: samples.start,
             samples: 0,
             refill_at: schedule.refill_at.unwrap_or(DEFAULT_REFILL_AT),
+            stage: 0,
+            capacity: 0,
             total_paths: 0,
+            queues: queues.device_ptr(stream).0,
+            wavefront: queue_state.device_ptr(stream).0,
             tile: Tile::whole(width, height),
         };
         let total = pixels * samples.len() as u64;
@@ -240,13 +273,16 @@ impl CudaRenderer {
         // Tiles one after the other, each with all its samples (the thesis's image tiling).
         for tile in Tile::grid(width, height, columns, rows) {
             let tile_pixels = tile.pixels();
-            let blocks = strategy.blocks(tile_pixels, per_sm * self.multiprocessors);
+            let blocks = strategy.blocks(tile_pixels, resident_blocks);
             let config = LaunchConfig {
                 grid_dim: (blocks, 1, 1),
                 block_dim: (BLOCK_SIZE, 1, 1),
                 shared_mem_bytes: 0,
             };
             params.tile = tile;
+            params.capacity = strategy
+                .wavefront_capacity(tile_pixels, resident_blocks as u64 * BLOCK_SIZE as u64)
+                as u32;
             for (_, count) in strategy.launches(tile_pixels, samples.len() as u32, || budget.get())
             {
                 let launched = Instant::now();
@@ -255,16 +291,52 @@ impl CudaRenderer {
                 stream
                     .memset_zeros(&mut next_path)
                     .doing("resetting the path counter")?;
-                // SAFETY: the kernel takes one `LaunchParams` of this scene type by value, whose film,
-                // counters, path counter and grids are the live allocations above, sized for this
-                // launch.
-                unsafe {
+                // SAFETY: the kernel takes one `LaunchParams` of this scene type by value, whose
+                // film, counters, path counter, queues and grids are the live allocations above,
+                // sized for this launch.
+                let launch = |params: LaunchParams<S::Params>, config| unsafe {
                     stream
                         .launch_builder(&kernel)
                         .arg(&ByValue(params.checked()))
                         .launch(config)
+                        .doing("launching the kernel")
+                };
+                if wavefront {
+                    stream
+                        .memset_zeros(&mut queue_state)
+                        .doing("resetting the queue counters")?;
+                    let plan = LaunchConfig {
+                        grid_dim: (1, 1, 1),
+                        ..config
+                    };
+                    // Iterations are queued without waiting, WAVEFRONT_BATCH at a time, until the
+                    // counters say every path has ended; the extra iterations find empty queues.
+                    let mut iteration = 0;
+                    loop {
+                        for _ in 0..WAVEFRONT_BATCH {
+                            for stage in Stage::iteration(iteration) {
+                                params.stage = stage.code();
+                                let config = match stage {
+                                    Stage::Plan { .. } => plan,
+                                    _ => config,
+                                };
+                                launch(params, config)?;
+                            }
+                            iteration += 1;
+                        }
+                        let state = stream
+                            .clone_dtoh(&queue_state)
+                            .doing("reading the queue counters")?;
+                        let state: Wavefront =
+                            bytemuck::pod_read_unaligned(bytemuck::cast_slice(&state));
+                        if state.done(params.total_paths) {
+                            break;
+                        }
+                    }
+                    params.stage = 0;
+                } else {
+                    launch(params, config)?;
                 }
-                .doing("launching the kernel")?;
                 stream.synchronize().doing("running the kernel")?;
                 budget.set(next_launch_paths(
                     params.total_paths,

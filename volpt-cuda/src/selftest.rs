@@ -1,7 +1,8 @@
 //! The strategies' collective building blocks on the GPU against plain CPU implementations, on
 //! random inputs with the corner cases (every, no, one and only the last thread of a block
-//! active): the block-wide exclusive count of streaming's compaction and the warp and block index
-//! takers of regeneration (`volpt_device::selftest`); and grid lookups through textures against
+//! active): the block-wide exclusive count of streaming's compaction, the block-wide radix sort of
+//! the sorting strategies (Morton keys, ended paths as the largest key, ties) and the warp and
+//! block index takers of regeneration (`volpt_device::selftest`); and grid lookups through textures against
 //! the CPU's reproduction of the texture unit's filter.
 
 use cudarc::driver::{CudaSlice, LaunchConfig, PushKernelArg};
@@ -100,6 +101,45 @@ pub fn check_taken(flags: &[bool], taken: &[u64], group: usize) -> Vec<String> {
     failures
 }
 
+/// Sort keys for every thread: per block, the flags of [`patterns`] say which threads hold a key
+/// (the others hold `order::INACTIVE_KEY`, as ended paths do); held keys are random Morton codes,
+/// drawn from few values in every other block so that ties are common.
+pub fn sort_keys(seed: u64) -> Vec<u32> {
+    let mut state = seed ^ 0x9e37_79b9_7f4a_7c15;
+    let mut next = move || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 33) as u32
+    };
+    patterns(seed)
+        .chunks(BLOCK_SIZE as usize)
+        .enumerate()
+        .flat_map(|(b, block)| {
+            block
+                .iter()
+                .map(|&held| match held {
+                    false => volpt_device::order::INACTIVE_KEY,
+                    true if b % 2 == 0 => next() % 4,
+                    true => next() & ((1 << 30) - 1),
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect()
+}
+
+/// What the block-wide sort must give each thread: its block's keys sorted stably, as (key, the
+/// thread of the block that held it).
+pub fn expected_sort(keys: &[u32]) -> Vec<(u32, u32)> {
+    keys.chunks(BLOCK_SIZE as usize)
+        .flat_map(|block| {
+            let mut order: Vec<u32> = (0..block.len() as u32).collect();
+            order.sort_by_key(|&t| block[t as usize]);
+            order.into_iter().map(|t| (block[t as usize], t))
+        })
+        .collect()
+}
+
 impl CudaRenderer {
     /// Runs every building block on the GPU and compares with the CPU.
     pub fn selftest(&self) -> Result<Vec<SelfTest>, CudaError> {
@@ -139,6 +179,36 @@ impl CudaRenderer {
                 .collect();
             results.push(SelfTest {
                 name: "block exclusive count",
+                threads,
+                failures,
+                measured: String::new(),
+            });
+
+            let keys = sort_keys(seed);
+            let input_keys = stream.clone_htod(&keys).doing("copying test input")?;
+            let kernel = self.kernel("selftest__block_sort", None)?;
+            let mut out: CudaSlice<u32> = stream
+                .alloc_zeros(2 * threads)
+                .doing("allocating test output")?;
+            // SAFETY: one key and two outputs per thread of the launch.
+            unsafe {
+                stream
+                    .launch_builder(&kernel)
+                    .arg(&input_keys)
+                    .arg(&mut out)
+                    .launch(config)
+            }
+            .doing("launching a selftest")?;
+            let got = stream.clone_dtoh(&out).doing("reading test output")?;
+            let failures = got
+                .chunks(2)
+                .zip(expected_sort(&keys))
+                .enumerate()
+                .filter(|(_, (g, e))| (g[0], g[1]) != *e)
+                .map(|(i, (g, e))| format!("thread {i}: ({}, {}), expected {e:?}", g[0], g[1]))
+                .collect();
+            results.push(SelfTest {
+                name: "block radix sort",
                 threads,
                 failures,
                 measured: String::new(),

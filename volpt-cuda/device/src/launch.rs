@@ -53,6 +53,10 @@ pub struct LaunchParams<P> {
     /// 1: at once), or when the whole warp is: fewer refills, each for more lanes at once, at the
     /// price of lanes idling in between (the host's default: 8).
     pub refill_at: u32,
+    /// A multi-kernel strategy's stage this launch runs ([`Stage::code`]); 0 otherwise.
+    pub stage: u32,
+    /// A multi-kernel strategy's queue capacity in paths (each of its two queues).
+    pub capacity: u32,
     /// `width * height * 3` `f64` sums of the samples' radiance, zeroed before the first launch;
     /// each launch adds its samples.
     pub film: u64,
@@ -63,6 +67,11 @@ pub struct LaunchParams<P> {
     pub next_path: u64,
     /// Paths to trace in this launch: `tile.pixels() * samples`.
     pub total_paths: u64,
+    /// A multi-kernel strategy's two path queues: `2 * capacity` [`Slot`]s, [`SLOT_BYTES`] apart.
+    pub queues: u64,
+    /// A multi-kernel strategy's [`Wavefront`] counters, zeroed before the render's first launch
+    /// of each launch's path range.
+    pub wavefront: u64,
     /// The part of the film this launch covers (`--tiles`; the whole film by default).
     pub tile: Tile,
 }
@@ -122,11 +131,11 @@ impl Tile {
 }
 
 impl<P: Pod> LaunchParams<P> {
-    /// The scene parameters are a multiple of 8 bytes (see `volpt_core::abi`), so the 64 bytes that
+    /// The scene parameters are a multiple of 8 bytes (see `volpt_core::abi`), so the 88 bytes that
     /// follow them need no padding.
     pub const LAYOUT: () = assert!(
         core::mem::size_of::<P>().is_multiple_of(8)
-            && core::mem::size_of::<Self>() == core::mem::size_of::<P>() + 64
+            && core::mem::size_of::<Self>() == core::mem::size_of::<P>() + 88
     );
 
     /// The parameters, once `LAYOUT` has been checked: the host ships only values built by this.
@@ -165,15 +174,177 @@ pub fn pixel_xy(pixel: u32, width: u32) -> (u32, u32) {
     (pixel % width, pixel / width)
 }
 
+/// How a strategy maps its work onto threads and launches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scheduling {
+    /// One thread per pixel, one launch per sample (naive-sk).
+    PerPixel,
+    /// Persistent threads take path indices from a global counter until the launch's paths are
+    /// done (regeneration and streaming, single kernel).
+    Persistent,
+    /// Multi-kernel: paths live in device memory between launches, and each iteration is three
+    /// launches of the strategy's kernel ([`Stage`]): extend every queued path by one segment and
+    /// compact the survivors into the other queue, plan the next batch of new paths, regenerate
+    /// (start them and trace their first segment).
+    Wavefront(Regeneration),
+}
+
+/// When a multi-kernel strategy starts new paths.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Regeneration {
+    /// Only when the queue is empty: a batch of `capacity` paths (one sample of every pixel) is
+    /// traced to its end before the next starts (the thesis's naiveMK).
+    WhenEmpty,
+    /// After every extension, into the room the finished paths left (the thesis's streamingMK).
+    Continuous,
+}
+
+/// The stages of a multi-kernel strategy's iteration, each one launch. `parity` says which
+/// queue the iteration consumes: extension reads queue `parity` and writes its survivors to queue
+/// `1 - parity`, to which regeneration adds the new paths; the next iteration has the other
+/// parity.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    Extend {
+        parity: u32,
+    },
+    /// One thread: [`Wavefront::plan`].
+    Plan {
+        parity: u32,
+    },
+    Regenerate {
+        parity: u32,
+    },
+}
+
+impl Stage {
+    /// The stage as [`LaunchParams::stage`] carries it.
+    pub fn code(self) -> u32 {
+        match self {
+            Stage::Extend { parity } => parity & 1,
+            Stage::Plan { parity } => 2 | (parity & 1),
+            Stage::Regenerate { parity } => 4 | (parity & 1),
+        }
+    }
+
+    #[inline(always)]
+    pub fn from_code(code: u32) -> Self {
+        let parity = code & 1;
+        match code >> 1 {
+            0 => Stage::Extend { parity },
+            1 => Stage::Plan { parity },
+            _ => Stage::Regenerate { parity },
+        }
+    }
+
+    /// The three launches of iteration `iteration`, in order.
+    pub fn iteration(iteration: u64) -> [Stage; 3] {
+        let parity = (iteration & 1) as u32;
+        [
+            Stage::Extend { parity },
+            Stage::Plan { parity },
+            Stage::Regenerate { parity },
+        ]
+    }
+}
+
+/// The counters of a multi-kernel strategy's queues in device memory, shared by its stages.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct Wavefront {
+    /// Paths in each queue.
+    pub count: [u64; 2],
+    /// Path indices handed out so far: `0 ..= total_paths`.
+    pub issued: u64,
+    /// The paths the next regeneration starts: indices `batch_first .. batch_first + batch_len`.
+    pub batch_first: u64,
+    pub batch_len: u64,
+}
+
+impl Wavefront {
+    /// The plan stage, after extension has compacted the survivors of queue `parity` into the
+    /// other: the next batch of new paths fills the room left in that queue (all of it, and only
+    /// once it is empty, for [`Regeneration::WhenEmpty`]), and queue `parity`, consumed, is
+    /// emptied for the next iteration's survivors.
+    #[inline(always)]
+    pub fn plan(
+        &mut self,
+        parity: u32,
+        capacity: u64,
+        total_paths: u64,
+        regeneration: Regeneration,
+    ) {
+        let live = self.count[(1 - (parity & 1)) as usize];
+        let room = match regeneration {
+            Regeneration::WhenEmpty if live > 0 => 0,
+            _ => capacity.saturating_sub(live),
+        };
+        let len = room.min(total_paths.saturating_sub(self.issued));
+        self.batch_first = self.issued;
+        self.batch_len = len;
+        self.issued += len;
+        self.count[(parity & 1) as usize] = 0;
+    }
+
+    /// Whether every path of a launch of `total_paths` paths has been started and has ended.
+    pub fn done(&self, total_paths: u64) -> bool {
+        self.issued >= total_paths && self.count == [0, 0]
+    }
+}
+
+/// Bytes from one queued path to the next: a [`Slot`] padded to a cache line, on the host and on
+/// the device alike (their layouts of `PathState` need not agree; this bound must).
+pub const SLOT_BYTES: usize = 128;
+
+/// A path in flight with the film pixel it belongs to (parked in shared or device memory by the
+/// strategies that move paths between threads).
+#[derive(Clone, Copy)]
+#[repr(C)]
+pub struct Slot {
+    pub path: volpt_core::path::PathState,
+    pub pixel: u32,
+}
+
+const _: () = assert!(core::mem::size_of::<Slot>() <= SLOT_BYTES);
+
+/// Queued paths per resident thread of streaming-mk: each thread extends several paths per
+/// launch, so that the launches' fixed cost is shared by more segments.
+pub const WAVEFRONT_PATHS_PER_THREAD: u64 = 8;
+
+/// The most paths a multi-kernel strategy queues (each queue; 2^22 slots are 512 MiB).
+pub const MAX_WAVEFRONT_CAPACITY: u64 = 1 << 22;
+
 impl Strategy {
+    /// How this strategy maps its work onto threads and launches.
+    pub fn scheduling(self) -> Scheduling {
+        match self {
+            Strategy::NaiveSk => Scheduling::PerPixel,
+            Strategy::NaiveMk => Scheduling::Wavefront(Regeneration::WhenEmpty),
+            Strategy::StreamingMk => Scheduling::Wavefront(Regeneration::Continuous),
+            _ => Scheduling::Persistent,
+        }
+    }
+
+    /// A multi-kernel strategy's queue capacity for a tile of `pixels` pixels on a GPU that
+    /// keeps `resident_threads` of its kernel: naive-mk queues one sample of every pixel (the
+    /// thesis's naiveMK: a launch per sample), streaming-mk [`WAVEFRONT_PATHS_PER_THREAD`] per
+    /// resident thread; at most [`MAX_WAVEFRONT_CAPACITY`], at least one path.
+    pub fn wavefront_capacity(self, pixels: u64, resident_threads: u64) -> u64 {
+        let wanted = match self.scheduling() {
+            Scheduling::Wavefront(Regeneration::WhenEmpty) => pixels,
+            _ => resident_threads * WAVEFRONT_PATHS_PER_THREAD,
+        };
+        wanted.clamp(1, MAX_WAVEFRONT_CAPACITY)
+    }
+
     /// Samples per pixel that one launch traces, out of the `remaining` samples of a render over
     /// `pixels` pixels, for a persistent strategy within a budget of `paths` paths (one sample at
     /// least).
     pub fn samples_per_launch(self, pixels: u64, remaining: u32, paths: u64) -> u32 {
-        match self {
+        match self.scheduling() {
             // One thread per pixel: several samples per launch would only lengthen the warp's
             // longest path, so each launch is one sample, and progress is reported per sample.
-            Strategy::NaiveSk => remaining.min(1),
+            Scheduling::PerPixel => remaining.min(1),
             _ => {
                 let fit = (paths / pixels.max(1)).max(1);
                 remaining.min(u32::try_from(fit).unwrap_or(u32::MAX))
@@ -203,9 +374,10 @@ impl Strategy {
     /// Blocks of [`BLOCK_SIZE`] threads one launch needs; `resident_blocks` is how many the GPU
     /// keeps resident at once for the kernel.
     pub fn blocks(self, pixels: u64, resident_blocks: u32) -> u32 {
-        match self {
-            Strategy::NaiveSk => pixels.div_ceil(BLOCK_SIZE as u64) as u32,
-            // Persistent threads: exactly as many blocks as the GPU keeps resident.
+        match self.scheduling() {
+            Scheduling::PerPixel => pixels.div_ceil(BLOCK_SIZE as u64) as u32,
+            // Persistent threads (and the multi-kernel stages, which loop over their queue):
+            // exactly as many blocks as the GPU keeps resident.
             _ => resident_blocks.max(1),
         }
     }

@@ -4,6 +4,7 @@
 //!   scene's typed device ABI ([`volpt_core::abi`]), and the scheduling arithmetic of every
 //!   strategy as plain functions (tested on the CPU, used by host and kernels alike).
 //! - [`Strategy`]: the scheduling strategies, generated from one list with their entry names.
+//! - [`order`]: Morton codes of path positions, the keys of the sorting strategies.
 //! - [`Math`]: exact (CPU-identical) or fast (approximate) kernels, two builds of one source.
 //! - [`export_kernels!`]: exports the kernels of every strategy for one scene type. The workspace's
 //!   kernels crate invokes it for every variant of the registry; a library user invokes it for a
@@ -22,6 +23,7 @@ extern crate std;
 
 pub mod launch;
 mod math;
+pub mod order;
 pub mod selftest;
 mod strategies;
 

@@ -22,6 +22,13 @@ pub fn global_thread_index() -> u32 {
     unsafe { nvptx::_block_idx_x() * nvptx::_block_dim_x() + nvptx::_thread_idx_x() }
 }
 
+/// Threads in the whole one-dimensional launch.
+#[inline(always)]
+pub fn grid_threads() -> u32 {
+    // SAFETY: special-register reads.
+    unsafe { nvptx::_grid_dim_x() * nvptx::_block_dim_x() }
+}
+
 #[inline(always)]
 pub fn lane_id() -> u32 {
     let r: u32;
@@ -89,6 +96,23 @@ fn shfl_down_u32(v: u32, delta: u32) -> u32 {
     r
 }
 
+/// `v` of lane `lane - delta`, or this lane's own `v` below lane `delta` (warp-collective).
+#[inline(always)]
+fn shfl_up_u32(v: u32, delta: u32) -> u32 {
+    let r: u32;
+    // SAFETY: a warp shuffle; every lane calls it.
+    unsafe {
+        asm!(
+            "shfl.sync.up.b32 {r}, {v}, {d}, 0, 0xffffffff;",
+            r = out(reg32) r,
+            v = in(reg32) v,
+            d = in(reg32) delta,
+            options(nomem, nostack)
+        )
+    };
+    r
+}
+
 /// `b`, hidden from the optimiser: an opaque copy at the top of a loop that runs collectives keeps
 /// LLVM from threading a value it knows on one edge (a path that just ended is inactive) into a
 /// copy of the loop's collective code, where lanes would vote or wait at different instructions.
@@ -100,6 +124,17 @@ pub fn opaque(b: bool) -> bool {
         asm!("mov.b32 {r}, {v};", r = out(reg32) r, v = in(reg32) b as u32, options(nomem, nostack))
     };
     r != 0
+}
+
+/// `v`, hidden from the optimiser, as [`opaque`].
+#[inline(always)]
+pub fn opaque_u32(v: u32) -> u32 {
+    let r: u32;
+    // SAFETY: a register copy; not `pure`, so it is neither folded nor moved.
+    unsafe {
+        asm!("mov.b32 {r}, {v};", r = out(reg32) r, v = in(reg32) v, options(nomem, nostack))
+    };
+    r
 }
 
 /// `v` of lane `src` (warp-collective).
@@ -263,6 +298,101 @@ pub fn block_exclusive_count(pred: bool) -> (u32, u32) {
     // The counts are read before any thread can overwrite them in the next call.
     sync_threads();
     (before + (votes & lanemask_lt()).count_ones(), total)
+}
+
+// Scratch of the block-wide radix sort: the count of each 4-bit digit in each warp, and the
+// (key, source thread) pairs exchanged after each pass.
+core::arch::global_asm!(
+    ".shared .align 4 .b32 volpt_digit_counts[{n}];",
+    ".shared .align 8 .b64 volpt_sort_pairs[{b}];",
+    n = const 16 * crate::launch::BLOCK_SIZE / 32,
+    b = const crate::launch::BLOCK_SIZE,
+);
+
+/// This thread's place in a stable counting sort of the block's 4-bit `digit`s (`digit < 16`):
+/// the threads with a smaller digit, plus those before this one with the same digit
+/// (block-collective: every thread must call it; two barriers). Each warp votes once per digit
+/// value and its lane `v` stores the count of digit `v`; then lane `v` of every warp sums digit
+/// `v` over the block and over the warps before its own, and a scan over the first 16 lanes turns
+/// the block's counts into the first place of each digit.
+#[inline(always)]
+pub fn block_digit_rank(digit: u32) -> u32 {
+    let warp = thread_index() / 32;
+    let warps = crate::launch::BLOCK_SIZE / 32;
+    let lane = lane_id();
+    let counts = shared_address!("volpt_digit_counts");
+    let mut same = 0;
+    for v in 0..16 {
+        let votes = ballot(digit == v);
+        if digit == v {
+            same = votes;
+        }
+        if lane == v {
+            // SAFETY: `16 * warp + v` is inside `volpt_digit_counts`.
+            unsafe {
+                asm!("st.shared.u32 [{a}], {n};", a = in(reg64) counts + 4 * (16 * warp + v) as u64,
+                    n = in(reg32) votes.count_ones(), options(nostack))
+            };
+        }
+    }
+    sync_threads();
+    // Lane `v < 16`: digit `v`'s count over the block and over the warps before this one.
+    let (mut total, mut before) = (0u32, 0u32);
+    if lane < 16 {
+        for w in 0..warps {
+            let n: u32;
+            // SAFETY: written before the barrier.
+            unsafe {
+                asm!("ld.shared.u32 {n}, [{a}];", n = out(reg32) n,
+                    a = in(reg64) counts + 4 * (16 * w + lane) as u64, options(nostack))
+            };
+            total += n;
+            if w < warp {
+                before += n;
+            }
+        }
+    }
+    // The counts are read before any thread can overwrite them in the next call.
+    sync_threads();
+    // Inclusive scan of `total` over the lanes; lanes from 16 on hold 0.
+    let mut scan = total;
+    let mut delta = 1;
+    while delta < 16 {
+        let up = shfl_up_u32(scan, delta);
+        if lane >= delta {
+            scan += up;
+        }
+        delta <<= 1;
+    }
+    let first = scan - total + before;
+    shfl_idx_u32(first, digit) + (same & lanemask_lt()).count_ones()
+}
+
+/// The block's 32-bit keys sorted ascending (stably: equal keys in thread order): this thread's
+/// place's key and the thread that held it. A least-significant-digit radix sort, eight passes of
+/// [`block_digit_rank`] on 4-bit digits, each followed by an exchange of (key, source) pairs
+/// through shared memory (block-collective: every thread must call it).
+#[inline(always)]
+pub fn block_sort_u32(key: u32) -> (u32, u32) {
+    let pairs = shared_to_generic(shared_address!("volpt_sort_pairs")) as *mut u64;
+    let thread = thread_index();
+    let (mut key, mut source) = (key, thread);
+    for pass in 0..8 {
+        let rank = block_digit_rank((key >> (4 * pass)) & 15);
+        // SAFETY: `rank < BLOCK_SIZE` pairs; the ranks of the block are a permutation.
+        unsafe {
+            pairs
+                .add(rank as usize)
+                .write(((key as u64) << 32) | source as u64)
+        };
+        sync_threads();
+        // SAFETY: written before the barrier.
+        let pair = unsafe { pairs.add(thread as usize).read() };
+        (key, source) = ((pair >> 32) as u32, pair as u32);
+        // Read before the next pass writes.
+        sync_threads();
+    }
+    (key, source)
 }
 
 /// Thread 0's `f()`, seen by every thread of the block (block-collective; two barriers).

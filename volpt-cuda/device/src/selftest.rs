@@ -1,13 +1,14 @@
 //! Kernels that test the strategies' collective building blocks against plain CPU code
 //! (`volpt selftest --backend cuda`, `volpt_cuda::selftest`): the block-wide exclusive count of
-//! streaming's compaction, the warp and block index takers of regeneration, and grid lookups
+//! streaming's compaction, the block-wide radix sort of the sorting strategies, the warp and block index takers of regeneration, and grid lookups
 //! through textures (against the CPU's filter). Each thread reads its input, runs the building
 //! block, and writes what it got.
 
 /// The selftest kernels' entry points, as [`export_selftests!`](crate::export_selftests) exports
 /// them.
-pub const ENTRIES: [&str; 5] = [
+pub const ENTRIES: [&str; 6] = [
     "selftest__block_exclusive_count",
+    "selftest__block_sort",
     "selftest__warp_take_indices",
     "selftest__block_take_indices",
     "selftest__texture_lookups_1",
@@ -28,6 +29,13 @@ macro_rules! export_selftests {
             ) {
                 // SAFETY: forwarded.
                 unsafe { $crate::selftest::block_exclusive_count(preds, out) }
+            }
+            /// # Safety
+            /// As [`volpt_device::selftest::block_sort`].
+            #[export_name = "selftest__block_sort"]
+            pub unsafe extern "ptx-kernel" fn block_sort(keys: *const u32, out: *mut u32) {
+                // SAFETY: forwarded.
+                unsafe { $crate::selftest::block_sort(keys, out) }
             }
             /// # Safety
             /// As [`volpt_device::selftest::warp_take_indices`].
@@ -96,6 +104,27 @@ pub unsafe fn block_exclusive_count(preds: *const u32, out: *mut u32) {
     unsafe {
         *out.add(2 * i) = rank;
         *out.add(2 * i + 1) = total;
+    }
+}
+
+/// Thread `i` writes the key of its place in its block's sort of `keys` and the thread that held
+/// it (`nvptx::block_sort_u32`) as `out[2i], out[2i + 1]`.
+///
+/// # Safety
+/// `keys` and `out` must hold one and two `u32` per thread of the launch, whose blocks are
+/// `BLOCK_SIZE` threads.
+#[cfg(target_arch = "nvptx64")]
+#[inline(always)]
+pub unsafe fn block_sort(keys: *const u32, out: *mut u32) {
+    use crate::nvptx::{block_sort_u32, global_thread_index, opaque_u32};
+    let i = global_thread_index() as usize;
+    // SAFETY: the caller's contract.
+    let key = opaque_u32(unsafe { *keys.add(i) });
+    let (sorted, source) = block_sort_u32(key);
+    // SAFETY: the caller's contract.
+    unsafe {
+        *out.add(2 * i) = sorted;
+        *out.add(2 * i + 1) = source;
     }
 }
 

@@ -15,6 +15,10 @@ macro_rules! strategies {
             (RegenerationWarpSk, regeneration_warp_sk, "regeneration-warp-sk")
             (RegenerationBlockSk, regeneration_block_sk, "regeneration-block-sk")
             (StreamingSk, streaming_sk, "streaming-sk")
+            (StreamingSortedSk, streaming_sorted_sk, "streaming-sorted-sk")
+            (SortingSk, sorting_sk, "sorting-sk")
+            (NaiveMk, naive_mk, "naive-mk")
+            (StreamingMk, streaming_mk, "streaming-mk")
         ] }
     };
 }

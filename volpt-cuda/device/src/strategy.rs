@@ -13,15 +13,20 @@
 //!   Radiance reaches the film through `f64` atomic additions, whose order varies: the image agrees
 //!   with the CPU's up to the rounding of the sums.
 
-use volpt_core::path::{sample_pixel, step, PathCounters, PathState, Truncation};
-use volpt_core::Scene;
+use volpt_core::medium::Medium;
+use volpt_core::path::{fly, sample_pixel, scatter, step, PathCounters, PathState, Truncation};
+use volpt_core::{Scene, Spectrum, Vec3};
 
-use crate::launch::{path_of, LaunchParams, BLOCK_SIZE};
-use crate::nvptx::{
-    atomic_add_u64, ballot, block_broadcast_u64, block_exclusive_count, global_thread_index,
-    lane_id, lanemask_lt, opaque, red_add_f64, red_add_u64, shared_address, shared_to_generic,
-    shfl_idx_u64, sync_threads, sync_threads_or, thread_index, warp_sum_u64,
+use crate::launch::{
+    path_of, LaunchParams, Regeneration, Slot, Stage, Wavefront, BLOCK_SIZE, SLOT_BYTES,
 };
+use crate::nvptx::{
+    atomic_add_u64, ballot, block_broadcast_u64, block_exclusive_count, block_sort_u32,
+    global_thread_index, grid_threads, lane_id, lanemask_lt, opaque, opaque_u32, red_add_f64,
+    red_add_u64, shared_address, shared_to_generic, shfl_idx_u64, sync_threads, sync_threads_or,
+    thread_index, warp_sum_u64,
+};
+use crate::order::{morton30, INACTIVE_KEY};
 
 /// Adds the warp's counters to the launch's totals (warp-collective: every lane calls it).
 #[inline(always)]
@@ -335,19 +340,31 @@ pub unsafe fn regeneration_block_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>
     unsafe { counters.flush(lp) };
 }
 
-/// A path parked in shared memory while the block compacts: its state and its pixel.
-#[derive(Clone, Copy)]
-#[repr(C)]
-struct Slot {
-    path: PathState,
-    pixel: u32,
-}
-
-// One slot per thread of the block, for streamingSK's compaction.
+// One slot per thread of the block, where streaming parks its paths to compact or sort them.
 core::arch::global_asm!(
     ".shared .align 16 .b8 volpt_stream_slots[{n}];",
     n = const core::mem::size_of::<Slot>() * BLOCK_SIZE as usize,
 );
+
+// sorting-sk's collision points and their albedos, one per thread of the block.
+core::arch::global_asm!(
+    ".shared .align 4 .b8 volpt_sort_points[{n}];",
+    ".shared .align 4 .b8 volpt_sort_albedos[{n}];",
+    n = const 12 * BLOCK_SIZE as usize,
+);
+
+/// How streaming regroups a block's paths after every step.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Regroup {
+    /// Live paths to the first threads, in thread order (a block-wide exclusive scan).
+    Compact,
+    /// Live paths to the first threads, in the Morton order of their positions (a block-wide
+    /// radix sort whose ended paths have the largest key).
+    SortPaths,
+    /// As `Compact`, and before that each collision's albedo is read by the lane of its place in
+    /// the Morton order of the block's collision points (the thesis's sortingSK).
+    SortAlbedoReads,
+}
 
 /// streamingSK (the thesis's algorithm 5, with compaction in the block): persistent blocks; after
 /// every step the block compacts its live paths to its first threads (a block-wide exclusive scan
@@ -359,6 +376,78 @@ core::arch::global_asm!(
 /// As [`regeneration_sk`]; every thread of the block runs it.
 #[inline(always)]
 pub unsafe fn streaming_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
+    // SAFETY: forwarded.
+    unsafe { streaming(scene, lp, Regroup::Compact) }
+}
+
+/// streamingSK with Morton sorting (the thesis's sorting variant of algorithm 5): as
+/// [`streaming_sk`], but the live paths are ordered by the Morton codes of their positions
+/// ([`crate::order::morton30`]; ended paths last), so that the lanes of a warp track through
+/// neighbouring cells and read neighbouring voxels.
+///
+/// # Safety
+/// As [`regeneration_sk`]; every thread of the block runs it.
+#[inline(always)]
+pub unsafe fn streaming_sorted_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
+    // SAFETY: forwarded.
+    unsafe { streaming(scene, lp, Regroup::SortPaths) }
+}
+
+/// sortingSK: as [`streaming_sk`], but each step stops at its collision
+/// ([`volpt_core::path::fly`]), the block sorts its collision points by Morton code, each lane
+/// reads the albedo at the point of its place in that order (neighbouring lanes, neighbouring
+/// voxels) and hands it back to the path's lane, which then scatters
+/// ([`volpt_core::path::scatter`]). The paths are those of the CPU: the albedo draws no random
+/// number (unlike the thesis's sortingSK, which applied roulette before the deferred albedo). A
+/// medium of constant albedo has no reads to order, and the step runs whole.
+///
+/// # Safety
+/// As [`regeneration_sk`]; every thread of the block runs it.
+#[inline(always)]
+pub unsafe fn sorting_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
+    // SAFETY: forwarded.
+    unsafe { streaming(scene, lp, Regroup::SortAlbedoReads) }
+}
+
+/// One step of the block's live paths with the albedo of their collisions read in Morton order
+/// (block-collective).
+#[inline(always)]
+fn step_with_sorted_albedo_reads<S: Scene>(scene: &S, path: &mut PathState, active: bool) {
+    let points = shared_to_generic(shared_address!("volpt_sort_points")) as *mut [f32; 3];
+    let albedos = shared_to_generic(shared_address!("volpt_sort_albedos")) as *mut [f32; 3];
+    let thread = thread_index() as usize;
+    let collision = if active { fly(scene, path) } else { None };
+    let key = match collision {
+        Some(p) => {
+            // SAFETY: one point per thread of the block.
+            unsafe { points.add(thread).write(p.to_array()) };
+            morton30(p, &scene.bounds())
+        }
+        None => INACTIVE_KEY,
+    };
+    // The sort's barriers order the points' writes before their reads below.
+    let (sorted, source) = block_sort_u32(opaque_u32(key));
+    if sorted != INACTIVE_KEY {
+        // SAFETY: `source` is a thread of the block that wrote its point.
+        let p = Vec3::from_array(unsafe { points.add(source as usize).read() });
+        let albedo = scene.medium().albedo(p).to_array();
+        // SAFETY: one albedo per thread of the block.
+        unsafe { albedos.add(source as usize).write(albedo) };
+    }
+    sync_threads();
+    if let Some(p) = collision {
+        // SAFETY: written before the barrier by the lane that read this path's albedo.
+        let albedo = Spectrum::from_array(unsafe { albedos.add(thread).read() });
+        scatter(scene, path, p, Some(albedo));
+    }
+    // The albedos and points are read before the next step's writes: the barriers of the
+    // compaction that follows order them.
+}
+
+/// # Safety
+/// As [`regeneration_sk`]; every thread of the block runs it.
+#[inline(always)]
+unsafe fn streaming<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, regroup: Regroup) {
     let width = scene.camera().width;
     let pixels = lp.tile.pixels();
     let film = lp.film as *mut f64;
@@ -373,28 +462,52 @@ pub unsafe fn streaming_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     };
     let mut active = false;
     let mut exhausted = false;
+    let sort_albedo_reads = regroup == Regroup::SortAlbedoReads && !S::Medium::CONSTANT_ALBEDO;
     loop {
-        if active {
+        if sort_albedo_reads {
+            step_with_sorted_albedo_reads(scene, &mut slot.path, opaque(active));
+        } else if active {
             step(scene, &mut slot.path);
-            if !slot.path.alive {
-                // SAFETY: `pixel` is inside the film.
-                unsafe { finish_path(&slot.path, slot.pixel, film, &mut counters, totals) };
-                active = false;
+        }
+        if active && !slot.path.alive {
+            // SAFETY: `pixel` is inside the film.
+            unsafe { finish_path(&slot.path, slot.pixel, film, &mut counters, totals) };
+            active = false;
+        }
+        if regroup == Regroup::SortPaths {
+            // Sorting: each thread parks its path at its own index and takes the path of its
+            // place in the Morton order; ended paths sort last.
+            let key = if active {
+                morton30(slot.path.ray.origin, &scene.bounds())
+            } else {
+                INACTIVE_KEY
+            };
+            let (sorted, source) = block_sort_u32(opaque_u32(key));
+            if active {
+                // SAFETY: one slot per thread of the block.
+                unsafe { slots.add(thread as usize).write(slot) };
+            }
+            sync_threads();
+            active = sorted != INACTIVE_KEY;
+            if active {
+                // SAFETY: written before the barrier by thread `source`, which was live.
+                slot = unsafe { slots.add(source as usize).read() };
+            }
+        } else {
+            // Compaction: live path `rank` moves to thread `rank`.
+            let (rank, live) = block_exclusive_count(opaque(active));
+            if active {
+                // SAFETY: `rank < BLOCK_SIZE` slots.
+                unsafe { slots.add(rank as usize).write(slot) };
+            }
+            sync_threads();
+            active = thread < live;
+            if active {
+                // SAFETY: written before the barrier by the thread of that rank.
+                slot = unsafe { slots.add(thread as usize).read() };
             }
         }
-        // Compaction: live path `rank` moves to thread `rank`.
-        let (rank, live) = block_exclusive_count(opaque(active));
-        if active {
-            // SAFETY: `rank < BLOCK_SIZE` slots.
-            unsafe { slots.add(rank as usize).write(slot) };
-        }
-        sync_threads();
-        active = thread < live;
-        if active {
-            // SAFETY: written before the barrier by the thread of that rank.
-            slot = unsafe { slots.add(thread as usize).read() };
-        }
-        // The slots are read before the next compaction writes them: the barrier in
+        // The slots are read before the next regrouping writes them: the barrier in
         // `block_exclusive_count` below orders them.
         let need = opaque(!active && !exhausted);
         // SAFETY: `next_path` is one `u64` (the caller's contract).
@@ -416,6 +529,121 @@ pub unsafe fn streaming_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
         if !sync_threads_or(opaque(active)) {
             break;
         }
+    }
+    // SAFETY: `lp.counters` holds `COUNTERS` totals.
+    unsafe { counters.flush(lp) };
+}
+
+/// naiveMK (the thesis's first multi-kernel strategy): a batch of one sample of every pixel is
+/// started and traced to its end, one segment per launch, before the next batch starts; see
+/// [`wavefront`].
+///
+/// # Safety
+/// As [`wavefront`].
+#[inline(always)]
+pub unsafe fn naive_mk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
+    // SAFETY: forwarded.
+    unsafe { wavefront(scene, lp, Regeneration::WhenEmpty) }
+}
+
+/// streamingMK (the thesis's multi-kernel streaming, with device-wide compaction): after every
+/// extension new paths fill the room the finished ones left; see [`wavefront`].
+///
+/// # Safety
+/// As [`wavefront`].
+#[inline(always)]
+pub unsafe fn streaming_mk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
+    // SAFETY: forwarded.
+    unsafe { wavefront(scene, lp, Regeneration::Continuous) }
+}
+
+/// The multi-kernel strategies' stages ([`Stage`]): paths live in two queues in device memory;
+/// extension advances every path of one queue by a segment and appends the survivors to the
+/// other (device-wide compaction: the warp's survivors take consecutive places with one atomic
+/// on the queue's count), the plan stage ([`Wavefront::plan`]) sizes the next batch of new paths,
+/// and regeneration starts them and traces their first segment (the camera ray to the box and
+/// beyond: the thesis's generate-and-first-intersection kernel), appending those still alive.
+/// Each launch reads its work from the counters in device memory, so the host queues iteration
+/// after iteration without waiting.
+///
+/// # Safety
+/// `lp.queues` must hold `2 * lp.capacity` slots of [`SLOT_BYTES`] and `lp.wavefront` one
+/// [`Wavefront`], zeroed before the launch's first iteration; the film and counters as
+/// [`naive_sk`]; blocks of `BLOCK_SIZE` threads.
+#[inline(always)]
+unsafe fn wavefront<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, regeneration: Regeneration) {
+    let state = lp.wavefront as *mut Wavefront;
+    let slot_at = |queue: u32, i: u64| -> *mut Slot {
+        let index = queue as u64 * lp.capacity as u64 + i;
+        (lp.queues + index * SLOT_BYTES as u64) as *mut Slot
+    };
+    let film = lp.film as *mut f64;
+    let totals = lp.counters as *mut u64;
+    let mut counters = ThreadCounters::default();
+    let (parity, regenerate) = match Stage::from_code(lp.stage) {
+        Stage::Plan { parity } => {
+            if global_thread_index() == 0 {
+                // SAFETY: one `Wavefront` (the caller's contract), and this the only thread.
+                let state = unsafe { &mut *state };
+                state.plan(parity, lp.capacity as u64, lp.total_paths, regeneration);
+            }
+            return;
+        }
+        Stage::Extend { parity } => (parity, false),
+        Stage::Regenerate { parity } => (parity, true),
+    };
+    // SAFETY: `state` is one `Wavefront`, written by earlier launches only (a launch reads what
+    // it works on before any thread of it writes the output queue's count).
+    let (work, batch_first) = unsafe {
+        let state = &*state;
+        let work = if regenerate {
+            state.batch_len
+        } else {
+            state.count[parity as usize]
+        };
+        (work, state.batch_first)
+    };
+    let output = 1 - parity;
+    // SAFETY: as above; the survivors' count of the output queue.
+    let output_count = unsafe { &raw mut (*state).count[output as usize] };
+    let width = scene.camera().width;
+    let pixels = lp.tile.pixels();
+    // The warp's lanes take consecutive items; `base` is the same in every lane of the warp, so
+    // the loop and the append's vote stay warp-uniform.
+    let stride = grid_threads() as u64;
+    let mut base = (global_thread_index() - lane_id()) as u64;
+    while base < work {
+        let i = base + lane_id() as u64;
+        let mut survivor = None;
+        if i < work {
+            let mut slot = if regenerate {
+                let (tile_pixel, sample) = path_of(batch_first + i, pixels, lp.first_sample);
+                let (px, py, pixel) = lp.tile.film_pixel(tile_pixel, width);
+                Slot {
+                    path: PathState::from_camera(scene, px, py, sample, lp.seed),
+                    pixel,
+                }
+            } else {
+                // SAFETY: `i` is below the queue's count, at most its capacity.
+                unsafe { slot_at(parity, i).read() }
+            };
+            step(scene, &mut slot.path);
+            if slot.path.alive {
+                survivor = Some(slot);
+            } else {
+                // SAFETY: `pixel` is inside the film.
+                unsafe { finish_path(&slot.path, slot.pixel, film, &mut counters, totals) };
+            }
+        }
+        let survives = opaque(survivor.is_some());
+        // SAFETY: the output queue's count; survivors never exceed the capacity (`plan`).
+        if let Some(place) = unsafe { warp_take_indices(survives, output_count) } {
+            if let Some(slot) = survivor {
+                // SAFETY: `place` is below the capacity.
+                unsafe { slot_at(output, place).write(slot) };
+            }
+        }
+        base += stride;
     }
     // SAFETY: `lp.counters` holds `COUNTERS` totals.
     unsafe { counters.flush(lp) };

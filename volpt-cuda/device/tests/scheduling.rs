@@ -1,10 +1,13 @@
 //! The scheduling arithmetic every strategy's host loop and kernel share: across a render's launches,
 //! every `(pixel, sample)` is traced exactly once, for odd image sizes and renders of several launches.
 
+use volpt_core::{Aabb, Vec3};
 use volpt_device::launch::{
-    next_launch_paths, path_of, pixel_xy, Tile, BLOCK_SIZE, FIRST_LAUNCH_PATHS,
+    next_launch_paths, path_of, pixel_xy, Regeneration, Scheduling, Slot, Stage, Tile, Wavefront,
+    BLOCK_SIZE, FIRST_LAUNCH_PATHS, MAX_WAVEFRONT_CAPACITY, SLOT_BYTES, WAVEFRONT_PATHS_PER_THREAD,
 };
-use volpt_device::Strategy;
+use volpt_device::order::{morton30, spread_bits, INACTIVE_KEY};
+use volpt_device::{LaunchParams, Strategy};
 
 /// How often each `(pixel, sample)` of a `pixels` x `spp` render is traced, as the kernels of
 /// `strategy` map their work onto paths, with launch budgets that change from launch to launch as
@@ -17,9 +20,9 @@ fn coverage(strategy: Strategy, pixels: u64, spp: u32) -> Vec<u32> {
         .cycle();
     for (first, samples) in strategy.launches(pixels, spp, || budgets.next().unwrap()) {
         launches += 1;
-        match strategy {
+        match strategy.scheduling() {
             // Thread `i` of the launch renders pixel `i`, all of the launch's samples.
-            Strategy::NaiveSk => {
+            Scheduling::PerPixel => {
                 let threads = strategy.blocks(pixels, 0) as u64 * BLOCK_SIZE as u64;
                 assert!(threads >= pixels);
                 for thread in 0..threads.min(pixels) {
@@ -28,8 +31,9 @@ fn coverage(strategy: Strategy, pixels: u64, spp: u32) -> Vec<u32> {
                     }
                 }
             }
-            // Persistent threads take path indices 0 .. total_paths from the global counter.
-            _ => {
+            // Persistent threads take path indices 0 .. total_paths from the global counter; the
+            // multi-kernel stages start them in batches (`wavefront_stages_start_every_path_once`).
+            Scheduling::Persistent | Scheduling::Wavefront(_) => {
                 for index in 0..pixels * samples as u64 {
                     let (pixel, sample) = path_of(index, pixels, first);
                     assert!((pixel as u64) < pixels && sample < spp);
@@ -181,4 +185,158 @@ fn tiles_cover_the_film_once_and_every_path_is_traced_once() {
     // The whole film is one tile.
     let whole: Vec<Tile> = Tile::grid(400, 300, 1, 1).collect();
     assert_eq!(whole, [Tile::whole(400, 300)]);
+}
+
+/// A multi-kernel launch of `total` paths run as the host and the stages run it, on the CPU:
+/// path index `k` lives `lengths(k)` segments (the regeneration stage traces the first). Returns
+/// how often each index was started and how many iterations the launch took, and checks on the
+/// way that no queue overflows, that naive-mk starts a batch only into an empty queue, and that
+/// the counters say "done" exactly when every path has ended.
+fn run_wavefront(
+    regeneration: Regeneration,
+    capacity: u64,
+    total: u64,
+    lengths: impl Fn(u64) -> u32,
+) -> (Vec<u32>, u64) {
+    let mut state = Wavefront::default();
+    // The queues: (path index, segments left).
+    let mut queues: [Vec<(u64, u32)>; 2] = [Vec::new(), Vec::new()];
+    let mut started = vec![0u32; total as usize];
+    let mut iteration = 0;
+    while !state.done(total) {
+        for stage in Stage::iteration(iteration) {
+            assert_eq!(Stage::from_code(stage.code()), stage);
+            match stage {
+                Stage::Extend { parity } => {
+                    let (p, o) = (parity as usize, 1 - parity as usize);
+                    assert_eq!(queues[p].len() as u64, state.count[p]);
+                    for (k, left) in std::mem::take(&mut queues[p]) {
+                        if left > 1 {
+                            queues[o].push((k, left - 1));
+                        }
+                    }
+                    state.count[o] = queues[o].len() as u64;
+                    // The input is consumed; `plan` zeroes its count.
+                }
+                Stage::Plan { parity } => {
+                    let live = state.count[1 - parity as usize];
+                    state.plan(parity, capacity, total, regeneration);
+                    if regeneration == Regeneration::WhenEmpty && live > 0 {
+                        assert_eq!(
+                            state.batch_len, 0,
+                            "naive-mk started paths into a busy queue"
+                        );
+                    }
+                    assert_eq!(state.count[parity as usize], 0);
+                }
+                Stage::Regenerate { parity } => {
+                    let o = 1 - parity as usize;
+                    for k in state.batch_first..state.batch_first + state.batch_len {
+                        started[k as usize] += 1;
+                        let left = lengths(k);
+                        if left > 1 {
+                            queues[o].push((k, left - 1));
+                        }
+                    }
+                    state.count[o] = queues[o].len() as u64;
+                    assert!(state.count[o] <= capacity, "queue {o} overflows");
+                }
+            }
+        }
+        iteration += 1;
+        let live = queues[0].len() + queues[1].len();
+        assert_eq!(state.done(total), live == 0 && state.issued == total);
+        assert!(iteration < 100 * total + 100, "the launch does not end");
+    }
+    (started, iteration)
+}
+
+#[test]
+fn wavefront_stages_start_every_path_once_and_end() {
+    for regeneration in [Regeneration::WhenEmpty, Regeneration::Continuous] {
+        for capacity in [1, 7, 64] {
+            for total in [0, 1, 63, 200] {
+                let lengths = |k: u64| (k * 2654435761 % 13) as u32 + 1;
+                let (started, _) = run_wavefront(regeneration, capacity, total, lengths);
+                assert!(
+                    started.iter().all(|&n| n == 1),
+                    "{regeneration:?}, capacity {capacity}, {total} paths"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn naive_mk_waits_for_its_batch_and_streaming_mk_does_not() {
+    // One path of 50 segments among short ones: naive-mk's batches each wait for their longest
+    // path (regeneration traces its first segment, 49 extensions the rest, and the next batch
+    // starts in the iteration of its last); streaming-mk refills around it.
+    let lengths = |k: u64| if k % 16 == 0 { 50 } else { 2 };
+    let (_, naive) = run_wavefront(Regeneration::WhenEmpty, 16, 160, lengths);
+    let (_, streaming) = run_wavefront(Regeneration::Continuous, 16, 160, lengths);
+    assert_eq!(naive, 10 * 49 + 1);
+    assert!(streaming < 150, "streaming-mk took {streaming} iterations");
+}
+
+#[test]
+fn wavefront_queues_hold_a_sample_for_naive_mk_and_several_paths_per_thread_for_streaming_mk() {
+    assert_eq!(
+        Strategy::NaiveMk.wavefront_capacity(160_000, 60_000),
+        160_000
+    );
+    assert_eq!(
+        Strategy::StreamingMk.wavefront_capacity(160_000, 60_000),
+        60_000 * WAVEFRONT_PATHS_PER_THREAD
+    );
+    assert_eq!(
+        Strategy::NaiveMk.wavefront_capacity(1 << 30, 1),
+        MAX_WAVEFRONT_CAPACITY
+    );
+    assert_eq!(Strategy::StreamingMk.wavefront_capacity(5, 0), 1);
+    for &s in Strategy::ALL {
+        let wavefront = matches!(s.scheduling(), Scheduling::Wavefront(_));
+        assert_eq!(
+            wavefront,
+            matches!(s, Strategy::NaiveMk | Strategy::StreamingMk),
+            "{s}"
+        );
+    }
+}
+
+#[test]
+fn morton_codes_interleave_the_cells_of_the_three_axes() {
+    assert_eq!(spread_bits(0b1011), 0b001_000_001_001);
+    assert_eq!(spread_bits(0x3ff), 0x0924_9249);
+    assert_eq!(spread_bits(0x400), 0, "only ten bits");
+    let bounds = Aabb::new(Vec3::new(-1.0, 0.0, 2.0), Vec3::new(1.0, 4.0, 3.0));
+    let code = |x, y, z| morton30(Vec3::new(x, y, z), &bounds);
+    assert_eq!(code(-1.0, 0.0, 2.0), 0);
+    assert_eq!(code(1.0, 4.0, 3.0), (1 << 30) - 1, "the far corner's cell");
+    // One cell step along x, y and z sets bits 0, 1 and 2.
+    let step = |axis: f32| axis / 1024.0 * 1.5;
+    assert_eq!(code(-1.0 + 2.0 * step(1.0), 0.0, 2.0), 0b001);
+    assert_eq!(code(-1.0, 4.0 * step(1.0), 2.0), 0b010);
+    assert_eq!(code(-1.0, 0.0, 2.0 + step(1.0)), 0b100);
+    // Outside the box and not a number: clamped to a cell, never above 30 bits.
+    for p in [
+        Vec3::splat(-1e30),
+        Vec3::splat(1e30),
+        Vec3::splat(f32::NAN),
+        Vec3::splat(f32::INFINITY),
+    ] {
+        assert!(morton30(p, &bounds) < 1 << 30);
+        assert!(morton30(p, &bounds) < INACTIVE_KEY);
+    }
+    // A flat box (zero extent on an axis) still codes.
+    let flat = Aabb::new(Vec3::ZERO, Vec3::new(1.0, 0.0, 1.0));
+    assert!(morton30(Vec3::splat(0.5), &flat) < 1 << 30);
+}
+
+#[test]
+fn the_launch_parameters_keep_their_layout_with_the_queue_fields() {
+    #[allow(clippy::let_unit_value)]
+    let () = LaunchParams::<[u64; 3]>::LAYOUT;
+    assert_eq!(size_of::<LaunchParams<[u64; 3]>>(), 24 + 88);
+    assert!(size_of::<Slot>() <= SLOT_BYTES);
 }
