@@ -14,7 +14,7 @@ mkdir -p "$OUT"
 VOLPT=$PWD/bin/volpt
 SPP=${SPP:-100}
 TRIALS=${TRIALS:-5}
-STRATEGIES=${STRATEGIES:-naive-sk regeneration-sk regeneration-warp-sk regeneration-block-sk streaming-sk}
+STRATEGIES=${STRATEGIES:-naive-sk regeneration-sk regeneration-warp-sk regeneration-block-sk regeneration-2p-sk streaming-sk streaming-sorted-sk sorting-sk naive-mk streaming-mk}
 CONFIGS=${CONFIGS:-exact:trilinear fast:texture}
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/thesis-tables.XXXXXX")
 export RUST_BACKTRACE=0 RUST_LIB_BACKTRACE=0

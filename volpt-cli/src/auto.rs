@@ -2,9 +2,9 @@
 //!
 //! The thesis's central finding is that the best strategy depends on the scene; so instead of a
 //! rule, short calibration renders of the actual scene time the candidates and the fastest wins:
-//! every strategy but the naive ones with the compiler's registers, then the fastest of them under two
-//! register caps (the caps' effect hardly depends on the strategy, and each candidate costs a JIT
-//! compilation). The
+//! the regeneration strategies and streaming-sk ([`TIMED`]) with the compiler's registers, then
+//! the fastest of them under two register caps (the caps' effect hardly depends on the strategy,
+//! and each candidate costs a JIT compilation). The
 //! choice and the measurements behind it are printed, and cached per scene, GPU and math in
 //! `$XDG_CACHE_HOME/volpt/auto.json` (or `~/.cache/volpt/`; `VOLPT_CACHE_DIR` overrides), so only
 //! the first render of a scene pays for the calibration (a few seconds, most of it JIT compilation).
@@ -36,17 +36,20 @@ const TRIALS: usize = 2;
 /// best fixed choice on most scenes (docs/strategies.md).
 pub const DEFAULT: Strategy = Strategy::RegenerationSk;
 
-/// The strategies a calibration times: every one but the naive baselines (naive-sk, naive-mk),
-/// which trace a batch of one sample per pixel to its longest path before the next starts.
-fn timed_strategies() -> impl Iterator<Item = Strategy> {
-    Strategy::ALL
-        .iter()
-        .copied()
-        .filter(|s| !matches!(s, Strategy::NaiveSk | Strategy::NaiveMk))
-}
+/// The strategies a calibration times. Not the naive baselines (naive-sk, naive-mk: a batch of
+/// one sample per pixel waits for its longest path), and not the sorting and multi-kernel
+/// strategies, which were 1.3-10x slower than the best strategy on each of the seven scenes of
+/// `docs/strategies.md` (H100, 2026-11-24): each candidate costs two calibration renders and a
+/// JIT compilation.
+const TIMED: [Strategy; 4] = [
+    Strategy::RegenerationSk,
+    Strategy::RegenerationWarpSk,
+    Strategy::RegenerationBlockSk,
+    Strategy::StreamingSk,
+];
 
 /// Candidates a calibration times: the timed strategies, then two register caps.
-const CANDIDATES: u64 = Strategy::ALL.len() as u64 - 2 + CAPS.len() as u64;
+const CANDIDATES: u64 = TIMED.len() as u64 + CAPS.len() as u64;
 
 /// The most a calibration has saved against [`DEFAULT`] (auto-check.sh on an H100, 2026-11-23:
 /// up to 16% with a register cap, on bucky), as a fraction of the render's time.
@@ -147,7 +150,7 @@ pub fn calibrate<S: SceneAbi>(
         })
     };
     let mut measurements = Vec::new();
-    for strategy in timed_strategies() {
+    for strategy in TIMED {
         measurements.push(time(strategy.into())?);
     }
     let winner = fastest(&measurements).strategy.clone();

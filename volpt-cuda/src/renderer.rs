@@ -333,6 +333,11 @@ impl CudaRenderer {
                             break;
                         }
                     }
+                    tracing::debug!(
+                        iterations = iteration,
+                        paths = params.total_paths,
+                        "wavefront launch"
+                    );
                     params.stage = 0;
                 } else {
                     launch(params, config)?;

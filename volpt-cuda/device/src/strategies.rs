@@ -1,6 +1,7 @@
-//! The scheduling strategies (Novák, Havran & Dachsbacher 2010; the thesis's naiveSK and
-//! regenerationSK), listed once: [`strategies!`](crate::strategies) generates the host's
-//! [`Strategy`] enum and [`export_kernels!`](crate::export_kernels) one kernel per strategy.
+//! The scheduling strategies (Novák, Havran & Dachsbacher 2010; the thesis's naiveSK,
+//! regenerationSK, streamingSK, sortingSK, naiveMK and streamingMK), listed once:
+//! [`strategies!`](crate::strategies) generates the host's [`Strategy`] enum and
+//! [`export_kernels!`](crate::export_kernels) one kernel per strategy.
 //!
 //! Each entry is `(CamelCase variant, kernel function in `strategy`, command-line name)`; the
 //! function's name is also the prefix of the kernels' entry points.
@@ -14,6 +15,7 @@ macro_rules! strategies {
             (RegenerationSk, regeneration_sk, "regeneration-sk")
             (RegenerationWarpSk, regeneration_warp_sk, "regeneration-warp-sk")
             (RegenerationBlockSk, regeneration_block_sk, "regeneration-block-sk")
+            (Regeneration2pSk, regeneration_2p_sk, "regeneration-2p-sk")
             (StreamingSk, streaming_sk, "streaming-sk")
             (StreamingSortedSk, streaming_sorted_sk, "streaming-sorted-sk")
             (SortingSk, sorting_sk, "sorting-sk")

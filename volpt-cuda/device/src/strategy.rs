@@ -289,6 +289,74 @@ unsafe fn regeneration<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, refill: Ref
     unsafe { counters.flush(lp) };
 }
 
+/// regenerationSK with two paths per thread (the thesis's instruction-level-parallelism study):
+/// each thread keeps two paths and steps both in every iteration, so that the latency of one
+/// path's memory reads and long arithmetic can overlap the other's, at the price of twice the
+/// path state in registers (lower occupancy). Each of the two path slots refills as
+/// [`Refill::Thread`] does.
+///
+/// # Safety
+/// As [`regeneration_sk`].
+#[inline(always)]
+pub unsafe fn regeneration_2p_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
+    // SAFETY: forwarded.
+    unsafe { regeneration_paths::<S, P, 2>(scene, lp) }
+}
+
+/// # Safety
+/// As [`regeneration_sk`].
+#[inline(always)]
+unsafe fn regeneration_paths<S: Scene, P, const K: usize>(scene: &S, lp: &LaunchParams<P>) {
+    let width = scene.camera().width;
+    let pixels = lp.tile.pixels();
+    let film = lp.film as *mut f64;
+    let next_path = lp.next_path as *mut u64;
+    let mut counters = ThreadCounters::default();
+    let totals = lp.counters as *mut u64;
+    let mut paths = [PathState::from_camera(scene, 0, 0, 0, lp.seed); K];
+    let mut pixel = [0u32; K];
+    let mut active = [false; K];
+    let mut exhausted = false;
+    loop {
+        for k in 0..K {
+            // Warp-uniform, as in `regeneration`: every lane votes for every slot.
+            let ready = lp.refill_at <= 1
+                || ballot(!active[k] && !exhausted).count_ones() >= lp.refill_at
+                || ballot(active[k]) == 0;
+            let need = ready && !active[k] && !exhausted;
+            // SAFETY: `next_path` is one `u64` (the caller's contract).
+            if let Some(index) = unsafe { warp_take_indices(need, next_path) } {
+                if need {
+                    if index < lp.total_paths {
+                        let (tile_pixel, sample) = path_of(index, pixels, lp.first_sample);
+                        let (px, py, film_pixel) = lp.tile.film_pixel(tile_pixel, width);
+                        paths[k] = PathState::from_camera(scene, px, py, sample, lp.seed);
+                        pixel[k] = film_pixel;
+                        active[k] = true;
+                    } else {
+                        exhausted = true;
+                    }
+                }
+            }
+        }
+        if ballot(active.iter().any(|&a| a)) == 0 {
+            break;
+        }
+        for k in 0..K {
+            if active[k] {
+                step(scene, &mut paths[k]);
+                if !paths[k].alive {
+                    // SAFETY: `pixel[k]` is inside the film.
+                    unsafe { finish_path(&paths[k], pixel[k], film, &mut counters, totals) };
+                    active[k] = false;
+                }
+            }
+        }
+    }
+    // SAFETY: `lp.counters` holds `COUNTERS` totals.
+    unsafe { counters.flush(lp) };
+}
+
 /// regenerationSK at block level: after every step the block counts its idle lanes (a block-wide
 /// scan), takes that many path indices with one atomic, and hands them out in thread order.
 ///
@@ -464,15 +532,22 @@ unsafe fn streaming<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, regroup: Regro
     let mut exhausted = false;
     let sort_albedo_reads = regroup == Regroup::SortAlbedoReads && !S::Medium::CONSTANT_ALBEDO;
     loop {
+        // A path that ends is recorded inside the step's branch: the same code as before
+        // sorting-sk shared this loop (a check after it cost streaming-sk ~3%).
         if sort_albedo_reads {
             step_with_sorted_albedo_reads(scene, &mut slot.path, opaque(active));
+            if active && !slot.path.alive {
+                // SAFETY: `pixel` is inside the film.
+                unsafe { finish_path(&slot.path, slot.pixel, film, &mut counters, totals) };
+                active = false;
+            }
         } else if active {
             step(scene, &mut slot.path);
-        }
-        if active && !slot.path.alive {
-            // SAFETY: `pixel` is inside the film.
-            unsafe { finish_path(&slot.path, slot.pixel, film, &mut counters, totals) };
-            active = false;
+            if !slot.path.alive {
+                // SAFETY: `pixel` is inside the film.
+                unsafe { finish_path(&slot.path, slot.pixel, film, &mut counters, totals) };
+                active = false;
+            }
         }
         if regroup == Regroup::SortPaths {
             // Sorting: each thread parks its path at its own index and takes the path of its

@@ -272,7 +272,7 @@ fn naive_mk_waits_for_its_batch_and_streaming_mk_does_not() {
     // One path of 50 segments among short ones: naive-mk's batches each wait for their longest
     // path (regeneration traces its first segment, 49 extensions the rest, and the next batch
     // starts in the iteration of its last); streaming-mk refills around it.
-    let lengths = |k: u64| if k % 16 == 0 { 50 } else { 2 };
+    let lengths = |k: u64| if k.is_multiple_of(16) { 50 } else { 2 };
     let (_, naive) = run_wavefront(Regeneration::WhenEmpty, 16, 160, lengths);
     let (_, streaming) = run_wavefront(Regeneration::Continuous, 16, 160, lengths);
     assert_eq!(naive, 10 * 49 + 1);
