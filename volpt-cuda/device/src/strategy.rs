@@ -532,8 +532,8 @@ unsafe fn streaming<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, regroup: Regro
     let mut exhausted = false;
     let sort_albedo_reads = regroup == Regroup::SortAlbedoReads && !S::Medium::CONSTANT_ALBEDO;
     loop {
-        // A path that ends is recorded inside the step's branch: the same code as before
-        // sorting-sk shared this loop (a check after it cost streaming-sk ~3%).
+        // A path that ends is recorded inside the step's branch, as streaming-sk did before
+        // sorting-sk shared this loop (one check after both branches changed its kernels' code).
         if sort_albedo_reads {
             step_with_sorted_albedo_reads(scene, &mut slot.path, opaque(active));
             if active && !slot.path.alive {
