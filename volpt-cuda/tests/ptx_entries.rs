@@ -69,9 +69,16 @@ fn every_kernel_compiles_alone() {
 /// LLVM left a scene part behind a pointer: a call it did not inline takes the scene by address,
 /// or a vector is indexed at run time. That cost cgg-logo 1.5x its time on an H100 (a 456-byte
 /// frame from a grid lookup that was not inlined, `docs/strategies.md`).
+///
+/// One kernel keeps local memory by design: regeneration-2p-sk walks its two paths in an array
+/// with a loop, so that one copy of the step's code serves both (`strategy::regeneration_2p_sk`
+/// says why); its frame may hold those paths, no more.
 #[test]
 fn no_kernel_keeps_the_scene_in_local_memory() {
     const COUNTER_FLUSH_BYTES: usize = 64;
+    // The counters' 64 bytes and 192 of two paths with their pixels and flags (256 in every
+    // regeneration-2p-sk kernel of both builds, 2026-11-24).
+    const TWO_PATH_ARRAY_BYTES: usize = 256;
     for math in Math::ALL.iter().copied() {
         let Some(ptx) = volpt_cuda::kernels_ptx(math) else {
             continue;
@@ -81,7 +88,12 @@ fn no_kernel_keeps_the_scene_in_local_memory() {
             let alone = volpt_cuda::entry::single_kernel_ptx(ptx, &entry, None)
                 .unwrap_or_else(|| panic!("{math}: {entry} not in the PTX"));
             let depot = local_depot_bytes(&alone);
-            if depot > COUNTER_FLUSH_BYTES {
+            let allowed = if entry.starts_with("regeneration_2p_sk__") {
+                TWO_PATH_ARRAY_BYTES
+            } else {
+                COUNTER_FLUSH_BYTES
+            };
+            if depot > allowed {
                 heavy.push(format!("{entry}: {depot} bytes"));
             }
         }

@@ -295,6 +295,14 @@ unsafe fn regeneration<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, refill: Ref
 /// path state in registers (lower occupancy). Each of the two path slots refills as
 /// [`Refill::Thread`] does.
 ///
+/// The paths live in an array walked by a loop, so that one copy of the step's code serves both;
+/// the array is indexed at run time and so kept in local memory (the one kernel that keeps more
+/// than the counters' 64 bytes there, `volpt-cuda/tests/ptx_entries.rs`). Two named paths stay in
+/// registers but inline the step twice: on an H100 (2026-11-24,
+/// `bench/results/2026-11-24-h100-strategies-all/bench-2p-named-slots.txt`) that kernel was
+/// 1.2-3.5x slower than this one on five of seven scenes and 1.1-1.6x faster on two (ad, the
+/// index-matched cube), and slower than regeneration-sk on all seven, like this one.
+///
 /// # Safety
 /// As [`regeneration_sk`].
 #[inline(always)]
