@@ -130,12 +130,17 @@ pub fn sin_cos_2pi(u: f32) -> (f32, f32) {
     let r2 = r * r;
     let sin = r * (S[0] + r2 * (S[1] + r2 * (S[2] + r2 * (S[3] + r2 * S[4]))));
     let cos = C[0] + r2 * (C[1] + r2 * (C[2] + r2 * (C[3] + r2 * (C[4] + r2 * C[5]))));
-    match k & 3 {
-        0 => (sin, cos),
-        1 => (cos, -sin),
-        2 => (-sin, -cos),
-        _ => (-cos, sin),
-    }
+    // Quadrant k maps (sin, cos) to (sin, cos), (cos, -sin), (-sin, -cos), (-cos, sin): a swap on
+    // bit 0 and sign flips (exactly negation) on bit 1 of k and of k + 1, written as selects and
+    // sign-bit masks. A `match` on the quadrant became a four-way indirect branch on the GPU, which
+    // the lanes of a warp take apart: the top stall of the index-matched cube (ncu, H100,
+    // 2026-11-24, docs/strategies.md).
+    let (a, b) = if k & 1 == 0 { (sin, cos) } else { (cos, sin) };
+    let sign = |bit: u32| (bit & 2) << 30;
+    (
+        f32::from_bits(a.to_bits() ^ sign(k)),
+        f32::from_bits(b.to_bits() ^ sign(k.wrapping_add(1))),
+    )
 }
 
 #[inline]

@@ -53,3 +53,25 @@ fn sin_cos_2pi_wraps_whole_turns() {
         );
     }
 }
+
+/// A quarter turn more rotates the pair exactly: for `u` on a grid of 2^-20 (where `u + j/4`, `4u`
+/// and the reduced angle are exact, so the polynomial sees the same argument), the pair at
+/// `u + j/4` is the pair at `u` turned by `j` quadrants, bit for bit: (cos, -sin), (-sin, -cos),
+/// (-cos, sin). This pins the quadrant's swap and signs (done with selects and sign-bit masks).
+#[test]
+fn sin_cos_2pi_turns_exactly_by_quarter_turns() {
+    let turn = |(s, c): (f32, f32)| (c, -s);
+    for i in 0..1u32 << 18 {
+        let u = i as f32 / (1u32 << 20) as f32;
+        let mut expected = sin_cos_2pi(u);
+        for j in 1..4 {
+            expected = turn(expected);
+            let got = sin_cos_2pi(u + j as f32 / 4.0);
+            assert_eq!(
+                (got.0.to_bits(), got.1.to_bits()),
+                (expected.0.to_bits(), expected.1.to_bits()),
+                "u = {u}, {j} quarter turns"
+            );
+        }
+    }
+}
