@@ -37,10 +37,10 @@ const TRIALS: usize = 2;
 pub const DEFAULT: Strategy = Strategy::RegenerationSk;
 
 /// The strategies a calibration times. Not the naive baselines (naive-sk, naive-mk: a batch of
-/// one sample per pixel waits for its longest path), and not the sorting and multi-kernel
-/// strategies, which were 1.3-10x slower than the best strategy on each of the seven scenes of
-/// `docs/strategies.md` (H100, 2026-11-24): each candidate costs two calibration renders and a
-/// JIT compilation.
+/// one sample per pixel waits for its longest path), and not the sorting, multi-kernel and
+/// two-path strategies, each slower than the best of these four on every one of the seven
+/// scenes of `docs/strategies.md` (by 1.04x at the least; H100, 2026-11-24): each candidate
+/// costs two calibration renders and a JIT compilation.
 const TIMED: [Strategy; 4] = [
     Strategy::RegenerationSk,
     Strategy::RegenerationWarpSk,

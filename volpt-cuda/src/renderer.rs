@@ -226,14 +226,12 @@ impl CudaRenderer {
         let [columns, rows] = schedule.tiles.unwrap_or([1, 1]);
         tracing::info!(kernel = %name, columns, rows, threads = BLOCK_SIZE, "launching");
         let resident_blocks = per_sm * self.multiprocessors;
+        let resident_threads = resident_blocks as u64 * BLOCK_SIZE as u64;
 
         // A multi-kernel strategy's queues, sized for the largest tile, and their counters.
         let wavefront = matches!(strategy.scheduling(), Scheduling::Wavefront(_));
         let capacity = Tile::grid(width, height, columns, rows)
-            .map(|tile| {
-                strategy
-                    .wavefront_capacity(tile.pixels(), resident_blocks as u64 * BLOCK_SIZE as u64)
-            })
+            .map(|tile| strategy.wavefront_capacity(tile.pixels(), resident_threads))
             .max()
             .unwrap_or(1);
         let queue_bytes = if wavefront {
@@ -280,9 +278,7 @@ impl CudaRenderer {
                 shared_mem_bytes: 0,
             };
             params.tile = tile;
-            params.capacity = strategy
-                .wavefront_capacity(tile_pixels, resident_blocks as u64 * BLOCK_SIZE as u64)
-                as u32;
+            params.capacity = strategy.wavefront_capacity(tile_pixels, resident_threads) as u32;
             for (_, count) in strategy.launches(tile_pixels, samples.len() as u32, || budget.get())
             {
                 let launched = Instant::now();

@@ -17,6 +17,15 @@ use crate::CudaRenderer;
 /// Blocks per test launch.
 const BLOCKS: usize = 96;
 
+/// `BLOCKS` blocks of `BLOCK_SIZE` threads: the launch of the collective building blocks' tests.
+fn test_blocks() -> LaunchConfig {
+    LaunchConfig {
+        grid_dim: (BLOCKS as u32, 1, 1),
+        block_dim: (BLOCK_SIZE, 1, 1),
+        shared_mem_bytes: 0,
+    }
+}
+
 /// One building block's result: how many inputs, what differed from the CPU, and what was
 /// measured on the way (empty if nothing).
 #[derive(Debug)]
@@ -145,74 +154,27 @@ impl CudaRenderer {
     pub fn selftest(&self) -> Result<Vec<SelfTest>, CudaError> {
         let stream = self.stream();
         let threads = BLOCKS * BLOCK_SIZE as usize;
-        let config = LaunchConfig {
-            grid_dim: (BLOCKS as u32, 1, 1),
-            block_dim: (BLOCK_SIZE, 1, 1),
-            shared_mem_bytes: 0,
-        };
+        let config = test_blocks();
         let mut results = Vec::new();
         for seed in 1..=4u64 {
             let flags = patterns(seed);
             let input: Vec<u32> = flags.iter().map(|&f| f as u32).collect();
             let input = stream.clone_htod(&input).doing("copying test input")?;
 
-            let kernel = self.kernel("selftest__block_exclusive_count", None)?;
-            let mut out: CudaSlice<u32> = stream
-                .alloc_zeros(2 * threads)
-                .doing("allocating test output")?;
-            // SAFETY: one flag and two outputs per thread of the launch.
-            unsafe {
-                stream
-                    .launch_builder(&kernel)
-                    .arg(&input)
-                    .arg(&mut out)
-                    .launch(config)
-            }
-            .doing("launching a selftest")?;
-            let got = stream.clone_dtoh(&out).doing("reading test output")?;
-            let failures = got
-                .chunks(2)
-                .zip(expected_counts(&flags))
-                .enumerate()
-                .filter(|(_, (g, e))| (g[0], g[1]) != *e)
-                .map(|(i, (g, e))| format!("thread {i}: ({}, {}), expected {e:?}", g[0], g[1]))
-                .collect();
-            results.push(SelfTest {
-                name: "block exclusive count",
-                threads,
-                failures,
-                measured: String::new(),
-            });
-
+            results.push(self.pair_per_thread(
+                "block exclusive count",
+                "selftest__block_exclusive_count",
+                &input,
+                expected_counts(&flags),
+            )?);
             let keys = sort_keys(seed);
             let input_keys = stream.clone_htod(&keys).doing("copying test input")?;
-            let kernel = self.kernel("selftest__block_sort", None)?;
-            let mut out: CudaSlice<u32> = stream
-                .alloc_zeros(2 * threads)
-                .doing("allocating test output")?;
-            // SAFETY: one key and two outputs per thread of the launch.
-            unsafe {
-                stream
-                    .launch_builder(&kernel)
-                    .arg(&input_keys)
-                    .arg(&mut out)
-                    .launch(config)
-            }
-            .doing("launching a selftest")?;
-            let got = stream.clone_dtoh(&out).doing("reading test output")?;
-            let failures = got
-                .chunks(2)
-                .zip(expected_sort(&keys))
-                .enumerate()
-                .filter(|(_, (g, e))| (g[0], g[1]) != *e)
-                .map(|(i, (g, e))| format!("thread {i}: ({}, {}), expected {e:?}", g[0], g[1]))
-                .collect();
-            results.push(SelfTest {
-                name: "block radix sort",
-                threads,
-                failures,
-                measured: String::new(),
-            });
+            results.push(self.pair_per_thread(
+                "block radix sort",
+                "selftest__block_sort",
+                &input_keys,
+                expected_sort(&keys),
+            )?);
 
             for (name, entry, group) in [
                 ("warp index taker", "selftest__warp_take_indices", 32),
@@ -259,6 +221,46 @@ impl CudaRenderer {
             results.push(self.texture_lookups::<1>(texel, Samples::Constant)?);
         }
         Ok(results)
+    }
+
+    /// Runs the selftest kernel `entry`, which reads one `u32` of `input` per thread and writes two,
+    /// on `BLOCKS` blocks, and compares each thread's pair with `expected`.
+    fn pair_per_thread(
+        &self,
+        name: &'static str,
+        entry: &str,
+        input: &CudaSlice<u32>,
+        expected: Vec<(u32, u32)>,
+    ) -> Result<SelfTest, CudaError> {
+        let stream = self.stream();
+        let threads = BLOCKS * BLOCK_SIZE as usize;
+        let kernel = self.kernel(entry, None)?;
+        let mut out: CudaSlice<u32> = stream
+            .alloc_zeros(2 * threads)
+            .doing("allocating test output")?;
+        // SAFETY: one input and two outputs per thread of the launch.
+        unsafe {
+            stream
+                .launch_builder(&kernel)
+                .arg(input)
+                .arg(&mut out)
+                .launch(test_blocks())
+        }
+        .doing("launching a selftest")?;
+        let got = stream.clone_dtoh(&out).doing("reading test output")?;
+        let failures = got
+            .chunks(2)
+            .zip(expected)
+            .enumerate()
+            .filter(|(_, (g, e))| (g[0], g[1]) != *e)
+            .map(|(i, (g, e))| format!("thread {i}: ({}, {}), expected {e:?}", g[0], g[1]))
+            .collect();
+        Ok(SelfTest {
+            name,
+            threads,
+            failures,
+            measured: String::new(),
+        })
     }
 
     /// Looks up a `C`-channel grid in a texture of `texel`s at random points (inside the box, on
