@@ -135,6 +135,20 @@ unsafe fn finish_path(
     }
 }
 
+/// Path index `index` of the launch ([`path_of`]) over its tile's `pixels` pixels: its first
+/// state, from the camera, and its film pixel. The callers count `pixels` once, before their
+/// loops, as they did before this was shared: counted here, the multiplication moved into every
+/// refill and the kernels' branches were laid out anew.
+#[inline(always)]
+fn start_path<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, pixels: u64, index: u64) -> Slot {
+    let (tile_pixel, sample) = path_of(index, pixels, lp.first_sample);
+    let (px, py, pixel) = lp.tile.film_pixel(tile_pixel, scene.camera().width);
+    Slot {
+        path: PathState::from_camera(scene, px, py, sample, lp.seed),
+        pixel,
+    }
+}
+
 /// naiveSK: thread `i` renders the tile's pixel `i`, adding this launch's samples to its `f64` sum with the
 /// CPU's own per-pixel loop, so the sums are the CPU's bit for bit.
 ///
@@ -208,6 +222,23 @@ enum Refill {
     Warp,
 }
 
+impl Refill {
+    /// Whether the warp refills its idle lanes now, for a lane whose path is `active` (or none
+    /// is left to take: `exhausted`). Warp-collective: the threshold is the same for every lane,
+    /// so every vote is warp-uniform.
+    #[inline(always)]
+    fn ready<P>(self, lp: &LaunchParams<P>, active: bool, exhausted: bool) -> bool {
+        match self {
+            Refill::Thread => {
+                lp.refill_at <= 1
+                    || ballot(!active && !exhausted).count_ones() >= lp.refill_at
+                    || ballot(active) == 0
+            }
+            Refill::Warp => ballot(active) == 0,
+        }
+    }
+}
+
 /// regenerationSK: persistent threads step their paths and refill finished lanes from a global
 /// path counter. Path index `k` is sample `k / pixels` of pixel `k % pixels`, so the paths in flight
 /// at any time are spread over the image and the film's atomics rarely collide.
@@ -234,7 +265,6 @@ pub unsafe fn regeneration_warp_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>)
 /// As [`regeneration_sk`].
 #[inline(always)]
 unsafe fn regeneration<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, refill: Refill) {
-    let width = scene.camera().width;
     let pixels = lp.tile.pixels();
     let film = lp.film as *mut f64;
     let next_path = lp.next_path as *mut u64;
@@ -247,26 +277,12 @@ unsafe fn regeneration<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, refill: Ref
     let mut exhausted = false;
     loop {
         // Refill: the lanes without a path take consecutive indices with one atomic per warp.
-        let ready = match refill {
-            // The threshold is the same for every lane, so every ballot is warp-uniform.
-            Refill::Thread => {
-                lp.refill_at <= 1
-                    || ballot(!active && !exhausted).count_ones() >= lp.refill_at
-                    || ballot(active) == 0
-            }
-            Refill::Warp => ballot(active) == 0,
-        };
-        let need = ready && !active && !exhausted;
+        let need = refill.ready(lp, active, exhausted) && !active && !exhausted;
         // SAFETY: `next_path` is one `u64` (the caller's contract).
         if let Some(index) = unsafe { warp_take_indices(need, next_path) } {
             if need {
                 if index < lp.total_paths {
-                    let sample;
-                    let tile_pixel;
-                    (tile_pixel, sample) = path_of(index, pixels, lp.first_sample);
-                    let (px, py);
-                    (px, py, pixel) = lp.tile.film_pixel(tile_pixel, width);
-                    path = PathState::from_camera(scene, px, py, sample, lp.seed);
+                    Slot { path, pixel } = start_path(scene, lp, pixels, index);
                     active = true;
                 } else {
                     exhausted = true;
@@ -315,7 +331,6 @@ pub unsafe fn regeneration_2p_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
 /// As [`regeneration_sk`].
 #[inline(always)]
 unsafe fn regeneration_paths<S: Scene, P, const K: usize>(scene: &S, lp: &LaunchParams<P>) {
-    let width = scene.camera().width;
     let pixels = lp.tile.pixels();
     let film = lp.film as *mut f64;
     let next_path = lp.next_path as *mut u64;
@@ -327,19 +342,16 @@ unsafe fn regeneration_paths<S: Scene, P, const K: usize>(scene: &S, lp: &Launch
     let mut exhausted = false;
     loop {
         for k in 0..K {
-            // Warp-uniform, as in `regeneration`: every lane votes for every slot.
-            let ready = lp.refill_at <= 1
-                || ballot(!active[k] && !exhausted).count_ones() >= lp.refill_at
-                || ballot(active[k]) == 0;
-            let need = ready && !active[k] && !exhausted;
+            // Every lane votes for every slot, so the votes stay warp-uniform.
+            let need = Refill::Thread.ready(lp, active[k], exhausted) && !active[k] && !exhausted;
             // SAFETY: `next_path` is one `u64` (the caller's contract).
             if let Some(index) = unsafe { warp_take_indices(need, next_path) } {
                 if need {
                     if index < lp.total_paths {
-                        let (tile_pixel, sample) = path_of(index, pixels, lp.first_sample);
-                        let (px, py, film_pixel) = lp.tile.film_pixel(tile_pixel, width);
-                        paths[k] = PathState::from_camera(scene, px, py, sample, lp.seed);
-                        pixel[k] = film_pixel;
+                        Slot {
+                            path: paths[k],
+                            pixel: pixel[k],
+                        } = start_path(scene, lp, pixels, index);
                         active[k] = true;
                     } else {
                         exhausted = true;
@@ -372,7 +384,6 @@ unsafe fn regeneration_paths<S: Scene, P, const K: usize>(scene: &S, lp: &Launch
 /// As [`regeneration_sk`]; every thread of the block runs it.
 #[inline(always)]
 pub unsafe fn regeneration_block_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
-    let width = scene.camera().width;
     let pixels = lp.tile.pixels();
     let film = lp.film as *mut f64;
     let next_path = lp.next_path as *mut u64;
@@ -388,12 +399,7 @@ pub unsafe fn regeneration_block_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>
         if let Some(index) = unsafe { block_take_indices(need, next_path) } {
             if need {
                 if index < lp.total_paths {
-                    let sample;
-                    let tile_pixel;
-                    (tile_pixel, sample) = path_of(index, pixels, lp.first_sample);
-                    let (px, py);
-                    (px, py, pixel) = lp.tile.film_pixel(tile_pixel, width);
-                    path = PathState::from_camera(scene, px, py, sample, lp.seed);
+                    Slot { path, pixel } = start_path(scene, lp, pixels, index);
                     active = true;
                 } else {
                     exhausted = true;
@@ -524,7 +530,6 @@ fn step_with_sorted_albedo_reads<S: Scene>(scene: &S, path: &mut PathState, acti
 /// As [`regeneration_sk`]; every thread of the block runs it.
 #[inline(always)]
 unsafe fn streaming<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, regroup: Regroup) {
-    let width = scene.camera().width;
     let pixels = lp.tile.pixels();
     let film = lp.film as *mut f64;
     let next_path = lp.next_path as *mut u64;
@@ -597,12 +602,7 @@ unsafe fn streaming<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, regroup: Regro
         if let Some(index) = unsafe { block_take_indices(need, next_path) } {
             if need {
                 if index < lp.total_paths {
-                    let sample;
-                    let tile_pixel;
-                    (tile_pixel, sample) = path_of(index, pixels, lp.first_sample);
-                    let (px, py);
-                    (px, py, slot.pixel) = lp.tile.film_pixel(tile_pixel, width);
-                    slot.path = PathState::from_camera(scene, px, py, sample, lp.seed);
+                    slot = start_path(scene, lp, pixels, index);
                     active = true;
                 } else {
                     exhausted = true;
@@ -689,7 +689,6 @@ unsafe fn wavefront<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, regeneration: 
     let output = 1 - parity;
     // SAFETY: as above; the survivors' count of the output queue.
     let output_count = unsafe { &raw mut (*state).count[output as usize] };
-    let width = scene.camera().width;
     let pixels = lp.tile.pixels();
     // The warp's lanes take consecutive items; `base` is the same in every lane of the warp, so
     // the loop and the append's vote stay warp-uniform.
@@ -700,12 +699,7 @@ unsafe fn wavefront<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, regeneration: 
         let mut survivor = None;
         if i < work {
             let mut slot = if regenerate {
-                let (tile_pixel, sample) = path_of(batch_first + i, pixels, lp.first_sample);
-                let (px, py, pixel) = lp.tile.film_pixel(tile_pixel, width);
-                Slot {
-                    path: PathState::from_camera(scene, px, py, sample, lp.seed),
-                    pixel,
-                }
+                start_path(scene, lp, pixels, batch_first + i)
             } else {
                 // SAFETY: `i` is below the queue's count, at most its capacity.
                 unsafe { slot_at(parity, i).read() }
