@@ -134,7 +134,7 @@ pub fn sin_cos_2pi(u: f32) -> (f32, f32) {
     // bit 0 and sign flips (exactly negation) on bit 1 of k and of k + 1, written as selects and
     // sign-bit masks. A `match` on the quadrant became a four-way indirect branch on the GPU, which
     // the lanes of a warp take apart: the top stall of the index-matched cube (ncu, H100,
-    // 2026-11-24, docs/strategies.md).
+    // 2026-11-25, docs/strategies.md).
     let (a, b) = if k & 1 == 0 { (sin, cos) } else { (cos, sin) };
     let sign = |bit: u32| (bit & 2) << 30;
     (
