@@ -12,7 +12,8 @@
 # 3. the benchmark: every scene x strategy x math (and bin/volpt-base, if carried, as the
 #    before), each `volpt bench` with one discarded warm-up; a register-cap sweep on two scenes.
 # Knobs: TRIALS (5), SCENES_ONLY (a regex of scene names), STRATEGIES, EXACT_STRATEGIES,
-# FAST_STRATEGIES, CAPS, T (seconds per command, 60), PROBE_T (30), SKIP_CHECKS=1, SKIP_BENCH=1,
+# FAST_STRATEGIES, CAPS, T (seconds per command, 60), PROBE_T (30), RACECHECK_T (300: a racecheck
+# of the sorting strategies takes ~80 s on an H100), SKIP_CHECKS=1, SKIP_BENCH=1,
 # SKIP_CAPS=1, BENCH_ARGS (added to every benchmark command, e.g. "--spp 16" for naive-mk),
 # BASE_STRATEGIES and BASE_MATH (what bin/volpt-base runs: regeneration-sk, exact).
 set -uo pipefail
@@ -120,7 +121,7 @@ if [ -z "${SKIP_CHECKS:-}" ]; then
     done
     # The strategies that exchange paths, keys or albedos through shared memory.
     for s in streaming-sk streaming-sorted-sk sorting-sk; do
-        [[ " ${STRATEGIES[*]} " == *" $s "* ]] && check "racecheck-$s" timeout "$T" compute-sanitizer --tool racecheck --error-exitcode 1 \
+        [[ " ${STRATEGIES[*]} " == *" $s "* ]] && check "racecheck-$s" timeout "${RACECHECK_T:-300}" compute-sanitizer --tool racecheck --error-exitcode 1 \
             "$VOLPT" render scenes/cgg-logo/scene.xml -Dresolution=32 --spp 1 --backend cuda --strategy "$s" \
             -o "$OUT/racecheck-$s.exr"
     done

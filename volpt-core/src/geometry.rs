@@ -1,5 +1,6 @@
 //! Rays and the axis-aligned box that bounds the medium.
 
+use crate::math::{div, recip};
 use crate::Vec3;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -61,7 +62,7 @@ impl Aabb {
     /// the last slab entered.
     #[inline]
     pub fn entry(&self, ray: &Ray) -> Option<BoxHit> {
-        let inv = ray.dir.recip();
+        let inv = recip(ray.dir);
         let t0 = (self.min - ray.origin) * inv;
         let t1 = (self.max - ray.origin) * inv;
         let near = t0.min(t1);
@@ -99,11 +100,7 @@ impl Aabb {
     /// the answer is right for an origin on a face, edge or corner, and never negative.
     #[inline]
     pub fn exit(&self, ray: &Ray) -> BoxHit {
-        let far_plane = Vec3::select(ray.dir.cmpgt(Vec3::ZERO), self.max, self.min);
-        let t = (far_plane - ray.origin) / ray.dir;
-        // Axes the ray runs parallel to give +-inf or NaN: never the exit face.
-        let t = Vec3::select(t.cmpeq(t), t, Vec3::splat(f32::INFINITY));
-        let t = Vec3::select(ray.dir.cmpeq(Vec3::ZERO), Vec3::splat(f32::INFINITY), t);
+        let (far_plane, t) = self.far_planes(ray);
         let axis = argmin(t);
         let t_exit = component(t, axis).max(0.0);
         let point = with_component(ray.at(t_exit), axis, component(far_plane, axis));
@@ -112,6 +109,27 @@ impl Aabb {
             point: self.clamp(point),
             normal: axis_normal(axis, component(ray.dir, axis) > 0.0),
         }
+    }
+
+    /// `exit(ray).t`, the same bits, without the exit point and face: a free flight needs only
+    /// the distance, and the face only when the flight escapes (1 flight in ~86 on the
+    /// index-matched cube). Computing point and face on every flight cost the GPU a third of the
+    /// exit's instructions and three branches.
+    #[inline]
+    pub fn exit_distance(&self, ray: &Ray) -> f32 {
+        let (_, t) = self.far_planes(ray);
+        component(t, argmin(t)).max(0.0)
+    }
+
+    /// The far plane of each slab for `ray`'s direction and the distance to it; axes the ray runs
+    /// parallel to (whose division gives +-inf or NaN) at +inf, never the exit face.
+    #[inline(always)]
+    fn far_planes(&self, ray: &Ray) -> (Vec3, Vec3) {
+        let far_plane = Vec3::select(ray.dir.cmpgt(Vec3::ZERO), self.max, self.min);
+        let t = div(far_plane - ray.origin, ray.dir);
+        let t = Vec3::select(t.cmpeq(t), t, Vec3::splat(f32::INFINITY));
+        let t = Vec3::select(ray.dir.cmpeq(Vec3::ZERO), Vec3::splat(f32::INFINITY), t);
+        (far_plane, t)
     }
 
     #[inline]

@@ -5,8 +5,12 @@
 //!
 //! The GPU's fast-math kernels (`--math fast`: built with `--cfg volpt_fast_math`, see
 //! `cargo xtask ptx`) swap in the hardware approximations behind the same names: `lg2.approx`,
-//! `ex2.approx` and `sqrt.approx` (relative errors of a few ulp, PTX ISA 9.7.3), an accuracy/time
-//! knob measured in `docs/strategies.md`; they are no longer bit-identical to the CPU.
+//! `ex2.approx`, `sqrt.approx`, `rcp.approx` and `div.approx` (relative errors of a few ulp, PTX
+//! ISA 9.7.3), an accuracy/time knob measured in `docs/strategies.md`; they are no longer
+//! bit-identical to the CPU. They flush subnormals to zero (`.ftz`): without it ptxas scales
+//! every input into the normal range and back (three instructions around each, on the chain of
+//! dependent instructions that sets the pace of a launch's last, longest paths), for arguments
+//! that a renderer's sampled quantities do not reach or that round to nothing it would see.
 
 pub const PI: f32 = core::f32::consts::PI;
 pub const INV_PI: f32 = core::f32::consts::FRAC_1_PI;
@@ -67,7 +71,37 @@ pub fn exp(x: f32) -> f32 {
     }
 }
 
-/// The GPU's approximate unary instructions, one function each.
+/// `a / b` per component: the correctly rounded quotient, or in the fast kernels `div.approx`.
+#[inline]
+pub fn div(a: crate::Vec3, b: crate::Vec3) -> crate::Vec3 {
+    #[cfg(all(target_arch = "nvptx64", volpt_fast_math))]
+    {
+        crate::Vec3::new(
+            approx::div(a.x, b.x),
+            approx::div(a.y, b.y),
+            approx::div(a.z, b.z),
+        )
+    }
+    #[cfg(not(all(target_arch = "nvptx64", volpt_fast_math)))]
+    {
+        a / b
+    }
+}
+
+/// `1 / v` per component: the correctly rounded reciprocal, or in the fast kernels `rcp.approx`.
+#[inline]
+pub fn recip(v: crate::Vec3) -> crate::Vec3 {
+    #[cfg(all(target_arch = "nvptx64", volpt_fast_math))]
+    {
+        crate::Vec3::new(approx::rcp(v.x), approx::rcp(v.y), approx::rcp(v.z))
+    }
+    #[cfg(not(all(target_arch = "nvptx64", volpt_fast_math)))]
+    {
+        v.recip()
+    }
+}
+
+/// The GPU's approximate instructions, one function each.
 #[cfg(all(target_arch = "nvptx64", volpt_fast_math))]
 mod approx {
     macro_rules! unary {
@@ -84,7 +118,23 @@ mod approx {
             }
         )*};
     }
-    unary!(sqrt: "sqrt.approx.f32", lg2: "lg2.approx.f32", ex2: "ex2.approx.f32");
+    unary!(
+        sqrt: "sqrt.approx.ftz.f32",
+        lg2: "lg2.approx.ftz.f32",
+        ex2: "ex2.approx.ftz.f32",
+        rcp: "rcp.approx.ftz.f32"
+    );
+
+    #[inline(always)]
+    pub fn div(a: f32, b: f32) -> f32 {
+        let r: f32;
+        // SAFETY: a pure arithmetic instruction on registers.
+        unsafe {
+            core::arch::asm!("div.approx.ftz.f32 {r}, {a}, {b};", r = out(reg32) r, a = in(reg32) a,
+                b = in(reg32) b, options(pure, nomem, nostack))
+        };
+        r
+    }
 }
 
 #[inline]

@@ -241,11 +241,11 @@ fn advance<S: Scene, const DEFER_SCATTER: bool>(scene: &S, path: &mut PathState)
         return None;
     }
     if path.inside {
-        let exit = scene.bounds().exit(&path.ray);
+        let t_exit = scene.bounds().exit_distance(&path.ray);
         let collision = delta_tracking(
             scene.medium(),
             &path.ray,
-            exit.t,
+            t_exit,
             &mut path.rng,
             &mut path.tracking_steps,
             scene.settings().max_tracking_steps,
@@ -258,7 +258,10 @@ fn advance<S: Scene, const DEFER_SCATTER: bool>(scene: &S, path: &mut PathState)
                 }
                 scatter(scene, path, p, None);
             }
-            FreeFlight::Escaped => interact_with_boundary(scene, path, exit),
+            FreeFlight::Escaped => {
+                let exit = scene.bounds().exit(&path.ray);
+                interact_with_boundary(scene, path, exit)
+            }
             FreeFlight::OutOfSteps => path.truncate(Truncation::TrackingSteps),
         }
     } else {
@@ -356,11 +359,10 @@ fn next_event_estimate<S: Scene>(scene: &S, path: &mut PathState, p: Vec3) -> bo
     };
     let phase = scene.phase().eval(path.ray.dir, light.dir);
     let shadow = Ray::new(p, light.dir);
-    let exit = scene.bounds().exit(&shadow);
     let Some(transmittance) = ratio_tracking(
         scene.medium(),
         &shadow,
-        exit.t,
+        scene.bounds().exit_distance(&shadow),
         &mut path.rng,
         &mut path.tracking_steps,
         scene.settings().max_tracking_steps,

@@ -284,6 +284,50 @@ fn exit_agrees_with_f64_slab_test() {
     }
 }
 
+/// The free flight's distance (`exit_distance`) is `exit(ray).t` bit for bit (paths take the
+/// same branches whichever they use): inside, from faces, edges and corners, pointing out, and
+/// along axes with signed zeros.
+#[test]
+fn exit_distance_is_the_exit_hits_distance() {
+    let b = unit_box();
+    let mut rng = TestRng::new(24);
+    let mut rays = Vec::new();
+    for _ in 0..20_000 {
+        let origin = Vec3::new(
+            rng.range(-1.0, 1.0) as f32,
+            rng.range(-2.0, 2.0) as f32,
+            rng.range(0.0, 4.0) as f32,
+        );
+        rays.push(Ray::new(origin, rng.unit_vector()));
+        let (_, _, p) = random_face_point(&b, &mut rng);
+        rays.push(Ray::new(p, rng.unit_vector()));
+    }
+    let corners = [
+        b.min,
+        b.max,
+        Vec3::new(-1.0, -2.0, 2.0),
+        Vec3::new(0.0, 0.0, 2.0),
+    ];
+    for origin in corners {
+        for a in 0..3 {
+            for sign in [1.0f32, -1.0] {
+                for z in [0.0f32, -0.0] {
+                    let mut dir = Vec3::splat(z);
+                    dir[a] = sign;
+                    rays.push(Ray::new(origin, dir));
+                }
+            }
+        }
+    }
+    for ray in &rays {
+        assert_eq!(
+            b.exit_distance(ray).to_bits(),
+            b.exit(ray).t.to_bits(),
+            "{ray:?}"
+        );
+    }
+}
+
 #[test]
 fn exit_from_the_surface() {
     let b = unit_box();

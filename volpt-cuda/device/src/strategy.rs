@@ -274,19 +274,21 @@ unsafe fn regeneration<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, refill: Ref
     let mut path = PathState::from_camera(scene, 0, 0, 0, lp.seed);
     let mut pixel = 0u32;
     let mut active = false;
+    // Warp-uniform: the launch's paths are all handed out. From then on the warp only steps its
+    // paths to their ends, without the refill's votes: that tail sets the pace of the launch's
+    // last, longest paths (docs/strategies.md).
     let mut exhausted = false;
     loop {
-        // Refill: the lanes without a path take consecutive indices with one atomic per warp.
-        let need = refill.ready(lp, active, exhausted) && !active && !exhausted;
-        // SAFETY: `next_path` is one `u64` (the caller's contract).
-        if let Some(index) = unsafe { warp_take_indices(need, next_path) } {
-            if need {
-                if index < lp.total_paths {
+        if !exhausted {
+            // Refill: the lanes without a path take consecutive indices with one atomic per warp.
+            let need = refill.ready(lp, active, false) && !active;
+            // SAFETY: `next_path` is one `u64` (the caller's contract).
+            if let Some(index) = unsafe { warp_take_indices(need, next_path) } {
+                if need && index < lp.total_paths {
                     Slot { path, pixel } = start_path(scene, lp, pixels, index);
                     active = true;
-                } else {
-                    exhausted = true;
                 }
+                exhausted = ballot(need && index >= lp.total_paths) != 0;
             }
         }
         if ballot(active) == 0 {
