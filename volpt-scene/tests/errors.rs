@@ -521,3 +521,71 @@ fn bad_lookat_is_named() {
     let err = error_at(&text, "<lookat");
     message_of(&err, &["<lookat target>", "different from the origin"]);
 }
+
+/// The limits of values that may be zero but not negative sit exactly at zero: a black
+/// environment and a zero medium scale load, a negative scale and a zero focal length do not.
+#[test]
+fn zero_is_the_edge_of_non_negative_and_positive_values() {
+    let black = cube_scene(
+        "        <bsdf type=\"null\"/>\n        <medium type=\"homogeneous\" name=\"interior\"/>",
+    )
+    .replace(
+        "</scene>",
+        "<emitter type=\"constant\"><rgb name=\"radiance\" value=\"0\"/></emitter>\n</scene>",
+    );
+    let (_dir, path) = scene_file(&black);
+    load_mitsuba(&path).expect("a black environment loads");
+    let scaled = |scale: &str| {
+        medium_scene(&format!(
+            "<medium type=\"homogeneous\" name=\"interior\"><float name=\"scale\" value=\"{scale}\"/></medium>"
+        ))
+    };
+    let (_dir, path) = scene_file(&scaled("0"));
+    load_mitsuba(&path).expect("scale 0 loads");
+    let err = error_at(&scaled("-1"), "name=\"scale\"");
+    message_of(&err, &["scale", ">= 0"]);
+    let focal = cube_scene("        <bsdf type=\"null\"/>").replace(
+        "<float name=\"fov\" value=\"40\"/>",
+        "<string name=\"focal_length\" value=\"0mm\"/>",
+    );
+    let err = error_at(&focal, "focal_length");
+    message_of(&err, &["focal_length", "positive length"]);
+}
+
+/// `<srgb>` decodes the sRGB curve's linear toe (values <= 0.04045 divide by 12.92) as well as its
+/// power segment.
+#[test]
+fn srgb_decodes_the_linear_toe_and_the_power_curve() {
+    let (_dir, path) = scene_file(&medium_scene(
+        r#"<medium type="homogeneous" name="interior"><srgb name="albedo" value="0.02, 0.5, 1"/></medium>"#,
+    ));
+    let scene = load_mitsuba(&path).expect("scene loads");
+    let volpt_scene::AlbedoDesc::Constant(rgb) = scene.medium.albedo else {
+        panic!(
+            "expected a constant albedo, found {:?}",
+            scene.medium.albedo
+        );
+    };
+    let expected = [0.02 / 12.92, ((0.5f64 + 0.055) / 1.055).powf(2.4), 1.0];
+    for (got, want) in rgb.iter().zip(expected) {
+        assert!((*got as f64 - want).abs() < 1e-6, "{rgb:?} vs {expected:?}");
+    }
+}
+
+/// Character data the loader cannot use is an error at its line, as is invalid UTF-8 (at the line
+/// of the first bad byte).
+#[test]
+fn cdata_and_invalid_utf8_are_errors_at_their_lines() {
+    let text = cube_scene("        <bsdf type=\"null\"/>")
+        .replace("<shape", "<![CDATA[ stray text ]]>\n    <shape");
+    let err = error_at(&text, "CDATA");
+    message_of(&err, &["CDATA"]);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.xml");
+    let mut bytes =
+        b"<scene version=\"3.0.0\">\n<!-- line 2 -->\n<!-- \xff -->\n</scene>\n".to_vec();
+    bytes.shrink_to_fit();
+    std::fs::write(&path, &bytes).unwrap();
+    let err = load_mitsuba(&path).expect_err("invalid UTF-8 is an error");
+    message_of(&err, &["scene.xml:3"]);
+}

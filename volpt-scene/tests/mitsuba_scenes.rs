@@ -232,6 +232,42 @@ fn cube_rotated_by_90_degrees_is_still_a_box() {
     );
 }
 
+/// `<rotate>` about an arbitrary (unnormalised) axis is the rotation by Rodrigues' formula,
+/// `R = cos(a) I + sin(a) [k]x + (1 - cos(a)) k k^T`, computed here in f64 for the sensor's
+/// `to_world` (axis-aligned rotations, elsewhere, leave the off-diagonal terms at zero).
+#[test]
+fn rotate_about_any_axis_is_rodrigues_rotation() {
+    for (axis, angle) in [
+        ([0.3, -0.5, 0.8], 37.0),
+        ([-2.0, 1.0, 0.5], -120.0),
+        ([1.0, 1.0, 1.0], 200.0),
+    ] {
+        let rotate = format!(
+            r#"<transform name="to_world"><rotate x="{}" y="{}" z="{}" angle="{angle}"/></transform>"#,
+            axis[0], axis[1], axis[2]
+        );
+        let text = cube_scene("        <bsdf type=\"null\"/>\n        <medium type=\"homogeneous\" name=\"interior\"/>")
+            .replace(
+                r#"<float name="fov" value="40"/>"#,
+                &format!(r#"<float name="fov" value="40"/>{rotate}"#),
+            );
+        let (_dir, path) = scene_file(&text);
+        let scene = load_mitsuba(&path).expect("scene loads");
+        let norm = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2] as f64).sqrt();
+        let k = axis.map(|v: f64| v / norm);
+        let (s, c) = (angle as f64).to_radians().sin_cos();
+        let cross = [[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]];
+        let mut expected = volpt_scene::IDENTITY;
+        for i in 0..3 {
+            for j in 0..3 {
+                let identity = if i == j { 1.0 } else { 0.0 };
+                expected[i][j] = (c * identity + s * cross[i][j] + (1.0 - c) * k[i] * k[j]) as f32;
+            }
+        }
+        assert_matrix(&scene.camera.to_world, &expected);
+    }
+}
+
 #[test]
 fn matrix_transform_is_row_major() {
     let (_dir, path) = scene_file(&bsdf_scene(r#"<bsdf type="null"/>"#).replace(
