@@ -589,3 +589,16 @@ fn cdata_and_invalid_utf8_are_errors_at_their_lines() {
     let err = load_mitsuba(&path).expect_err("invalid UTF-8 is an error");
     message_of(&err, &["scene.xml:3"]);
 }
+
+/// A long quoted value is cut at a character boundary at or below the limit, never inside a
+/// multi-byte character.
+#[test]
+fn excerpt_cuts_long_text_at_a_character_boundary() {
+    use volpt_scene::error::{excerpt, MAX_QUOTED_BYTES};
+    let text = format!("a{}", "é".repeat(150));
+    assert_eq!(text.len(), 301);
+    assert!(!text.is_char_boundary(MAX_QUOTED_BYTES));
+    let cut = excerpt(&text);
+    assert_eq!(cut, format!("a{}... (301 bytes in all)", "é".repeat(99)));
+    assert_eq!(excerpt("short"), "short");
+}
