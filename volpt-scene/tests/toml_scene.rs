@@ -160,3 +160,59 @@ fn unknown_extension_is_an_error() {
         .to_string();
     assert!(err.contains(".toml"), "{err}");
 }
+
+/// Values just inside each limit load, the limits themselves do not: `g` in (-1, 1), a positive
+/// roughness, a field of view in (0, 180), a depth >= 0.
+#[test]
+fn values_inside_the_limits_load_and_the_limits_do_not() {
+    let (_dir, path) = scene("[phase]\ng = -0.5\n[integrator]\nmax_depth = 5\n");
+    let desc = load(&path, Config::default()).unwrap();
+    assert_eq!(desc.medium.phase, PhaseDesc::HenyeyGreenstein { g: -0.5 });
+    assert_eq!(desc.integrator.max_depth, Some(5));
+    assert!(error("[phase]\ng = -1.0\n").contains("phase.g"));
+    for alpha in ["0.0", "-0.1"] {
+        let err = error(&format!("[boundary]\nalpha = {alpha}\n"));
+        assert!(err.contains("boundary.alpha"), "alpha {alpha}: {err}");
+    }
+    let err = error("[camera]\nfov = 0.0\n");
+    assert!(err.contains("camera.fov"), "{err}");
+}
+
+/// The camera: the thesis's field of view by default, and Mitsuba's `lookat` frame (+z towards
+/// the target, +y up, +x to the image's left) built here in f64 for an oblique view.
+#[test]
+fn camera_frame_is_mitsubas_lookat() {
+    let (_dir, path) = scene("");
+    assert_eq!(
+        load(&path, Config::default()).unwrap().camera.fov_degrees,
+        0.7
+    );
+    let (origin, target, up) = ([3.0, 4.0, 12.0], [1.0, -1.0, 0.5], [0.2, 1.0, 0.1]);
+    let (_dir, path) = scene(&format!(
+        "[camera]\norigin = {origin:?}\ntarget = {target:?}\nup = {up:?}\n"
+    ));
+    let to_world = load(&path, Config::default()).unwrap().camera.to_world;
+    let normalize = |v: [f64; 3]| {
+        let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        v.map(|c| c / n)
+    };
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let forward = normalize([0, 1, 2].map(|i| target[i] - origin[i]));
+    let left = normalize(cross(up, forward));
+    let new_up = cross(forward, left);
+    for i in 0..3 {
+        let expected = [left[i], new_up[i], forward[i], origin[i]];
+        for (j, want) in expected.into_iter().enumerate() {
+            assert!(
+                (to_world[i][j] as f64 - want).abs() < 1e-5,
+                "row {i} column {j}: {to_world:?}"
+            );
+        }
+    }
+}
