@@ -253,9 +253,10 @@ fn rotate_about_any_axis_is_rodrigues_rotation() {
             );
         let (_dir, path) = scene_file(&text);
         let scene = load_mitsuba(&path).expect("scene loads");
-        let norm = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2] as f64).sqrt();
-        let k = axis.map(|v: f64| v / norm);
-        let (s, c) = (angle as f64).to_radians().sin_cos();
+        let axis: [f64; 3] = axis;
+        let norm = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+        let k = axis.map(|v| v / norm);
+        let (s, c) = f64::to_radians(angle).sin_cos();
         let cross = [[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]];
         let mut expected = volpt_scene::IDENTITY;
         for i in 0..3 {
