@@ -270,8 +270,8 @@ fn rotate_about_any_axis_is_rodrigues_rotation() {
 }
 
 /// `<lookat>` for an oblique view is Mitsuba's frame (+z towards the target, +y up, +x to the
-/// image's left), built here in f64 (the other scenes look along a coordinate axis, where one
-/// component of each cross product vanishes).
+/// image's left), against the frame built in f64 (`assert_lookat_frame`; the other scenes look
+/// along a coordinate axis, where one component of each cross product vanishes).
 #[test]
 fn oblique_lookat_is_mitsubas_frame() {
     let (origin, target, up) = ([3.0, 4.0, 12.0], [1.0, -1.0, 0.5], [0.2, 1.0, 0.1]);
@@ -285,31 +285,7 @@ fn oblique_lookat_is_mitsubas_frame() {
     );
     let (_dir, path) = scene_file(&text);
     let to_world = load_mitsuba(&path).expect("scene loads").camera.to_world;
-    let normalize = |v: [f64; 3]| {
-        let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-        v.map(|c| c / n)
-    };
-    let cross = |a: [f64; 3], b: [f64; 3]| {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    };
-    let forward = normalize([0, 1, 2].map(|i| target[i] - origin[i]));
-    let left = normalize(cross(up, forward));
-    let new_up = cross(forward, left);
-    for i in 0..3 {
-        for (j, want) in [left[i], new_up[i], forward[i], origin[i]]
-            .into_iter()
-            .enumerate()
-        {
-            assert!(
-                (to_world[i][j] as f64 - want).abs() < 1e-5,
-                "row {i} column {j}: {to_world:?}"
-            );
-        }
-    }
+    assert_lookat_frame(&to_world, origin, target, up);
 }
 
 #[test]

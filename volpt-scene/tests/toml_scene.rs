@@ -1,7 +1,10 @@
 //! volpt TOML scene files: what they load to, and one clear error per kind of mistake.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
+use common::assert_lookat_frame;
 use volpt_scene::{
     builder_for, AlbedoDesc, BsdfDesc, Config, DensityDesc, PhaseDesc, SceneAssembler, SceneError,
 };
@@ -179,7 +182,8 @@ fn values_inside_the_limits_load_and_the_limits_do_not() {
 }
 
 /// The camera: the thesis's field of view by default, and Mitsuba's `lookat` frame (+z towards
-/// the target, +y up, +x to the image's left) built here in f64 for an oblique view.
+/// the target, +y up, +x to the image's left) for an oblique view, against the frame built in
+/// f64 (`assert_lookat_frame`).
 #[test]
 fn camera_frame_is_mitsubas_lookat() {
     let (_dir, path) = scene("");
@@ -192,27 +196,5 @@ fn camera_frame_is_mitsubas_lookat() {
         "[camera]\norigin = {origin:?}\ntarget = {target:?}\nup = {up:?}\n"
     ));
     let to_world = load(&path, Config::default()).unwrap().camera.to_world;
-    let normalize = |v: [f64; 3]| {
-        let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-        v.map(|c| c / n)
-    };
-    let cross = |a: [f64; 3], b: [f64; 3]| {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    };
-    let forward = normalize([0, 1, 2].map(|i| target[i] - origin[i]));
-    let left = normalize(cross(up, forward));
-    let new_up = cross(forward, left);
-    for i in 0..3 {
-        let expected = [left[i], new_up[i], forward[i], origin[i]];
-        for (j, want) in expected.into_iter().enumerate() {
-            assert!(
-                (to_world[i][j] as f64 - want).abs() < 1e-5,
-                "row {i} column {j}: {to_world:?}"
-            );
-        }
-    }
+    assert_lookat_frame(&to_world, origin, target, up);
 }

@@ -114,3 +114,38 @@ pub fn assert_matrix(a: &[[f32; 4]; 4], b: &[[f32; 4]; 4]) {
         }
     }
 }
+
+/// `to_world` is Mitsuba's `lookat` frame for `origin`, `target` and `up` (+z towards the target,
+/// +y up, +x to the image's left), built here in f64 independently of the loaders' f32 code.
+pub fn assert_lookat_frame(
+    to_world: &[[f32; 4]; 4],
+    origin: [f64; 3],
+    target: [f64; 3],
+    up: [f64; 3],
+) {
+    let normalize = |v: [f64; 3]| {
+        let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        v.map(|c| c / n)
+    };
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let forward = normalize([0, 1, 2].map(|i| target[i] - origin[i]));
+    let left = normalize(cross(up, forward));
+    let new_up = cross(forward, left);
+    for i in 0..3 {
+        for (j, want) in [left[i], new_up[i], forward[i], origin[i]]
+            .into_iter()
+            .enumerate()
+        {
+            assert!(
+                (to_world[i][j] as f64 - want).abs() < 1e-5,
+                "row {i} column {j}: {to_world:?}"
+            );
+        }
+    }
+}
