@@ -332,3 +332,95 @@ fn appended_data_that_ends_early_is_an_error_not_a_panic() {
     let p = problem(&path, None);
     assert!(matches!(p, GridProblem::Decode { .. }), "{p}");
 }
+
+/// The legacy prescan names the line of the declaration it refuses (line 9: the head takes four
+/// lines).
+#[test]
+fn a_refused_legacy_declaration_names_its_line() {
+    let text = format!(
+        "{LEGACY_HEAD}DIMENSIONS 2 1 1\nORIGIN 0 0 0\nSPACING 1 1 1\n\
+         POINT_DATA 2\nSCALARS d float 1000\nLOOKUP_TABLE default\n0 1\n"
+    );
+    let (_dir, path) = text_file("wide.vtk", &text);
+    let p = problem(&path, None);
+    assert!(
+        p.to_string()
+            .contains("line 9: SCALARS declares 2000 values"),
+        "{p}"
+    );
+}
+
+/// An explicit identity `Direction` is an axis-aligned grid (any other matrix is refused, see
+/// `malformed_and_unsupported_files`).
+#[test]
+fn an_identity_direction_is_accepted() {
+    let xml = std::fs::read_to_string(fixture("tiny_ascii.vti")).unwrap();
+    let aligned = xml.replace(
+        "Spacing=\"1 2 3\"",
+        "Spacing=\"1 2 3\" Direction=\"1 0 0  0 1 0  0 0 1\"",
+    );
+    let (_dir, path) = text_file("aligned.vti", &aligned);
+    let grid = read_vtk(&path, None).expect("identity direction");
+    assert_eq!(grid, read_vtk(&fixture("tiny_ascii.vti"), None).unwrap());
+}
+
+/// A piece's extent is checked like the whole extent: a huge one is refused before vtkio
+/// reserves memory for it.
+#[test]
+fn a_huge_piece_extent_is_refused_before_vtkio_reads_it() {
+    let text = std::fs::read_to_string(fixture("tiny_ascii.vti"))
+        .unwrap()
+        .replace(
+            "Piece Extent=\"1 2 0 1 0 0\"",
+            "Piece Extent=\"0 99999 0 99999 0 99999\"",
+        );
+    let (_dir, path) = text_file("huge_piece.vti", &text);
+    let p = problem(&path, None);
+    assert!(matches!(p, GridProblem::TooLarge { .. }), "{p}");
+}
+
+/// A `DataArray` without `NumberOfTuples` has one tuple per point of its piece: 3 components x
+/// 200 points declare 600 values, more than this file's bytes, where one tuple would be 3.
+#[test]
+fn an_array_without_a_tuple_count_has_one_tuple_per_point() {
+    let text = "<?xml version=\"1.0\"?>\n\
+        <VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\">\n\
+        <ImageData WholeExtent=\"0 9 0 9 0 1\" Origin=\"0 0 0\" Spacing=\"1 1 1\">\n\
+        <Piece Extent=\"0 9 0 9 0 1\"><PointData>\n\
+        <DataArray type=\"UInt8\" Name=\"d\" NumberOfComponents=\"3\" format=\"ascii\">0 0 0\
+        </DataArray>\n</PointData></Piece></ImageData></VTKFile>\n";
+    // The extent's 200 points fit the file's bytes; 600 values do not.
+    assert!((200..600).contains(&text.len()), "{}", text.len());
+    let (_dir, path) = text_file("short.vti", text);
+    let p = problem(&path, None);
+    assert!(
+        p.to_string().contains("DataArray declares 600 values"),
+        "{p}"
+    );
+}
+
+/// A bare grid file renders in the unit cube: its box (2 x 1 x 4 here) scaled so that the longest
+/// side is 1, centred at the origin, aspect kept.
+#[test]
+fn a_bare_grid_file_is_fitted_into_the_unit_cube() {
+    let dir = TempDir::new().unwrap();
+    let path = dir.path().join("tall.vti");
+    let mut g = grid([2, 1, 4], 1);
+    g.bounds = Bounds {
+        min: [3.0, -1.0, 0.0],
+        max: [5.0, 0.0, 4.0],
+    };
+    write_vtk(&path, &g, "d").unwrap();
+    let desc = volpt_scene::SceneAssembler::new(volpt_scene::Config::default())
+        .assemble(volpt_scene::builder_for(&path).unwrap().as_ref())
+        .expect("a grid file loads");
+    let fitted = Bounds {
+        min: [-0.25, -0.125, -0.5],
+        max: [0.25, 0.125, 0.5],
+    };
+    assert_close(desc.boundary.bounds, fitted);
+    let volpt_scene::DensityDesc::Grid(density) = &desc.medium.density else {
+        panic!("a grid file gives a grid density");
+    };
+    assert_close(density.bounds, fitted);
+}

@@ -103,4 +103,18 @@ mod tests {
         assert!(box_from_corners(&flat).is_none());
         assert!(box_from_corners(&[]).is_none());
     }
+
+    /// The tolerance scales with the box: a box 1e-4 across is a box, and so is one 1e4 across
+    /// whose corners are off by a relative 1e-6 (1e-2), as a mesh's rounded corners are.
+    #[test]
+    fn tolerance_is_relative_to_the_box_size() {
+        let small = box_from_corners(&cube_corners(0.0, 1e-4)).expect("a small box");
+        assert_eq!(small.max, [1e-4; 3]);
+        let mut large = cube_corners(-5e3, 5e3);
+        large[3][0] += 1e-2;
+        large[5][2] -= 1e-2;
+        assert!(box_from_corners(&large).is_some());
+        large[6][1] += 1.0;
+        assert!(box_from_corners(&large).is_none());
+    }
 }

@@ -1,0 +1,55 @@
+//! `numerics`: the check that `f32` positions resolve the medium's mean free path, on the largest
+//! extinction (scale x largest density) of descriptions changed in code.
+
+mod common;
+
+use common::*;
+use volpt_scene::numerics::{check_position_resolution, max_extinction};
+use volpt_scene::*;
+
+/// A homogeneous medium in the cube [-1, 1]^3: positions near 1 are 2^-23 apart.
+fn base() -> SceneDescription {
+    let (_dir, path) = scene_file(&medium_scene(
+        r#"<medium type="homogeneous" name="interior"/>"#,
+    ));
+    load_mitsuba(&path).expect("scene loads")
+}
+
+#[test]
+fn the_largest_extinction_is_the_scale_times_the_largest_density() {
+    let mut desc = base();
+    desc.medium.scale = 3.0;
+    desc.medium.density = DensityDesc::Constant(5.0);
+    assert_eq!(max_extinction(&desc.medium), 15.0);
+    desc.medium.density = DensityDesc::Grid(GridDesc {
+        resolution: [2, 1, 1],
+        channels: 1,
+        bounds: unit_bounds(),
+        convention: GridConvention::Cell,
+        data: vec![0.5, 4.0],
+    });
+    assert_eq!(max_extinction(&desc.medium), 12.0);
+}
+
+/// In [-1, 1]^3 the mean free path must span 16 spacings of 2^-23: an extinction of at most
+/// 2^19 = 1024 x 512, met exactly. 1024 x 513 is refused, where a sum of the factors would pass;
+/// the message names the box's largest coordinate and the largest extinction it allows.
+#[test]
+fn the_mean_free_path_must_span_sixteen_position_steps() {
+    let mut desc = base();
+    let source = std::path::Path::new("scene.xml");
+    desc.medium.scale = 1024.0;
+    desc.medium.density = DensityDesc::Constant(512.0);
+    check_position_resolution(&desc, source).expect("a mean free path of exactly 16 steps");
+    desc.medium.density = DensityDesc::Constant(513.0);
+    let err = check_position_resolution(&desc, source).expect_err("under 16 steps");
+    message_of(
+        &err,
+        &[
+            "scene.xml",
+            "coordinates up to ~1.000e0 are 1.192e-7 apart",
+            "an extinction of at most 5.243e5",
+            "a largest extinction of 5.25312e5",
+        ],
+    );
+}
