@@ -56,9 +56,15 @@ enum Command {
     Compare(compare::CompareArgs),
     /// Error against time for each setting: progressive renders, CSV, SVG and PNG plots, a table.
     Converge(converge::ConvergeArgs),
-    /// Test the GPU strategies' collective building blocks (block scan, warp and block index
-    /// takers) on the GPU against plain CPU implementations.
-    Selftest,
+    /// Test the GPU strategies' collective building blocks (block scan and sort, warp and block
+    /// index takers, texture lookups) and the kernels' math functions on the GPU against plain
+    /// CPU implementations.
+    Selftest {
+        /// Which kernels: `exact` must give the CPU's bits, `fast` the documented accuracy of
+        /// its approximate instructions.
+        #[arg(long, value_enum, default_value_t = volpt_cuda::Math::Exact)]
+        math: volpt_cuda::Math,
+    },
     /// Plot a `volpt converge` run again from the converge.csv in DIR (SVG and PNG).
     Plot {
         dir: PathBuf,
@@ -436,7 +442,7 @@ fn main() -> Result<()> {
         }
         Command::Compare(args) => compare::run(&args),
         Command::Converge(args) => converge::run(&args),
-        Command::Selftest => selftest(),
+        Command::Selftest { math } => selftest(math),
         Command::Plot { dir, title } => {
             let title = title.unwrap_or_else(|| export_name(&dir));
             converge::replot(&dir, &title)
@@ -678,8 +684,8 @@ fn bench_command(args: BenchArgs) -> Result<()> {
     Ok(())
 }
 
-fn selftest() -> Result<()> {
-    let renderer = volpt_cuda::CudaRenderer::new(0, volpt_cuda::Math::Exact)?;
+fn selftest(math: volpt_cuda::Math) -> Result<()> {
+    let renderer = volpt_cuda::CudaRenderer::new(0, math)?;
     let mut failed = 0;
     for test in renderer.selftest()? {
         if test.failures.is_empty() {

@@ -12,6 +12,9 @@
 //! dependent instructions that sets the pace of a launch's last, longest paths), for arguments
 //! that a renderer's sampled quantities do not reach or that round to nothing it would see.
 
+/// Whether this build computes with the GPU's approximate instructions (the fast kernels).
+pub const FAST: bool = cfg!(all(target_arch = "nvptx64", volpt_fast_math));
+
 pub const PI: f32 = core::f32::consts::PI;
 pub const INV_PI: f32 = core::f32::consts::FRAC_1_PI;
 pub const INV_4PI: f32 = 0.25 * core::f32::consts::FRAC_1_PI;

@@ -2,8 +2,11 @@
 //! random inputs with the corner cases (every, no, one and only the last thread of a block
 //! active): the block-wide exclusive count of streaming's compaction, the block-wide radix sort of
 //! the sorting strategies (Morton keys, ended paths as the largest key, ties) and the warp and
-//! block index takers of regeneration (`volpt_device::selftest`); and grid lookups through textures against
-//! the CPU's reproduction of the texture unit's filter.
+//! block index takers of regeneration (`volpt_device::selftest`); grid lookups through textures against
+//! the CPU's reproduction of the texture unit's filter; and `volpt_core::math` as the loaded kernels
+//! compile it ([`math`]: the CPU's bits, or the fast kernels' documented accuracy).
+
+pub mod math;
 
 use cudarc::driver::{CudaSlice, LaunchConfig, PushKernelArg};
 use volpt_core::abi::GridParams;
@@ -220,7 +223,52 @@ impl CudaRenderer {
             results.push(self.texture_lookups::<3>(texel, Samples::Random)?);
             results.push(self.texture_lookups::<1>(texel, Samples::Constant)?);
         }
+        results.push(self.math_functions()?);
         Ok(results)
+    }
+
+    /// Runs `volpt_core::math`'s functions on the GPU ([`math`]) and compares with the CPU's bits
+    /// or, if the kernels say they are the fast build, with the true values.
+    fn math_functions(&self) -> Result<SelfTest, CudaError> {
+        use volpt_device::selftest::MATH_OUTPUTS;
+        const N: usize = 1 << 16;
+        let stream = self.stream();
+        let inputs = math::inputs(N);
+        let input = stream.clone_htod(&inputs).doing("copying test input")?;
+        let mut out: CudaSlice<f32> = stream
+            .alloc_zeros(MATH_OUTPUTS * N)
+            .doing("allocating test output")?;
+        let mut fast: CudaSlice<u32> = stream.alloc_zeros(1).doing("allocating a flag")?;
+        let kernel = self.kernel("selftest__math_functions", None)?;
+        let config = LaunchConfig {
+            grid_dim: ((N as u32).div_ceil(BLOCK_SIZE), 1, 1),
+            block_dim: (BLOCK_SIZE, 1, 1),
+            shared_mem_bytes: 0,
+        };
+        // SAFETY: three inputs and seven outputs per thread below N, one flag.
+        unsafe {
+            stream
+                .launch_builder(&kernel)
+                .arg(&input)
+                .arg(&mut out)
+                .arg(&mut fast)
+                .arg(&(N as u32))
+                .launch(config)
+        }
+        .doing("launching a selftest")?;
+        let got = stream.clone_dtoh(&out).doing("reading test output")?;
+        let fast = stream.clone_dtoh(&fast).doing("reading the flag")?[0] != 0;
+        let (failures, measured) = math::check(&inputs, &got, fast);
+        Ok(SelfTest {
+            name: if fast {
+                "math functions (fast kernels)"
+            } else {
+                "math functions (exact kernels)"
+            },
+            threads: N,
+            failures,
+            measured,
+        })
     }
 
     /// Runs the selftest kernel `entry`, which reads one `u32` of `input` per thread and writes two,

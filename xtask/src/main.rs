@@ -4,6 +4,10 @@
 //!   (`volpt-kernels`), written to `volpt-cuda/ptx/volpt_kernels.ptx` and, built with fast math,
 //!   `volpt_kernels_fast.ptx`, which `volpt-cuda` embeds at its next build; any other kernels crate of the workspace (a library user's, see
 //!   `docs/extending.md`) to `<its directory>/ptx/<crate>.ptx`.
+//! - `ptx-selftests DIR`: only the selftest kernels of `volpt-kernels` (`--cfg
+//!   volpt_selftests_only`), fast math, to `DIR/selftests_fast.ptx`: what `volpt selftest` needs
+//!   (through `VOLPT_PTX`) to judge a mutant of volpt-core's GPU-only code in a minute instead
+//!   of a full build (`scripts/gpu-mutants.sh`).
 //! - `device-bundle`: the PTX, a release `volpt` with it embedded, the library-user example and its
 //!   PTX, the scenes, the third-party data and the device scripts (`bench/device/*.sh`), in
 //!   `bundle/` (git-ignored), ready to carry to the GPU machine.
@@ -20,9 +24,22 @@ fn main() -> Result<()> {
             let package = std::env::args().nth(2);
             ptx(package.as_deref().unwrap_or(KERNELS)).map(|_| ())
         }
+        Some("ptx-selftests") => {
+            let Some(dir) = std::env::args().nth(2) else {
+                bail!("usage: cargo xtask ptx-selftests DIR");
+            };
+            let built = ptx_build(KERNELS, Flavour::Fast, Only::Selftests)?;
+            let dir = PathBuf::from(dir);
+            std::fs::create_dir_all(&dir)?;
+            let out = dir.join("selftests_fast.ptx");
+            std::fs::copy(&built, &out)
+                .with_context(|| format!("copying {} to {}", built.display(), out.display()))?;
+            eprintln!("xtask: selftest kernels -> {}", out.display());
+            Ok(())
+        }
         Some("device-bundle") => device_bundle(),
         _ => {
-            eprintln!("usage: cargo xtask <ptx [PACKAGE]|device-bundle>");
+            eprintln!("usage: cargo xtask <ptx [PACKAGE]|ptx-selftests DIR|device-bundle>");
             std::process::exit(2)
         }
     }
@@ -66,9 +83,17 @@ const EXAMPLE_KERNELS: &str = "volpt-example-smooth-ball-kernels";
 /// crate is built twice, exact and fast (`--math fast`), and the path of the exact PTX returned.
 fn ptx(package: &str) -> Result<PathBuf> {
     if package == KERNELS {
-        ptx_build(package, Flavour::Fast)?;
+        ptx_build(package, Flavour::Fast, Only::All)?;
     }
-    ptx_build(package, Flavour::Exact)
+    ptx_build(package, Flavour::Exact, Only::All)
+}
+
+/// Which kernels of the crate: all, or (`volpt-kernels` only) the selftests alone, built apart
+/// and not written where `volpt-cuda` embeds its PTX.
+#[derive(Clone, Copy, PartialEq)]
+enum Only {
+    All,
+    Selftests,
 }
 
 /// The kernels' arithmetic (`volpt_device::Math`).
@@ -86,7 +111,7 @@ enum Flavour {
 ///
 /// The fast flavour sets `volpt_fast_math` (approximate `lg2`, `ex2`, `sqrt` in `volpt_core::math`)
 /// and lets LLVM's NVPTX backend use approximate division and square roots and fuse multiply-adds.
-fn ptx_build(package: &str, flavour: Flavour) -> Result<PathBuf> {
+fn ptx_build(package: &str, flavour: Flavour, only: Only) -> Result<PathBuf> {
     ensure_rust_src()?;
     let root = root();
     let (target_dir, flags, suffix) = match flavour {
@@ -98,12 +123,16 @@ fn ptx_build(package: &str, flavour: Flavour) -> Result<PathBuf> {
             "_fast",
         ),
     };
+    let (target_dir, only_flag) = match only {
+        Only::All => (target_dir, ""),
+        Only::Selftests => (target_dir.join("selftests"), " --cfg volpt_selftests_only"),
+    };
     run(Command::new(env!("CARGO"))
         .current_dir(&root)
         .env("RUSTC_BOOTSTRAP", "1")
         .env(
             "CARGO_TARGET_NVPTX64_NVIDIA_CUDA_RUSTFLAGS",
-            format!("-C target-cpu=sm_70 --emit=asm{flags}"),
+            format!("-C target-cpu=sm_70 --emit=asm{flags}{only_flag}"),
         )
         .env("CARGO_TARGET_NVPTX64_NVIDIA_CUDA_LINKER", "/bin/true")
         .args([
@@ -121,6 +150,9 @@ fn ptx_build(package: &str, flavour: Flavour) -> Result<PathBuf> {
     let entries = ptx.lines().filter(|l| l.contains(".entry")).count();
     if entries == 0 {
         bail!("{} has no kernel entry points", built.display());
+    }
+    if only == Only::Selftests {
+        return Ok(built);
     }
     let out = if package == KERNELS {
         root.join(format!("volpt-cuda/ptx/volpt_kernels{suffix}.ptx"))

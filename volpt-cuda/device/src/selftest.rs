@@ -6,13 +6,14 @@
 
 /// The selftest kernels' entry points, as [`export_selftests!`](crate::export_selftests) exports
 /// them.
-pub const ENTRIES: [&str; 6] = [
+pub const ENTRIES: [&str; 7] = [
     "selftest__block_exclusive_count",
     "selftest__block_sort",
     "selftest__warp_take_indices",
     "selftest__block_take_indices",
     "selftest__texture_lookups_1",
     "selftest__texture_lookups_3",
+    "selftest__math_functions",
 ];
 
 /// Exports the selftest kernels (the workspace's kernels crate invokes it once).
@@ -82,6 +83,18 @@ macro_rules! export_selftests {
             ) {
                 // SAFETY: forwarded.
                 unsafe { $crate::selftest::texture_lookups::<3>(grid, points, out, n) }
+            }
+            /// # Safety
+            /// As [`volpt_device::selftest::math_functions`].
+            #[export_name = "selftest__math_functions"]
+            pub unsafe extern "ptx-kernel" fn math_functions(
+                inputs: *const f32,
+                out: *mut f32,
+                fast: *mut u32,
+                n: u32,
+            ) {
+                // SAFETY: forwarded.
+                unsafe { $crate::selftest::math_functions(inputs, out, fast, n) }
             }
         };
     };
@@ -193,5 +206,52 @@ pub unsafe fn texture_lookups<const C: usize>(
     for (c, v) in v.into_iter().enumerate() {
         // SAFETY: the caller's contract.
         unsafe { *out.add(C * i + c) = v };
+    }
+}
+
+/// Inputs per thread of [`math_functions`]: `(a, b, u)`.
+pub const MATH_INPUTS: usize = 3;
+/// Outputs per thread of [`math_functions`].
+pub const MATH_OUTPUTS: usize = 7;
+
+/// Thread `i < n` reads `(a, b, u) = inputs[3i..]` and writes `sqrt(a)`, `ln(a)`, `exp(b)`,
+/// `a / b` (`math::div`), `1 / b` (`math::recip`) and `sin_cos_2pi(u)` to `out[7i..]`, through
+/// `volpt_core::math` as this build of the kernels compiles it; thread 0 writes to `*fast`
+/// whether it is the fast-math build.
+///
+/// # Safety
+/// `inputs` must hold `3 n` values, `out` `7 n` and `fast` one.
+#[cfg(target_arch = "nvptx64")]
+#[inline(always)]
+pub unsafe fn math_functions(inputs: *const f32, out: *mut f32, fast: *mut u32, n: u32) {
+    use volpt_core::{math, Vec3};
+
+    use crate::nvptx::global_thread_index;
+    let i = global_thread_index() as usize;
+    if i == 0 {
+        // SAFETY: the caller's contract.
+        unsafe { *fast = u32::from(math::FAST) };
+    }
+    if i >= n as usize {
+        return;
+    }
+    // SAFETY: the caller's contract.
+    let (a, b, u) = unsafe {
+        let p = inputs.add(MATH_INPUTS * i);
+        (*p, *p.add(1), *p.add(2))
+    };
+    let (sin, cos) = math::sin_cos_2pi(u);
+    let values = [
+        math::sqrt(a),
+        math::ln(a),
+        math::exp(b),
+        math::div(Vec3::splat(a), Vec3::splat(b)).x,
+        math::recip(Vec3::splat(b)).x,
+        sin,
+        cos,
+    ];
+    for (k, v) in values.into_iter().enumerate() {
+        // SAFETY: the caller's contract.
+        unsafe { *out.add(MATH_OUTPUTS * i + k) = v };
     }
 }

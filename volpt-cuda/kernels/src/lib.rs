@@ -7,11 +7,13 @@
 //! (`volpt_core::abi::SceneAbi::names`).
 //!
 //! On any target but nvptx64 this crate is empty, so that host builds of the workspace pass.
+//! With `--cfg volpt_selftests_only` (`cargo xtask ptx-selftests`) it exports the selftest
+//! kernels alone: a build in a minute, for judging mutants of volpt-core's GPU-only code.
 #![cfg_attr(target_arch = "nvptx64", no_std)]
 #![cfg_attr(target_arch = "nvptx64", feature(abi_ptx))]
 
 /// `export_kernels!` for each variant of the registry.
-#[cfg(target_arch = "nvptx64")]
+#[cfg(all(target_arch = "nvptx64", not(volpt_selftests_only)))]
 macro_rules! export_registry {
     (axes $axes:tt variants [$([($M:ident, $m:ident, $mt:ty) ($B:ident, $b:ident, $bt:ty)
         ($P:ident, $p:ident, $pt:ty) ($E:ident, $e:ident, $et:ty)])*]) => {$(
@@ -19,7 +21,7 @@ macro_rules! export_registry {
     )*};
 }
 
-#[cfg(target_arch = "nvptx64")]
+#[cfg(all(target_arch = "nvptx64", not(volpt_selftests_only)))]
 volpt_core::variants!('static => export_registry {});
 
 #[cfg(target_arch = "nvptx64")]
