@@ -624,6 +624,52 @@ mod tests {
         }
     }
 
+    /// Each `GridReads` is the lookup it names (the media specialised for it compute nothing
+    /// else): `AnyLayout` reads the grid's own layout and lookup, `DenseTrilinear` the dense
+    /// trilinear lookup, `TextureTrilinear` (on the CPU) the texture unit's filter. Nothing else
+    /// compares them: the renderer's references never render an any-layout medium.
+    #[test]
+    fn each_grid_reads_is_the_lookup_it_names() {
+        let bounds = Aabb::new(Vec3::new(-1.0, 0.5, 2.0), Vec3::new(3.0, 1.5, 2.25));
+        let res = [9, 8, 17];
+        let mapping = GridMapping::cell_centred(bounds, res);
+        let dense: Vec<f32> = (0..res.iter().product::<u32>()).map(hash).collect();
+        let bricked = brick::<1>(&dense, res);
+        let grids = [
+            Grid::<1>::new(&dense, res, mapping),
+            Grid::<1>::new(&dense, res, mapping).with_lookup(GridLookup::Nearest),
+            Grid::<1>::with_layout(&bricked, res, mapping, GridLayout::Bricked),
+        ];
+        let (min, extent) = (bounds.min, bounds.extent());
+        let mut inside = 0;
+        for i in 0..2000u32 {
+            let u = Vec3::new(hash(3 * i), hash(3 * i + 1), hash(3 * i + 2)) * 1.1 - 0.05;
+            let p = min + u * extent;
+            for grid in &grids {
+                assert_eq!(AnyLayout::lookup(grid, p), grid.lookup(p), "{p:?}");
+            }
+            let dense = &grids[0];
+            assert_eq!(
+                DenseTrilinear::lookup(dense, p),
+                dense.lookup_dense_trilinear(p)
+            );
+            assert_eq!(
+                TextureTrilinear::lookup(dense, p),
+                dense.lookup_texture_filter(p)
+            );
+            inside += usize::from(dense.lookup(p)[0] > 0.0);
+        }
+        assert!(inside > 1000, "{inside} lookups were not zero");
+    }
+
+    #[test]
+    fn texel_formats_travel_as_their_codes() {
+        for format in [TexelFormat::F32, TexelFormat::F16] {
+            assert_eq!(TexelFormat::from_u32(format.to_u32()), format);
+        }
+        assert_eq!(TexelFormat::from_u32(7), TexelFormat::F32);
+    }
+
     #[test]
     fn layout_sizes_overflow_cleanly() {
         assert_eq!(GridLayout::Dense.values([2, 3, 4], 3), Some(72));
