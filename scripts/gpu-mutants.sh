@@ -14,7 +14,9 @@
 # kernels are built with it (`cargo xtask ptx-selftests`: fast math, a minute instead of the full
 # kernels' build), and the device script runs `volpt selftest` on each: a mutant is caught when a
 # selftest fails. The unmutated build goes first and must pass. Mutants of these functions that
-# change CPU code too are judged here as well (they are also judged by the CPU tests).
+# change CPU code too are judged here as well (they are also judged by the CPU tests); a mutant
+# whose selftest PTX is byte for byte the unmutated one (it mutates the CPU's side of a cfg) is
+# reported as unreached, for the CPU tests to judge.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 out="$root/${OUT:-bundle-mutants}"
@@ -50,6 +52,12 @@ while read -r id file name; do
     patch --quiet "$file" "$out/$id.diff"
     if cargo xtask ptx-selftests "$out/$id" >"$out/$id.log" 2>&1; then
         rm "$out/$id.log"
+        # A mutant of a branch the fast kernels do not compile (the CPU's and the exact
+        # kernels' side of a cfg) leaves their PTX as it was: the CPU tests judge it.
+        if cmp -s "$out/$id/selftests_fast.ptx" "$out/baseline/selftests_fast.ptx"; then
+            touch "$out/$id/unreached"
+            echo "unreached: the fast kernels' PTX is unchanged"
+        fi
     else
         echo "unviable: the selftest kernels do not build (see $id.log)"
     fi

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Judges the mutants of volpt-core's GPU-only code that scripts/gpu-mutants.sh built (one
 # selftest PTX each, in DIR): `volpt selftest` with each PTX (`VOLPT_PTX`); a mutant is caught
-# when a selftest fails, missed when all pass. The unmutated build (DIR/baseline) must pass
-# first, and so must the bundle's own exact and fast kernels.
+# when a selftest fails, missed when all pass, unreached when its PTX is the unmutated one (a
+# mutant of the CPU's side of a cfg, which the CPU tests judge). The unmutated build
+# (DIR/baseline) must pass first, and so must the bundle's own exact and fast kernels.
 #   bash bundle/gpu-mutants.sh bundle-mutants   -> $OUT/gpu-mutants.txt, $OUT/gpu-mutants.log
 set -uo pipefail
 dir=$(cd "${1:?usage: gpu-mutants.sh DIR}" && pwd)
@@ -29,12 +30,17 @@ else
     say "FAIL baseline: the unmutated selftest kernels fail, so no mutant can be judged"
     exit 1
 fi
-caught=0 missed=0 unviable=0
+caught=0 missed=0 unviable=0 unreached=0
 while read -r id file name; do
     ptx="$dir/$id/selftests_fast.ptx"
     if [ ! -f "$ptx" ]; then
         say "unviable $name"
         unviable=$((unviable + 1))
+        continue
+    fi
+    if [ -f "$dir/$id/unreached" ]; then
+        say "unreached $name"
+        unreached=$((unreached + 1))
         continue
     fi
     timeout 120 env VOLPT_PTX="$ptx" "$VOLPT" selftest --math fast >"$OUT/one.log" 2>&1
@@ -50,4 +56,4 @@ while read -r id file name; do
     fi
 done <"$dir/mutants.txt"
 rm -f "$OUT/one.log"
-say "GPU-only mutants: $caught caught, $missed missed, $unviable unviable"
+say "GPU-only mutants: $caught caught, $missed missed, $unviable unviable, $unreached unreached"
