@@ -23,8 +23,9 @@ out="$root/${OUT:-bundle-mutants}"
 tree="$root/target/${TREE:-gpu-mutants-tree}"
 FUNCTIONS=${FUNCTIONS:-'^volpt-core/src/(math\.rs:.*(replace (sqrt|ln|exp|div|recip|approx::\w+) ->| in (ln|exp|div|recip|approx::\w+)$)|grid\.rs:.*(TextureTrilinear>::lookup|texture_fetch))'}
 
-if ! cargo mutants --version >/dev/null 2>&1; then
-    cargo install cargo-mutants --locked --version 27.1.0
+version=27.1.0
+if ! cargo mutants --version 2>/dev/null | grep -qF "$version"; then
+    cargo install cargo-mutants --locked --version "$version"
 fi
 "$root/scripts/sync-tree.sh" "$tree"
 cd "$tree"

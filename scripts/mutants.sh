@@ -42,13 +42,7 @@ if ! cargo mutants --version 2>/dev/null | grep -qF "$version"; then
 fi
 
 tree="$root/target/${TREE:-mutants-tree}"
-mkdir -p "$tree"
-# Copy the sources (not target/ or .git) that differ from the previous copy, with a fresh mtime:
-# unchanged files keep theirs (no needless rebuild), and a changed file is always newer than the
-# builds of the previous run (copying with its own, older mtime once left a stale build "fresh").
-(cd "$root" && git ls-files -co --exclude-standard -z | while IFS= read -r -d '' f; do
-    cmp -s "$f" "$tree/$f" || cp --parents -t "$tree" "$f"
-done)
+"$root/scripts/sync-tree.sh" "$tree"
 cd "$tree"
 
 mutants() {
