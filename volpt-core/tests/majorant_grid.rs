@@ -31,6 +31,9 @@ fn resolution_follows_the_longest_axis() {
     assert_eq!(MajorantGrid::resolution_for(b, 8), [8, 4, 2]);
     let thin = Aabb::new(Vec3::ZERO, Vec3::new(3.0, 1.0, 0.001));
     assert_eq!(MajorantGrid::resolution_for(thin, 10), [10, 4, 1]);
+    // A box of no extent still gets one cell along each axis, never 0 / 0.
+    let point = Aabb::new(Vec3::ONE, Vec3::ONE);
+    assert_eq!(MajorantGrid::resolution_for(point, 10), [1, 1, 1]);
 }
 
 #[test]
@@ -142,6 +145,19 @@ fn dda_walks_the_cells_the_ray_crosses() {
         Ray::new(Vec3::new(2.9, 0.7, 3.1), Vec3::new(-1.0, 0.0, -0.0)),
         Ray::new(Vec3::new(0.3, 0.1, 2.2), Vec3::new(-0.0, 0.0, 1.0)),
     ];
+    // Rays entering through each of the three far faces (a camera ray's entry point lies exactly
+    // on the box), whose grid coordinate along that axis is the resolution itself: the DDA must
+    // start in the last cell, not one past it.
+    for axis in 0..3 {
+        for _ in 0..20 {
+            let u = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
+            let mut origin = bounds().min + bounds().extent() * u;
+            origin[axis] = bounds().max[axis];
+            let mut d = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - Vec3::ONE;
+            d[axis] = -0.5 - rng.next_f32();
+            rays.push(Ray::new(origin, d.normalize()));
+        }
+    }
     for _ in 0..200 {
         let u = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
         let origin = bounds().min + bounds().extent() * u;
