@@ -554,7 +554,11 @@ mod tests {
         (h >> 8) as f32 / (1 << 24) as f32
     }
 
-    const SHAPES: [[u32; 3]; 7] = [
+    /// Grid shapes for the bricked layout: whole and partial bricks, one sample, a long line, and
+    /// a resolution of whole bricks along x (and along y) under more than one brick across the
+    /// other axes, where a miscounted number of bricks per row (or per slice) moves later
+    /// bricks.
+    const SHAPES: [[u32; 3]; 9] = [
         [1, 1, 1],
         [8, 8, 8],
         [9, 8, 17],
@@ -562,6 +566,8 @@ mod tests {
         [2048, 1, 1],
         [3, 16, 24],
         [17, 17, 17],
+        [16, 9, 9],
+        [9, 15, 9],
     ];
 
     #[test]
