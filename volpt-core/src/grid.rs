@@ -668,6 +668,22 @@ mod tests {
         assert!(inside > 1000, "{inside} lookups were not zero");
     }
 
+    /// `with_texel` sets the format that texture lookups (and the CPU's filter of them) read:
+    /// 0.1 is no half value, so half texels hold the largest half below it.
+    #[test]
+    fn with_texel_sets_what_texture_lookups_read() {
+        let data = [0.1f32; 8];
+        let mapping = GridMapping::cell_centred(Aabb::new(Vec3::ZERO, Vec3::ONE), [2, 2, 2]);
+        let grid = Grid::<1>::new(&data, [2, 2, 2], mapping);
+        let p = Vec3::new(0.3, 0.6, 0.45);
+        assert_eq!(TextureTrilinear::lookup(&grid, p), [0.1]);
+        let half = half_toward_zero(0.1);
+        assert!(half < 0.1);
+        let grid = grid.with_texel(TexelFormat::F16);
+        assert_eq!(grid.texel, TexelFormat::F16);
+        assert_eq!(TextureTrilinear::lookup(&grid, p), [half]);
+    }
+
     #[test]
     fn texel_formats_travel_as_their_codes() {
         for format in [TexelFormat::F32, TexelFormat::F16] {
