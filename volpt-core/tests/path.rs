@@ -1,7 +1,8 @@
 //! The path step on a scene built by hand, without the render factory: the white furnace (every
 //! estimator and roulette rule must return exactly the environment's radiance on average, also
 //! behind a dielectric), where next-event estimation runs, `max_depth`, the albedo's weight, the
-//! safety bounds, the random streams of pixels and samples, `sample_pixel` and the path counters.
+//! safety bounds, the random streams of pixels and samples, `sample_pixel`, the path counters, and
+//! the split step (`fly` + `scatter`) of the sorting strategy against `step`.
 //! Cheap (well under a second): the whole-renderer tests check the same paths against independent
 //! references, but only with `max_depth = 2`, where roulette never runs, and they never reach the
 //! safety bounds.
@@ -9,7 +10,7 @@
 mod common;
 
 use common::{Moments, Z_MAX};
-use volpt_core::path::{sample_pixel, step, trace, Truncation};
+use volpt_core::path::{fly, sample_pixel, scatter, step, trace, Truncation};
 use volpt_core::{
     Aabb, ConstantEnvironment, Estimator, HenyeyGreenstein, HomogeneousMedium, NullBoundary,
     PathCounters, PathSettings, PathState, PerspectiveCamera, Ray, Rng, Roulette, SmoothDielectric,
@@ -262,6 +263,57 @@ fn each_collision_weighs_the_throughput_by_the_albedo() {
         deepest = deepest.max(path.depth);
     }
     assert!(deepest >= 3, "paths collided at most {deepest} times");
+}
+
+/// `fly` up to a real collision and `scatter` there, with the albedo read by `scatter` or handed
+/// in (as sorting-sk does after reading its block's albedos in Morton order), trace the same path
+/// as `step`, bit for bit and state by state: with and without next-event estimation, behind an
+/// index-matched and a refracting boundary. Only the GPU's sorting-sk runs this split, so the
+/// CPU's images never see it.
+#[test]
+fn fly_then_scatter_is_the_step() {
+    fn compare<B: volpt_core::Bsdf>(scene: &Furnace<B>) -> u32 {
+        use volpt_core::Medium;
+        let mut collisions = 0;
+        for handed_in in [false, true] {
+            for sample in 0..128 {
+                // The central pixels, whose rays enter the box.
+                let (px, py) = (2 + sample % 4, 1 + (sample / 4) % 4);
+                let mut whole = PathState::from_camera(scene, px, py, sample, 5);
+                let mut split = whole;
+                while whole.alive {
+                    step(scene, &mut whole);
+                    if let Some(p) = fly(scene, &mut split) {
+                        let albedo = handed_in.then(|| scene.medium.albedo(p));
+                        scatter(scene, &mut split, p, albedo);
+                        collisions += 1;
+                    }
+                    assert_eq!(
+                        format!("{whole:?}"),
+                        format!("{split:?}"),
+                        "sample {sample}"
+                    );
+                }
+                assert!(!split.alive);
+            }
+        }
+        collisions
+    }
+    for estimator in [Estimator::PathTracing, Estimator::NextEvent] {
+        let settings = PathSettings {
+            estimator,
+            ..PathSettings::default()
+        };
+        let mut scene = furnace(settings);
+        scene.medium.albedo = Spectrum::new(0.9, 0.7, 0.5);
+        assert!(compare(&scene) > 300, "{estimator:?}: too few collisions");
+        let mut behind = furnace_behind(SmoothDielectric { eta: 1.3 }, settings);
+        behind.medium.albedo = Spectrum::new(0.9, 0.7, 0.5);
+        assert!(
+            compare(&behind) > 300,
+            "{estimator:?} behind a dielectric: too few collisions"
+        );
+    }
 }
 
 /// Past `max_segments` free flights a path ends, contributes nothing (even light it had gathered)
