@@ -9,7 +9,7 @@ use volpt_core::{
     Aabb, Component, ConstantEnvironment, Estimator, Grid, GridAlbedo, GridLayout, GridLookup,
     GridMapping, GridMedium, GridPlacement, HenyeyGreenstein, HomogeneousMedium, Isotropic,
     LatLongEnvironment, LatLongRows, NullBoundary, PathSettings, PerspectiveCamera,
-    RoughDielectric, Roulette, SceneAbi, Vec2, Vec3, VolumeScene,
+    RoughDielectric, Roulette, SceneAbi, SmoothDielectric, Vec2, Vec3, VolumeScene,
 };
 
 /// A closure uploader that hands out made-up device addresses and records what it was given.
@@ -147,6 +147,27 @@ fn scene() -> Furnace {
         environment: ConstantEnvironment(Vec3::new(0.25, 1.5, 3.0)),
         settings: settings()[0],
     }
+}
+
+/// Both dielectric boundaries through their device parameters: the relative index (and the rough
+/// one's roughness) decoded again. The scene above has an index-matched boundary, which has none.
+#[test]
+fn dielectric_boundaries_survive_the_device_encoding() {
+    let mut calls = Vec::new();
+    let smooth = SmoothDielectric { eta: 1.33 };
+    // SAFETY: the parameters hold no address.
+    let decoded =
+        unsafe { SmoothDielectric::from_params(&smooth.to_params(&mut recording(&mut calls))) };
+    assert_eq!(decoded.eta, smooth.eta);
+    let rough = RoughDielectric {
+        eta: 1.05,
+        distribution: volpt_core::microfacet::Ggx { alpha: 0.1 },
+    };
+    // SAFETY: as above.
+    let decoded =
+        unsafe { RoughDielectric::from_params(&rough.to_params(&mut recording(&mut calls))) };
+    assert_eq!((decoded.eta, decoded.distribution.alpha), (1.05, 0.1));
+    assert!(calls.is_empty(), "a boundary lives in its parameters alone");
 }
 
 /// The whole scene's parameters, decoded again: the very numbers (and, since `to_params` evaluates
