@@ -3,10 +3,13 @@
 //! sees every tentative collision (the closure impl replaced by `true` left every judge green:
 //! only `tests/tests/heterogeneous.rs`, which no mutation stage runs, walks with a closure), and
 //! ratio tracking's estimate is exactly the product of `1 - sigma_t / majorant`, with its roulette
-//! starting once the product falls below 1/8, not at 1/8.
+//! starting once the product falls below 1/8, not at 1/8. Under a majorant grid the walk counts
+//! every step too (shard 2/8 of 2026-11-25: the grid loop's `*steps += 1` as `*= 1` left every
+//! judge green), and its budget ends a walk that would not end.
 
+use volpt_core::majorant::MajorantGrid;
 use volpt_core::tracking::{ratio_tracking, walk_majorants, FreeFlight};
-use volpt_core::{Medium, Ray, Rng, Spectrum, Vec3};
+use volpt_core::{Aabb, Medium, Ray, Rng, Spectrum, Vec3};
 
 /// Extinction exactly half the majorant everywhere, declared heterogeneous so that the walk's
 /// rejection and ratio steps run: each tentative collision halves ratio tracking's product, exactly.
@@ -82,6 +85,82 @@ fn a_closure_sees_every_tentative_collision() {
         assert_eq!((calls, steps), (3, 3), "seed {seed}");
     }
     // Optical depth 8 under the majorant: about 8 steps a walk.
+    assert!(total > 200, "only {total} tentative collisions in 50 walks");
+}
+
+/// [`HalfOfMajorant`] under a majorant grid: four cells of majorant 2 along x over the box the
+/// test ray crosses, so that the walk takes the grid's loop (cell by cell) instead of the global
+/// one.
+struct HalfOfGridMajorant(MajorantGrid<'static>);
+
+const GRID_CELLS: [f32; 4] = [2.0; 4];
+
+impl HalfOfGridMajorant {
+    fn new() -> Self {
+        let bounds = Aabb::new(Vec3::new(0.0, -2.0, 0.0), Vec3::new(4.0, 0.0, 6.0));
+        Self(MajorantGrid::new(&GRID_CELLS, [4, 1, 1], bounds))
+    }
+}
+
+impl Medium for HalfOfGridMajorant {
+    const HOMOGENEOUS: bool = false;
+
+    fn majorant(&self) -> f32 {
+        2.0
+    }
+
+    fn majorant_grid(&self) -> Option<&MajorantGrid<'_>> {
+        Some(&self.0)
+    }
+
+    fn sigma_t(&self, _p: Vec3) -> f32 {
+        1.0
+    }
+
+    fn albedo(&self, _p: Vec3) -> Spectrum {
+        Spectrum::ONE
+    }
+}
+
+/// Through the grid's cells the walk counts one step for each tentative collision it offers the
+/// closure, and with an endless `t_max` (the last cell's end is infinite) it stops at exactly
+/// `max_steps`, out of steps.
+#[test]
+fn the_grid_walk_counts_every_step_and_keeps_its_budget() {
+    let (medium, ray) = (HalfOfGridMajorant::new(), ray());
+    let mut total = 0;
+    for seed in 0..50 {
+        let mut calls = 0;
+        let mut steps = 0;
+        let flight = walk_majorants(
+            &medium,
+            &ray,
+            4.0,
+            &mut Rng::new(seed, 1, 2),
+            &mut steps,
+            1000,
+            |_: &mut Rng, _: f32, majorant: f32| {
+                calls += 1;
+                assert_eq!(majorant, 2.0);
+                false
+            },
+        );
+        assert_eq!(flight, FreeFlight::Escaped, "seed {seed}");
+        assert_eq!(calls, steps, "seed {seed}: one step counted a call");
+        total += calls;
+
+        let mut steps = 0;
+        let flight = walk_majorants(
+            &medium,
+            &ray,
+            f32::INFINITY,
+            &mut Rng::new(seed, 1, 2),
+            &mut steps,
+            25,
+            |_: &mut Rng, _: f32, _: f32| false,
+        );
+        assert_eq!((flight, steps), (FreeFlight::OutOfSteps, 25), "seed {seed}");
+    }
     assert!(total > 200, "only {total} tentative collisions in 50 walks");
 }
 
