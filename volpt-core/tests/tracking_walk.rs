@@ -13,13 +13,30 @@ use volpt_core::{Aabb, Medium, Ray, Rng, Spectrum, Vec3};
 
 /// Extinction exactly half the majorant everywhere, declared heterogeneous so that the walk's
 /// rejection and ratio steps run: each tentative collision halves ratio tracking's product, exactly.
-struct HalfOfMajorant;
+/// With a majorant grid (four cells of majorant 2 along x over the box the test ray crosses) the
+/// walk takes the grid's loop, cell by cell, instead of the global one.
+struct HalfOfMajorant(Option<MajorantGrid<'static>>);
+
+const HALF_OF_MAJORANT: HalfOfMajorant = HalfOfMajorant(None);
+
+const GRID_CELLS: [f32; 4] = [2.0; 4];
+
+impl HalfOfMajorant {
+    fn with_grid() -> Self {
+        let bounds = Aabb::new(Vec3::new(0.0, -2.0, 0.0), Vec3::new(4.0, 0.0, 6.0));
+        Self(Some(MajorantGrid::new(&GRID_CELLS, [4, 1, 1], bounds)))
+    }
+}
 
 impl Medium for HalfOfMajorant {
     const HOMOGENEOUS: bool = false;
 
     fn majorant(&self) -> f32 {
         2.0
+    }
+
+    fn majorant_grid(&self) -> Option<&MajorantGrid<'_>> {
+        self.0.as_ref()
     }
 
     fn sigma_t(&self, _p: Vec3) -> f32 {
@@ -40,7 +57,7 @@ fn ray() -> Ray {
 /// collision at the distance it was given.
 #[test]
 fn a_closure_sees_every_tentative_collision() {
-    let (medium, ray) = (HalfOfMajorant, ray());
+    let (medium, ray) = (HALF_OF_MAJORANT, ray());
     let mut total = 0;
     for seed in 0..50 {
         let mut seen = Vec::new();
@@ -88,46 +105,12 @@ fn a_closure_sees_every_tentative_collision() {
     assert!(total > 200, "only {total} tentative collisions in 50 walks");
 }
 
-/// [`HalfOfMajorant`] under a majorant grid: four cells of majorant 2 along x over the box the
-/// test ray crosses, so that the walk takes the grid's loop (cell by cell) instead of the global
-/// one.
-struct HalfOfGridMajorant(MajorantGrid<'static>);
-
-const GRID_CELLS: [f32; 4] = [2.0; 4];
-
-impl HalfOfGridMajorant {
-    fn new() -> Self {
-        let bounds = Aabb::new(Vec3::new(0.0, -2.0, 0.0), Vec3::new(4.0, 0.0, 6.0));
-        Self(MajorantGrid::new(&GRID_CELLS, [4, 1, 1], bounds))
-    }
-}
-
-impl Medium for HalfOfGridMajorant {
-    const HOMOGENEOUS: bool = false;
-
-    fn majorant(&self) -> f32 {
-        2.0
-    }
-
-    fn majorant_grid(&self) -> Option<&MajorantGrid<'_>> {
-        Some(&self.0)
-    }
-
-    fn sigma_t(&self, _p: Vec3) -> f32 {
-        1.0
-    }
-
-    fn albedo(&self, _p: Vec3) -> Spectrum {
-        Spectrum::ONE
-    }
-}
-
 /// Through the grid's cells the walk counts one step for each tentative collision it offers the
 /// closure, and with an endless `t_max` (the last cell's end is infinite) it stops at exactly
 /// `max_steps`, out of steps.
 #[test]
 fn the_grid_walk_counts_every_step_and_keeps_its_budget() {
-    let (medium, ray) = (HalfOfGridMajorant::new(), ray());
+    let (medium, ray) = (HalfOfMajorant::with_grid(), ray());
     let mut total = 0;
     for seed in 0..50 {
         let mut calls = 0;
@@ -170,7 +153,7 @@ fn the_grid_walk_counts_every_step_and_keeps_its_budget() {
 /// 1/8. So every estimate is exactly 1, 1/2, 1/4, 1/8 or 0, each where its step count says.
 #[test]
 fn ratio_tracking_multiplies_exact_ratios_and_roulettes_below_an_eighth() {
-    let (medium, ray) = (HalfOfMajorant, ray());
+    let (medium, ray) = (HALF_OF_MAJORANT, ray());
     let mut counts = [0u32; 5];
     for seed in 0..2000 {
         let mut steps = 0;

@@ -29,6 +29,15 @@ fn test_blocks() -> LaunchConfig {
     }
 }
 
+/// One thread per item of `n`, in blocks of `BLOCK_SIZE`.
+fn one_thread_each(n: usize) -> LaunchConfig {
+    LaunchConfig {
+        grid_dim: ((n as u32).div_ceil(BLOCK_SIZE), 1, 1),
+        block_dim: (BLOCK_SIZE, 1, 1),
+        shared_mem_bytes: 0,
+    }
+}
+
 /// One building block's result: how many inputs, what differed from the CPU, and what was
 /// measured on the way (empty if nothing).
 #[derive(Debug)]
@@ -240,11 +249,7 @@ impl CudaRenderer {
             .doing("allocating test output")?;
         let mut fast: CudaSlice<u32> = stream.alloc_zeros(1).doing("allocating a flag")?;
         let kernel = self.kernel("selftest__math_functions", None)?;
-        let config = LaunchConfig {
-            grid_dim: ((N as u32).div_ceil(BLOCK_SIZE), 1, 1),
-            block_dim: (BLOCK_SIZE, 1, 1),
-            shared_mem_bytes: 0,
-        };
+        let config = one_thread_each(N);
         // SAFETY: three inputs and seven outputs per thread below N, one flag.
         unsafe {
             stream
@@ -362,11 +367,7 @@ impl CudaRenderer {
             "selftest__texture_lookups_3"
         };
         let kernel = self.kernel(entry, None)?;
-        let config = LaunchConfig {
-            grid_dim: ((POINTS as u32).div_ceil(BLOCK_SIZE), 1, 1),
-            block_dim: (BLOCK_SIZE, 1, 1),
-            shared_mem_bytes: 0,
-        };
+        let config = one_thread_each(POINTS);
         // SAFETY: one grid's parameters, 3 coordinates and C outputs per point, for the launch.
         unsafe {
             stream

@@ -214,23 +214,38 @@ pub const MATH_INPUTS: usize = 3;
 /// Outputs per thread of [`math_functions`].
 pub const MATH_OUTPUTS: usize = 7;
 
-/// Thread `i < n` reads `(a, b, u) = inputs[3i..]` and writes `sqrt(a)`, `ln(a)`, `exp(b)`,
-/// `a / b` (`math::div`), `1 / b` (`math::recip`) and `sin_cos_2pi(u)` to `out[7i..]`, through
-/// `volpt_core::math` as this build of the kernels compiles it; thread 0 writes to `*fast`
-/// whether it is the fast-math build.
+/// What [`math_functions`] computes for `(a, b, u)`: `sqrt(a)`, `ln(a)`, `exp(b)`, `a / b`
+/// (`math::div`), `1 / b` (`math::recip`) and `sin_cos_2pi(u)`, through `volpt_core::math` as
+/// the build that calls it compiles it: in a kernel, the kernels' arithmetic; on the host, the
+/// CPU's, which the exact kernels must match bit for bit.
+#[inline(always)]
+pub fn math_values(a: f32, b: f32, u: f32) -> [f32; MATH_OUTPUTS] {
+    use volpt_core::{math, Vec3};
+    let (sin, cos) = math::sin_cos_2pi(u);
+    [
+        math::sqrt(a),
+        math::ln(a),
+        math::exp(b),
+        math::div(Vec3::splat(a), Vec3::splat(b)).x,
+        math::recip(Vec3::splat(b)).x,
+        sin,
+        cos,
+    ]
+}
+
+/// Thread `i < n` reads `(a, b, u) = inputs[3i..]` and writes [`math_values`] to `out[7i..]`;
+/// thread 0 writes to `*fast` whether this is the fast-math build.
 ///
 /// # Safety
 /// `inputs` must hold `3 n` values, `out` `7 n` and `fast` one.
 #[cfg(target_arch = "nvptx64")]
 #[inline(always)]
 pub unsafe fn math_functions(inputs: *const f32, out: *mut f32, fast: *mut u32, n: u32) {
-    use volpt_core::{math, Vec3};
-
     use crate::nvptx::global_thread_index;
     let i = global_thread_index() as usize;
     if i == 0 {
         // SAFETY: the caller's contract.
-        unsafe { *fast = u32::from(math::FAST) };
+        unsafe { *fast = u32::from(volpt_core::math::FAST) };
     }
     if i >= n as usize {
         return;
@@ -240,17 +255,7 @@ pub unsafe fn math_functions(inputs: *const f32, out: *mut f32, fast: *mut u32, 
         let p = inputs.add(MATH_INPUTS * i);
         (*p, *p.add(1), *p.add(2))
     };
-    let (sin, cos) = math::sin_cos_2pi(u);
-    let values = [
-        math::sqrt(a),
-        math::ln(a),
-        math::exp(b),
-        math::div(Vec3::splat(a), Vec3::splat(b)).x,
-        math::recip(Vec3::splat(b)).x,
-        sin,
-        cos,
-    ];
-    for (k, v) in values.into_iter().enumerate() {
+    for (k, v) in math_values(a, b, u).into_iter().enumerate() {
         // SAFETY: the caller's contract.
         unsafe { *out.add(MATH_OUTPUTS * i + k) = v };
     }
