@@ -5,7 +5,8 @@
 //! - [`entry`]: the kernel entry point of a scene type, derived from its parts' names.
 //! - [`Strategy`]: the GPU scheduling strategies, selectable at run time (`volpt_device`), and
 //!   [`Math`]: exact or fast kernels.
-//! - [`selftest`]: the strategies' collective building blocks on the GPU against the CPU.
+//! - [`selftest`]: the strategies' collective building blocks, texture lookups and the kernels' math
+//!   functions on the GPU against the CPU.
 //! - [`error`]: what can go wrong, from "no GPU here" to a failed launch.
 //!
 //! The CUDA driver is loaded at run time, so a binary with this crate builds and runs on machines

@@ -9,7 +9,8 @@
 //! - [`export_kernels!`]: exports the kernels of every strategy for one scene type. The workspace's
 //!   kernels crate invokes it for every variant of the registry; a library user invokes it for a
 //!   scene of their own parts (see `docs/extending.md`).
-//! - [`selftest`]: kernels that test the strategies' collective building blocks against the CPU.
+//! - [`selftest`]: kernels that test the strategies' collective building blocks, texture lookups
+//!   and `volpt_core::math` against the CPU.
 //! - on nvptx64 only: [`strategy`] (the strategies' kernel bodies) and the PTX intrinsics they use.
 #![no_std]
 #![cfg_attr(
