@@ -23,10 +23,7 @@ out="$root/${OUT:-bundle-mutants}"
 tree="$root/target/${TREE:-gpu-mutants-tree}"
 FUNCTIONS=${FUNCTIONS:-'^volpt-core/src/(math\.rs:.*(replace (sqrt|ln|exp|div|recip|approx::\w+) ->| in (ln|exp|div|recip|approx::\w+)$)|grid\.rs:.*(TextureTrilinear>::lookup|texture_fetch))'}
 
-version=27.1.0
-if ! cargo mutants --version 2>/dev/null | grep -qF "$version"; then
-    cargo install cargo-mutants --locked --version "$version"
-fi
+"$root/scripts/install-cargo-mutants.sh"
 "$root/scripts/sync-tree.sh" "$tree"
 cd "$tree"
 

@@ -32,14 +32,11 @@
 #       --sharding round-robin --shard 4/8 > target/mutants-4.log 2>&1 &
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-version=27.1.0
 
 scope=${1:?usage: scripts/mutants.sh core|loaders [cargo-mutants options]}
 shift
 
-if ! cargo mutants --version 2>/dev/null | grep -qF "$version"; then
-    cargo install cargo-mutants --locked --version "$version"
-fi
+"$root/scripts/install-cargo-mutants.sh"
 
 tree="$root/target/${TREE:-mutants-tree}"
 "$root/scripts/sync-tree.sh" "$tree"
