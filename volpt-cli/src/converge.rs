@@ -28,16 +28,14 @@ use std::time::Duration;
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
-use volpt_core::{Estimator, PathSettings};
-use volpt_cuda::{Math, Strategy};
-use volpt_film::Film;
-use volpt_render::{path_settings, Image, RenderOptions};
+use volpt::{Backend, Estimator, Film, Image, Math, PathSettings, Quiet, Scene, Strategy};
+use volpt_render::path_settings;
 use volpt_scene::description::{AlbedoDesc, BsdfDesc, EnvironmentDesc};
-use volpt_scene::SceneDescription;
+use volpt_scene::{GridStorage, SceneDescription};
 
-use crate::backend::{Backend, BackendKind, RenderJob, StrategyArg};
+use crate::backend::{BackendKind, StrategyArg};
 use crate::plot::{log_log_png, log_log_svg, Series};
-use crate::{load, options, AccumulationArg, LookupArg, SamplingArgs, SceneArgs};
+use crate::{AccumulationArg, LookupArg, SamplingArgs, SceneArgs};
 
 #[derive(Args)]
 pub struct ConvergeArgs {
@@ -342,14 +340,14 @@ impl Halves {
     }
 }
 
-/// Adds samples `samples` (of seed `options.seed`) to `film`: every batch of the runs.
+/// Adds samples `samples` (of the scene's seed) to `film`: every batch of the runs.
 fn add_batch(
     backend: &Backend,
-    job: &RenderJob,
+    scene: &Scene,
     film: &mut Film,
     samples: std::ops::Range<u32>,
 ) -> Result<Duration> {
-    let stats = backend.render_into(job, film, samples)?;
+    let stats = backend.render(scene, film, samples, &Quiet)?.stats;
     if stats.counters.truncated > 0 {
         tracing::warn!(
             truncated = stats.counters.truncated,
@@ -360,9 +358,9 @@ fn add_batch(
 }
 
 pub fn run(args: &ConvergeArgs) -> Result<()> {
-    let mut desc = load(&args.scene)?;
-    let base = options(&desc, &args.sampling)?;
-    let configurations = configurations(&desc, &args.sampling, &args.settings);
+    let mut scene = args.scene.load(Some(&args.sampling))?;
+    let seed = scene.seed();
+    let configurations = configurations(scene.description(), &args.sampling, &args.settings);
     // Before the reference, so that a configuration a backend cannot render costs nothing.
     if let Some(c) = configurations
         .iter()
@@ -373,15 +371,14 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
             c.label
         );
     }
-    let mut backend = Backend::open(args.sampling.backend, args.sampling.gpu)?;
-    backend.place_volumes(&args.sampling.volumes, &mut desc)?;
+    let backend = args.sampling.open()?;
+    backend.prepare(&mut scene);
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
-    let reference = reference(args, &desc, &backend, base)?;
+    let reference = reference(args, &mut scene, &backend)?;
     drop(backend);
-    let scene_lookup = desc.medium.lookup;
-    let scene_storage = desc.medium.storage;
-    let (w, h) = (desc.film.width, desc.film.height);
+    let scene_lookup = scene.description().medium.lookup;
+    let (w, h) = scene.resolution();
 
     let mut results = Vec::new();
     for (k, config) in configurations.iter().enumerate() {
@@ -396,11 +393,11 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
             configurations.len(),
             config.label
         ));
-        let mut backend = Backend::open(config.sampling.backend, config.sampling.gpu)?;
-        desc.medium.storage = scene_storage;
-        backend.place_volumes(&config.sampling.volumes, &mut desc)?;
-        desc.medium.lookup = config.lookup.map_or(scene_lookup, Into::into);
-        crate::check_lookup(&desc)?;
+        let backend = config.sampling.open()?;
+        scene.set_storage(GridStorage::Dense);
+        backend.prepare(&mut scene);
+        scene.set_lookup(config.lookup.map_or(scene_lookup, Into::into))?;
+        scene.set_path_settings(config.settings);
         let film = Film::new(w, h).with_accumulation(config.accumulation.into());
         let mut halves = Halves {
             films: [film.clone(), film],
@@ -412,18 +409,9 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
             let spp = 1u32 << round.min(20);
             let samples = halves.spp_each..halves.spp_each + spp;
             for (half, film) in (0u32..).zip(&mut halves.films) {
-                let job = RenderJob {
-                    desc: &desc,
-                    settings: config.settings,
-                    // One seed per half (not the reference's); each round continues its samples.
-                    options: RenderOptions {
-                        seed: base.seed.wrapping_add(half + 1),
-                        ..base
-                    },
-                    effects: args.scene.effects(),
-                    show_progress: false,
-                };
-                time += add_batch(&backend, &job, film, samples.clone())?.as_secs_f64();
+                // One seed per half (not the reference's); each round continues its samples.
+                scene.set_seed(seed.wrapping_add(half + 1));
+                time += add_batch(&backend, &scene, film, samples.clone())?.as_secs_f64();
             }
             halves.spp_each += spp;
             let (mse, rel_mse, variance) = halves.errors(&reference);
@@ -454,13 +442,9 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     write_outputs(args, &results)
 }
 
-/// The reference the errors are measured against.
-fn reference(
-    args: &ConvergeArgs,
-    desc: &SceneDescription,
-    backend: &Backend,
-    base: RenderOptions,
-) -> Result<Reference> {
+/// The reference the errors are measured against; `scene` is left with its seed and settings.
+fn reference(args: &ConvergeArgs, scene: &mut Scene, backend: &Backend) -> Result<Reference> {
+    let desc = scene.description();
     let (w, h) = (desc.film.width, desc.film.height);
     if let Some(path) = &args.reference {
         let image = Image::read_exr(path)?;
@@ -489,25 +473,23 @@ fn reference(
         return Ok(Reference::from_halves(&a?, &b?));
     }
     tracing::info!(spp = args.reference_spp, "rendering the reference");
+    let (seed, settings) = (scene.seed(), scene.path_settings());
+    scene.set_path_settings(reference_settings(desc));
+    let spp = args.reference_spp.div_ceil(2);
     let mut halves = Vec::new();
     for (half, path) in cached.iter().enumerate() {
-        let options = RenderOptions {
-            spp: args.reference_spp.div_ceil(2),
-            // Seeds no batch of the runs uses (they count up from the base seed).
-            seed: base.seed.wrapping_sub(1 + half as u32),
-            ..base
-        };
-        let job = RenderJob {
-            desc,
-            settings: reference_settings(desc),
-            options,
-            effects: args.scene.effects(),
-            show_progress: true,
-        };
-        let (image, _) = backend.render(&job)?;
+        // Seeds no batch of the runs uses (they count up from the base seed).
+        scene.set_seed(seed.wrapping_sub(1 + half as u32));
+        let terminal = crate::backend::Terminal::new(true);
+        let mut film = scene.film();
+        backend.render(scene, &mut film, 0..spp, &terminal)?;
+        terminal.finish();
+        let image = film.image(spp);
         image.write_exr(path)?;
         halves.push(image);
     }
+    scene.set_seed(seed);
+    scene.set_path_settings(settings);
     Ok(Reference::from_halves(&halves[0], &halves[1]))
 }
 
@@ -543,7 +525,7 @@ fn reference_key(args: &ConvergeArgs, desc: &SceneDescription) -> u64 {
     let key = format!(
         "{:?} {:?} {:?} {:?} {} {}",
         std::fs::canonicalize(&args.scene.scene).unwrap_or_else(|_| args.scene.scene.clone()),
-        args.scene.config(),
+        args.scene.settings(None).config(),
         desc.medium.lookup,
         reference_settings(desc),
         args.reference_spp,

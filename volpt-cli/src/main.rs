@@ -1,6 +1,5 @@
 //! `volpt`: render solid participating media from Mitsuba scene files.
 
-mod auto;
 mod backend;
 mod bench;
 mod checkpoint;
@@ -15,15 +14,14 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use tracing_subscriber::EnvFilter;
-use volpt_core::grid::HALF_MAX;
+use volpt::{
+    Backend, BackendOptions, Effects, Estimator, GridLookup, Image, RenderSettings, RenderStats,
+    Roulette, Scene, Variant,
+};
 use volpt_film::Accumulation;
-use volpt_render::factory::{Effects, Parts};
 use volpt_render::image::preview_path;
-use volpt_render::{path_settings, Image, RenderOptions, RenderStats, Variant};
-use volpt_scene::{AlbedoDesc, Config, DensityDesc, GridLookup, SceneAssembler, SceneDescription};
 
-use backend::{Backend, BackendKind, GpuArgs, RenderJob};
-use volpt_core::{Estimator, PathSettings, Roulette};
+use backend::{BackendKind, GpuArgs, Terminal};
 
 #[derive(Parser)]
 #[command(
@@ -167,12 +165,30 @@ enum Tracking {
     Grid,
 }
 
+impl From<Tracking> for volpt::Tracking {
+    fn from(t: Tracking) -> Self {
+        match t {
+            Tracking::Global => volpt::Tracking::Global,
+            Tracking::Grid => volpt::Tracking::Grid,
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 enum EstimatorArg {
     /// Path tracing: light only where a path escapes.
     Pt,
     /// Next-event estimation of the environment at scattering events, with MIS.
     Nee,
+}
+
+impl From<EstimatorArg> for Estimator {
+    fn from(e: EstimatorArg) -> Self {
+        match e {
+            EstimatorArg::Pt => Estimator::PathTracing,
+            EstimatorArg::Nee => Estimator::NextEvent,
+        }
+    }
 }
 
 /// `--lookup`: a grid's reconstruction.
@@ -201,38 +217,6 @@ impl From<LookupArg> for GridLookup {
     }
 }
 
-/// Refuses a lookup the medium's grids cannot take: half-precision texels end at 65504.
-fn check_lookup(desc: &SceneDescription) -> Result<()> {
-    if desc.medium.lookup != GridLookup::TextureHalf {
-        return Ok(());
-    }
-    let largest = [
-        (
-            "density",
-            match &desc.medium.density {
-                DensityDesc::Constant(v) => *v,
-                DensityDesc::Grid(grid) => grid.max_value(),
-            },
-        ),
-        (
-            "albedo",
-            match &desc.medium.albedo {
-                AlbedoDesc::Constant(rgb) => rgb.iter().copied().fold(0.0, f32::max),
-                AlbedoDesc::Grid(grid) => grid.max_value(),
-            },
-        ),
-    ];
-    for (name, largest) in largest {
-        if largest > HALF_MAX {
-            bail!(
-                "--lookup texture-f16: the medium's largest {name} is {largest}, above half \
-                 precision's largest value, {HALF_MAX} (use --lookup texture: f32 texels)"
-            );
-        }
-    }
-    Ok(())
-}
-
 /// The precision a film adds samples in (`volpt converge --setting accumulation=...`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum AccumulationArg {
@@ -250,49 +234,32 @@ impl From<AccumulationArg> for Accumulation {
 }
 
 impl SceneArgs {
-    /// The scene's integrator settings with the command line's tracking and estimator.
-    fn settings(&self, desc: &SceneDescription) -> Result<PathSettings> {
-        let mut settings = path_settings(desc);
-        settings.majorant_resolution = match (self.tracking, self.majorant_resolution) {
-            (Some(Tracking::Global), Some(r)) if r > 1 => bail!(
-                "--tracking global uses one majorant; --majorant-resolution {r} asks for a grid"
-            ),
-            (Some(Tracking::Global), _) => 1,
-            (_, Some(r)) => r,
-            (Some(Tracking::Grid), None) if settings.majorant_resolution <= 1 => {
-                PathSettings::DEFAULT_MAJORANT_RESOLUTION
-            }
-            (_, None) => settings.majorant_resolution,
-        };
-        if let Some(roulette) = self.roulette {
-            settings.roulette = roulette.into();
-        }
-        if let Some(estimator) = self.estimator {
-            settings.estimator = match estimator {
-                EstimatorArg::Pt => Estimator::PathTracing,
-                EstimatorArg::Nee => Estimator::NextEvent,
-            };
-        }
-        Ok(settings)
-    }
-
-    fn effects(&self) -> Effects {
-        if self.general {
-            Effects::General
-        } else {
-            Effects::Specialised
-        }
-    }
-
-    /// The command line's part of the scene, for the assembler.
-    fn config(&self) -> Config {
-        Config {
+    /// The library's settings: these flags over the scene file, with `sampling`'s seed and
+    /// threads.
+    fn settings(&self, sampling: Option<&SamplingArgs>) -> RenderSettings {
+        RenderSettings {
             params: self.params.clone(),
             spp: self.spp,
             resolution: self.resolution,
             max_depth: self.max_depth.map(depth),
             rr_depth: self.rr_depth.map(depth),
+            tracking: self.tracking.map(Into::into),
+            majorant_resolution: self.majorant_resolution,
+            estimator: self.estimator.map(Into::into),
+            lookup: self.lookup.map(Into::into),
+            roulette: self.roulette.map(Into::into),
+            effects: if self.general {
+                Effects::General
+            } else {
+                Effects::Specialised
+            },
+            seed: sampling.map_or(0, |s| s.seed),
+            threads: sampling.and_then(|s| s.threads),
         }
+    }
+
+    fn load(&self, sampling: Option<&SamplingArgs>) -> Result<Scene> {
+        Ok(Scene::load(&self.scene, &self.settings(sampling))?)
     }
 }
 
@@ -311,6 +278,16 @@ struct SamplingArgs {
     gpu: GpuArgs,
     #[command(flatten)]
     volumes: volume::VolumeArgs,
+}
+
+impl SamplingArgs {
+    /// Opens the backend these flags name; flags that do not apply to it are refused.
+    fn open(&self) -> Result<Backend> {
+        Ok(Backend::open(&BackendOptions {
+            kind: self.backend.into(),
+            gpu: self.gpu.options(&self.volumes),
+        })?)
+    }
 }
 
 #[derive(Args)]
@@ -418,18 +395,26 @@ fn main() -> Result<()> {
         Command::Render(args) => render_command(args),
         Command::Bench(args) => bench_command(args),
         Command::Info(args) => {
-            let desc = load(&args)?;
-            let settings = args.settings(&desc)?;
+            let scene = args.load(None)?;
             print!(
                 "{}",
-                info::describe(&args.scene, &desc, args.effects(), &settings)
+                info::describe(
+                    &args.scene,
+                    scene.description(),
+                    scene.effects(),
+                    &scene.path_settings()
+                )
             );
             Ok(())
         }
-        Command::Scene(SceneCommand::Export { scene, out, name }) => {
-            let desc = load(&scene)?;
-            let name = name.unwrap_or_else(|| export_name(&scene.scene));
-            for path in volpt_scene::mitsuba::write_mitsuba3(&desc, &out, &name)? {
+        Command::Scene(SceneCommand::Export {
+            scene: args,
+            out,
+            name,
+        }) => {
+            let scene = args.load(None)?;
+            let name = name.unwrap_or_else(|| export_name(&args.scene));
+            for path in volpt_scene::mitsuba::write_mitsuba3(scene.description(), &out, &name)? {
                 println!("wrote {}", path.display());
             }
             Ok(())
@@ -466,56 +451,20 @@ fn export_name(scene: &Path) -> String {
     }
 }
 
-fn load(args: &SceneArgs) -> Result<SceneDescription> {
-    let builder = volpt_scene::builder_for(&args.scene)?;
-    let mut desc = SceneAssembler::new(args.config()).assemble(builder.as_ref())?;
-    if let Some(lookup) = args.lookup {
-        desc.medium.lookup = lookup.into();
-        check_lookup(&desc)?;
-    }
-    Ok(desc)
-}
-
-fn options(desc: &SceneDescription, sampling: &SamplingArgs) -> Result<RenderOptions> {
-    if let Some(threads) = sampling.threads {
-        // Threads beyond the cores only cost memory and start-up; tens of thousands of them
-        // exhaust the system before the render starts.
-        let cores = std::thread::available_parallelism().map_or(1, usize::from);
-        let most = 4 * cores;
-        if !(1..=most).contains(&threads) {
-            bail!(
-                "--threads: expected 1 to {most} (4 x the {cores} cores of this machine), \
-                 found {threads}"
-            );
-        }
-    }
-    Ok(RenderOptions {
-        spp: desc.spp,
-        seed: sampling.seed,
-        threads: sampling.threads,
-    })
-}
-
 fn render_command(args: RenderArgs) -> Result<()> {
     // Before the render, so that a bad name costs nothing.
     let preview = preview_for(&args.output)?;
-    let mut desc = load(&args.scene)?;
-    let mut backend = Backend::open(args.sampling.backend, args.sampling.gpu)?;
-    backend.place_volumes(&args.sampling.volumes, &mut desc)?;
-    let job = RenderJob {
-        desc: &desc,
-        settings: args.scene.settings(&desc)?,
-        options: options(&desc, &args.sampling)?,
-        effects: args.scene.effects(),
-        show_progress: true,
-    };
-    let variant = Parts::of(&desc, job.effects).variant();
+    let mut scene = args.scene.load(Some(&args.sampling))?;
+    let backend = args.sampling.open()?;
+    backend.prepare(&mut scene);
+    let spp = scene.spp();
+    let variant = scene.variant();
     tracing::info!(
         scene = %args.scene.scene.display(),
         %variant,
-        width = desc.film.width,
-        height = desc.film.height,
-        spp = job.options.spp,
+        width = scene.resolution().0,
+        height = scene.resolution().1,
+        spp,
         device = %backend.device_name(),
         strategy = ?backend.strategy(),
         math = ?backend.math(),
@@ -523,36 +472,43 @@ fn render_command(args: RenderArgs) -> Result<()> {
     );
     let save = checkpoint::save_path(args.checkpoint.as_deref(), args.resume.as_deref());
     let (image, stats) = match save {
-        None => backend.render(&job)?,
+        None => {
+            let terminal = Terminal::new(true);
+            let mut film = scene.film();
+            let rendered = backend.render(&scene, &mut film, 0..spp, &terminal)?;
+            terminal.finish();
+            (film.image(spp), rendered.stats)
+        }
         Some(save) => {
             if !(args.checkpoint_interval.is_finite() && args.checkpoint_interval > 0.0) {
                 bail!("--checkpoint-interval must be a positive number of seconds");
             }
-            let checkpointing = checkpoint::Checkpointing {
+            let checkpointing = volpt::Checkpointing {
                 save,
                 resume: args.resume.clone(),
                 interval: std::time::Duration::from_secs_f64(args.checkpoint_interval),
             };
-            match checkpoint::render(&backend, &job, &checkpointing)? {
-                Ok(done) => done,
-                Err(stopped) => {
-                    println!(
-                        "interrupted after {} of {} samples per pixel: saved to {}; continue \
-                         with --resume {}",
-                        stopped.samples,
-                        job.options.spp,
-                        stopped.path.display(),
-                        stopped.path.display()
-                    );
-                    std::process::exit(130);
-                }
+            let terminal = Terminal::new(true).interruptible()?;
+            let (film, rendered) =
+                volpt::render_checkpointed(&backend, &scene, &checkpointing, &terminal)?;
+            terminal.finish();
+            if rendered.samples.end < spp {
+                println!(
+                    "interrupted after {} of {spp} samples per pixel: saved to {}; continue with \
+                     --resume {}",
+                    rendered.samples.end,
+                    checkpointing.save.display(),
+                    checkpointing.save.display()
+                );
+                std::process::exit(130);
             }
+            (film.image(spp), rendered.stats)
         }
     };
     image
         .write_exr(&args.output)
         .with_context(|| format!("writing {}", args.output.display()))?;
-    println!("{}", summary(&image, job.options.spp, &stats, variant));
+    println!("{}", summary(&image, spp, &stats, variant));
     match preview {
         Some(preview) => {
             image.write_png(&preview)?;
@@ -623,25 +579,22 @@ fn truncation_warning(c: &volpt_core::PathCounters) -> Option<String> {
 }
 
 fn bench_command(args: BenchArgs) -> Result<()> {
-    let mut desc = load(&args.scene)?;
-    let mut backend = Backend::open(args.sampling.backend, args.sampling.gpu)?;
-    backend.place_volumes(&args.sampling.volumes, &mut desc)?;
-    let job = RenderJob {
-        desc: &desc,
-        settings: args.scene.settings(&desc)?,
-        options: options(&desc, &args.sampling)?,
-        effects: args.scene.effects(),
-        show_progress: false,
-    };
+    let mut scene = args.scene.load(Some(&args.sampling))?;
+    let backend = args.sampling.open()?;
+    backend.prepare(&mut scene);
+    let spp = scene.spp();
     let mut trials = Vec::new();
     let mut last = None;
     for trial in 0..=args.trials {
-        let (image, stats) = backend.render(&job)?;
+        let mut film = scene.film();
+        let stats = backend
+            .render(&scene, &mut film, 0..spp, &Terminal::new(false))?
+            .stats;
         tracing::debug!(trial, seconds = stats.elapsed.as_secs_f64(), "trial");
         if trial > 0 {
             trials.push(stats);
         }
-        last = Some(image);
+        last = Some(film.image(spp));
     }
     let image = last.expect("at least one trial ran");
     let time = bench::time_stats(&trials);
@@ -655,13 +608,13 @@ fn bench_command(args: BenchArgs) -> Result<()> {
     let report = bench::BenchReport {
         scene: args.scene.scene.display().to_string(),
         backend: format!("{:?}", args.sampling.backend).to_lowercase(),
-        strategy: backend.strategy().map(|s| s.to_string()),
-        math: backend.math().map(|m| m.name().to_owned()),
+        strategy: backend::strategy_name(backend.strategy()),
+        math: backend::math_name(backend.math()),
         device: backend.device_name(),
-        variant: Parts::of(&desc, job.effects).variant().to_string(),
+        variant: scene.variant().to_string(),
         width: image.width,
         height: image.height,
-        spp: job.options.spp,
+        spp,
         trials: trials.len(),
         time_mean_s: time.mean,
         time_std_s: time.std,

@@ -1,10 +1,8 @@
 //! Where the GPU reads volumes from: `--volume-memory`, `--device-memory-budget`, `--bricked`
 //! (docs/out-of-core.md).
 
-use anyhow::Result;
 use clap::Args;
-use volpt_core::GridLayout;
-use volpt_zerocopy::{VolumeMemory, VolumePolicy};
+use volpt_zerocopy::VolumeMemory;
 
 #[derive(Args, Clone, Debug, Default)]
 pub struct VolumeArgs {
@@ -22,31 +20,4 @@ pub struct VolumeArgs {
     /// across the bus (the image is the same bit for bit).
     #[arg(long)]
     pub bricked: bool,
-}
-
-impl VolumeArgs {
-    /// The policy for the GPU backend.
-    pub fn policy(&self) -> VolumePolicy {
-        VolumePolicy {
-            memory: self.volume_memory.unwrap_or(VolumeMemory::Auto),
-            layout: if self.bricked {
-                GridLayout::Bricked
-            } else {
-                GridLayout::Dense
-            },
-            budget: self.device_memory_budget,
-        }
-    }
-
-    /// Refuses the flags for a backend that has no device memory.
-    pub fn check_cpu(&self) -> Result<()> {
-        if self.volume_memory.is_some() || self.device_memory_budget.is_some() || self.bricked {
-            anyhow::bail!(
-                "--volume-memory, --device-memory-budget and --bricked place grids for the GPU; \
-                 the CPU backend reads them where they were loaded (use --backend cuda, or drop \
-                 them)"
-            );
-        }
-        Ok(())
-    }
 }

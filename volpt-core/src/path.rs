@@ -37,6 +37,7 @@ use crate::{Ray, Spectrum, Vec3};
 
 /// The integrator's limits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PathSettings {
     /// Longest path in segments (Mitsuba's `max_depth`); `u32::MAX` for unlimited.
     pub max_depth: u32,
@@ -69,6 +70,7 @@ impl PathSettings {
 /// Russian roulette's survival probability `q`; a surviving path's throughput is divided by `q`, so
 /// any `q` in (0, 1] keeps the estimator unbiased and only changes its variance and cost.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Roulette {
     /// Mitsuba's `volpath`: `q = min(max(throughput) * eta^2, 0.95)`. In an albedo-1 region the
     /// cap divides the throughput by 0.95 at every bounce a path survives: long paths come back
@@ -83,6 +85,7 @@ pub enum Roulette {
 
 /// How a path gathers the environment's light.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Estimator {
     /// Only where a path escapes: the phase function alone picks the directions.
     PathTracing,

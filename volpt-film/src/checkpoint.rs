@@ -78,17 +78,29 @@ impl Checkpoint {
     /// Writes the checkpoint to `path` atomically: to a temporary file beside it, then renamed, so
     /// that an interruption while writing leaves the previous checkpoint intact.
     pub fn write(&self, path: &Path) -> Result<(), CheckpointError> {
+        Self::write_film(path, self.fingerprint, self.seed, self.samples, &self.film)
+    }
+
+    /// Writes `film`, the sums of samples `0 .. samples` of a render of `fingerprint` and `seed`,
+    /// as [`Checkpoint::write`] does, without first moving the film into a checkpoint.
+    pub fn write_film(
+        path: &Path,
+        fingerprint: u64,
+        seed: u32,
+        samples: u32,
+        film: &Film,
+    ) -> Result<(), CheckpointError> {
         let io = |source| CheckpointError::Io {
             path: path.to_owned(),
             source,
         };
-        let mut bytes = Vec::with_capacity(HEADER + self.film.sums.len() * 24 + 8);
+        let mut bytes = Vec::with_capacity(HEADER + film.sums.len() * 24 + 8);
         bytes.extend_from_slice(MAGIC);
-        bytes.extend_from_slice(&self.fingerprint.to_le_bytes());
-        for v in [self.film.width, self.film.height, self.seed, self.samples] {
+        bytes.extend_from_slice(&fingerprint.to_le_bytes());
+        for v in [film.width, film.height, seed, samples] {
             bytes.extend_from_slice(&v.to_le_bytes());
         }
-        for sum in &self.film.sums {
+        for sum in &film.sums {
             for c in sum {
                 bytes.extend_from_slice(&c.to_le_bytes());
             }

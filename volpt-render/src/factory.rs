@@ -163,7 +163,7 @@ impl fmt::Display for Variant {
 }
 
 /// How the factory chooses parts.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 pub enum Effects {
     /// Simulate only the effects the scene calls for: a value that makes an effect trivial selects
     /// the simpler part ([`Simplification`]).

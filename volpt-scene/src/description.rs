@@ -2,9 +2,12 @@
 //!
 //! Nothing here knows about a file format or about a backend. Units are Mitsuba's: world space is
 //! whatever the scene file says, extinction coefficients are per world unit, colours are linear RGB.
+//! Every type serialises (serde), so that a render's fingerprint can take in all of it.
+
+use serde::Serialize;
 
 /// An axis-aligned box in world space.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Bounds {
     pub min: [f32; 3],
     pub max: [f32; 3],
@@ -21,7 +24,7 @@ pub const IDENTITY: Matrix4 = [
 ];
 
 /// Everything needed to render one image.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize)]
 pub struct SceneDescription {
     pub camera: CameraDesc,
     pub film: FilmDesc,
@@ -34,7 +37,7 @@ pub struct SceneDescription {
 }
 
 /// Which image axis the field of view spans (Mitsuba's `fovAxis` / `fov_axis`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub enum FovAxis {
     X,
     Y,
@@ -48,7 +51,7 @@ pub enum FovAxis {
 
 /// A pinhole perspective camera. Camera space is Mitsuba's: it looks along +z with +y up and +x to the
 /// left of the image; `to_world` maps camera space to world space.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct CameraDesc {
     pub to_world: Matrix4,
     /// Full field of view in degrees along `fov_axis`.
@@ -56,14 +59,14 @@ pub struct CameraDesc {
     pub fov_axis: FovAxis,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub struct FilmDesc {
     pub width: u32,
     pub height: u32,
 }
 
 /// Mitsuba's `volpath` settings. `None` means unlimited (Mitsuba's -1).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub struct IntegratorDesc {
     /// Longest path, counted in segments: 1 shows only directly visible light.
     pub max_depth: Option<u32>,
@@ -72,13 +75,13 @@ pub struct IntegratorDesc {
 }
 
 /// The shape that encloses the medium, and its surface.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct BoundaryDesc {
     pub bounds: Bounds,
     pub bsdf: BsdfDesc,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub enum BsdfDesc {
     /// Index-matched boundary: light crosses it unchanged.
     Null,
@@ -92,7 +95,7 @@ pub enum BsdfDesc {
     },
 }
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct MediumDesc {
     /// Density; the extinction coefficient is `scale * density`.
     pub density: DensityDesc,
@@ -107,7 +110,7 @@ pub struct MediumDesc {
 }
 
 /// How a GPU stores a medium's grids.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 pub enum GridStorage {
     /// Samples in x-fastest order.
     #[default]
@@ -117,7 +120,7 @@ pub enum GridStorage {
 }
 
 /// How a grid is reconstructed between its samples (Mitsuba 3's `filter_type`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 pub enum GridLookup {
     /// Trilinear interpolation of the eight samples around a point.
     #[default]
@@ -131,27 +134,27 @@ pub enum GridLookup {
     TextureHalf,
 }
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub enum DensityDesc {
     Constant(f32),
     Grid(GridDesc),
 }
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub enum AlbedoDesc {
     Constant([f32; 3]),
     /// A 3-channel grid (a 1-channel grid is expanded to grey RGB by the loader).
     Grid(GridDesc),
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub enum PhaseDesc {
     Isotropic,
     HenyeyGreenstein { g: f32 },
 }
 
 /// Where the grid's samples sit inside its bounding box.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub enum GridConvention {
     /// Mitsuba 0.5/0.6: sample `i` at `min + i / (res - 1) * extent` (samples on the box's faces).
     Vertex,
@@ -160,7 +163,7 @@ pub enum GridConvention {
 }
 
 /// A dense 3D grid, x fastest: `data[((z * res_y + y) * res_x + x) * channels + c]`.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct GridDesc {
     pub resolution: [u32; 3],
     pub channels: u32,
@@ -175,7 +178,7 @@ impl GridDesc {
     }
 }
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub enum EnvironmentDesc {
     /// Constant radiance from every direction.
     Constant([f32; 3]),
@@ -186,7 +189,7 @@ pub enum EnvironmentDesc {
 /// A latitude-longitude environment map. The look direction `d`, taken to the map's frame by the
 /// inverse of `to_world`, is found at `u = atan2(d.x, -d.z) / 2 pi` (wrapping around) and
 /// `v = acos(d.y) / pi`: the top row is the +y pole and the centre column looks along -z.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct LatLongDesc {
     pub width: u32,
     pub height: u32,
@@ -202,7 +205,7 @@ pub struct LatLongDesc {
 
 /// Where a latitude-longitude map's rows sit between the poles; columns sit at
 /// `u = (i + 0.5) / width` in every Mitsuba generation.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub enum LatLongRows {
     /// Mitsuba 0.5/0.6: row `j` at `v = (j + 0.5) / height`.
     CellCentred,

@@ -14,11 +14,12 @@ use std::path::PathBuf;
 use std::sync::Mutex;
 use std::time::Duration;
 
-use anyhow::Result;
 use serde::{Deserialize, Serialize};
 use volpt_core::abi::SceneAbi;
 use volpt_cuda::{CudaRenderer, Schedule, Strategy};
-use volpt_render::{Film, RenderOptions};
+use volpt_film::{Film, RenderOptions};
+
+use crate::Error;
 
 /// Register caps tried on the fastest strategy.
 const CAPS: [u32; 2] = [96, 64];
@@ -131,11 +132,11 @@ pub fn calibrate<S: SceneAbi>(
     renderer: &CudaRenderer,
     scene: &S,
     options: &RenderOptions,
-) -> Result<Choice> {
+) -> Result<Choice, Error> {
     let (width, height) = (scene.camera().width, scene.camera().height);
     let pixels = width as u64 * height as u64;
     let spp = CALIBRATION_PATHS.div_ceil(pixels.max(1)).clamp(1, 64) as u32;
-    let time = |schedule: Schedule| -> Result<Measurement> {
+    let time = |schedule: Schedule| -> Result<Measurement, Error> {
         let mut best = Duration::MAX;
         for _ in 0..TRIALS {
             let mut film = Film::new(width, height);

@@ -1,0 +1,58 @@
+//! volpt as a library: render solid participating media from the files users already have.
+//!
+//! ```no_run
+//! use volpt::{Backend, BackendOptions, Film, RenderSettings, Scene};
+//!
+//! let scene = Scene::load("scenes/example/cube.xml", &RenderSettings::default())?;
+//! let backend = Backend::open(&BackendOptions::default())?; // the CPU; `BackendKind::Cuda` for a GPU
+//! let mut film = scene.film();
+//! backend.render(&scene, &mut film, 0..scene.spp(), &volpt::Quiet)?;
+//! film.image(scene.spp()).write_exr("cube.exr".as_ref())?;
+//! # Ok::<(), volpt::Error>(())
+//! ```
+//!
+//! - [`settings`]: [`RenderSettings`], what a user overrides of a scene file's values (scene file <
+//!   settings), resolved once when a scene is loaded.
+//! - [`scene`]: [`Scene`], a loaded scene with its resolved settings, its [`fingerprint`] and the
+//!   parameters that change between renders without reloading its grids ([`Scene::set`]).
+//! - [`backend`]: [`Backend`], the CPU or a GPU with its strategy (or `auto`), math and memory
+//!   placement, opened once and reused; [`Backend::render`] adds a sample range to a [`Film`].
+//! - [`observer`]: what a render tells its caller while it runs (progress, notes) and how the caller
+//!   stops it ([`Observer`]).
+//! - [`auto`]: the `auto` strategy: calibration renders, a cache per scene and GPU.
+//! - [`checkpoint`]: long renders saved as they go and resumed bit for bit; films of disjoint sample
+//!   ranges merged.
+//! - [`fingerprint`]: what makes two renders the same render, as one hash.
+//! - [`error`]: every way the above fails, as one [`Error`].
+//!
+//! The crates below this one (`volpt-core`, `volpt-scene`, `volpt-render`, `volpt-cpu`,
+//! `volpt-cuda`, `volpt-film`) are re-exported for what the facade does not wrap.
+
+pub mod auto;
+pub mod backend;
+pub mod checkpoint;
+pub mod error;
+pub mod fingerprint;
+pub mod observer;
+pub mod scene;
+pub mod settings;
+
+pub use backend::{Backend, BackendKind, BackendOptions, GpuOptions, Rendered, StrategyChoice};
+pub use checkpoint::{merge, render_checkpointed, Checkpointing, Part};
+pub use error::Error;
+pub use observer::{Observer, Quiet};
+pub use scene::{ParamValue, Scene, PARAMS};
+pub use settings::{RenderSettings, Tracking};
+
+pub use volpt_core::{Estimator, PathSettings, Roulette};
+pub use volpt_cuda::{Math, Strategy};
+pub use volpt_film::{Film, Image, RenderStats};
+pub use volpt_render::{Effects, Variant};
+pub use volpt_scene::{GridLookup, SceneDescription};
+pub use volpt_zerocopy::VolumeMemory;
+
+pub use volpt_core as core;
+pub use volpt_cuda as cuda;
+pub use volpt_film as film;
+pub use volpt_render as render;
+pub use volpt_scene as scene_files;

@@ -1,0 +1,419 @@
+//! [`Scene`]: a scene loaded from any supported source, with its settings resolved, and the
+//! parameters that change between renders without reloading its grids.
+
+use std::path::Path;
+
+use volpt_core::grid::HALF_MAX;
+use volpt_core::PathSettings;
+use volpt_film::{Film, RenderOptions};
+use volpt_render::factory::Parts;
+use volpt_render::{Effects, Variant};
+use volpt_scene::toml_scene::look_at;
+use volpt_scene::{
+    AlbedoDesc, DensityDesc, GridLookup, GridStorage, PhaseDesc, SceneAssembler, SceneBuilder,
+    SceneDescription,
+};
+
+use crate::settings::RenderSettings;
+use crate::Error;
+
+/// A scene ready to render: its description, the path settings and variant choice it renders with,
+/// and its seed.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Names the scene in errors: its file, or the builder's source.
+    source: String,
+    desc: SceneDescription,
+    path: PathSettings,
+    effects: Effects,
+    seed: u32,
+    threads: Option<usize>,
+}
+
+/// A parameter's value ([`Scene::get`], [`Scene::set`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ParamValue {
+    Int(i64),
+    Float(f32),
+    Rgb([f32; 3]),
+    Vec3([f32; 3]),
+}
+
+/// The parameters a scene takes between renders: key and what it is.
+pub const PARAMS: &[(&str, &str)] = &[
+    ("spp", "samples per pixel, an integer of at least 1"),
+    (
+        "seed",
+        "seed of the random streams, an integer from 0 to 2^32 - 1",
+    ),
+    (
+        "max_depth",
+        "longest path in segments, an integer; -1 is unlimited",
+    ),
+    (
+        "rr_depth",
+        "depth from which Russian roulette runs, an integer; -1 never",
+    ),
+    ("camera.origin", "the camera's position, a 3-vector"),
+    (
+        "camera.target",
+        "a point the camera looks at (get: one unit ahead), a 3-vector",
+    ),
+    ("camera.up", "the camera's up direction, a 3-vector"),
+    (
+        "camera.fov",
+        "the field of view in degrees along the scene's fov axis, in (0, 180)",
+    ),
+    (
+        "medium.scale",
+        "the density's scale (extinction = scale x density), finite and >= 0",
+    ),
+    (
+        "medium.albedo",
+        "the constant single-scattering albedo, RGB in [0, 1] (not a grid's)",
+    ),
+    (
+        "phase.g",
+        "Henyey-Greenstein's mean cosine in (-1, 1); 0 is isotropic",
+    ),
+];
+
+impl Scene {
+    /// Loads the scene file at `path` (Mitsuba XML, volpt TOML, or a grid file) with `settings`
+    /// over its own values.
+    pub fn load(path: impl AsRef<Path>, settings: &RenderSettings) -> Result<Self, Error> {
+        let builder = volpt_scene::builder_for(path.as_ref())?;
+        Self::build(builder.as_ref(), settings)
+    }
+
+    /// The scene `builder` makes (any source, e.g. one written in code), with `settings` over it.
+    pub fn build(builder: &dyn SceneBuilder, settings: &RenderSettings) -> Result<Self, Error> {
+        settings.check_threads()?;
+        let mut desc = SceneAssembler::new(settings.config()).assemble(builder)?;
+        if let Some(lookup) = settings.lookup {
+            desc.medium.lookup = lookup;
+        }
+        check_lookup(&desc)?;
+        Ok(Self {
+            source: builder.source(),
+            path: settings.path_settings(&desc)?,
+            effects: settings.effects,
+            seed: settings.seed,
+            threads: settings.threads,
+            desc,
+        })
+    }
+
+    pub fn description(&self) -> &SceneDescription {
+        &self.desc
+    }
+
+    /// The scene file, or the builder's source.
+    pub fn source(&self) -> &str {
+        &self.source
+    }
+
+    pub fn path_settings(&self) -> PathSettings {
+        self.path
+    }
+
+    pub fn effects(&self) -> Effects {
+        self.effects
+    }
+
+    /// The monomorphised variant the factory picks for this scene.
+    pub fn variant(&self) -> Variant {
+        Parts::of(&self.desc, self.effects).variant()
+    }
+
+    pub fn spp(&self) -> u32 {
+        self.desc.spp
+    }
+
+    pub fn seed(&self) -> u32 {
+        self.seed
+    }
+
+    pub fn resolution(&self) -> (u32, u32) {
+        (self.desc.film.width, self.desc.film.height)
+    }
+
+    /// An empty film of this scene's size.
+    pub fn film(&self) -> Film {
+        let (width, height) = self.resolution();
+        Film::new(width, height)
+    }
+
+    /// Samples per pixel, seed and threads, as the backends take them.
+    pub fn options(&self) -> RenderOptions {
+        RenderOptions {
+            spp: self.desc.spp,
+            seed: self.seed,
+            threads: self.threads,
+        }
+    }
+
+    /// What makes two renders the same render ([`crate::fingerprint`]).
+    pub fn fingerprint(&self) -> u64 {
+        crate::fingerprint::fingerprint(&self.desc, &self.path, self.effects)
+    }
+
+    /// Replaces the path settings (tracking, estimator, roulette, depths) the scene renders with.
+    pub fn set_path_settings(&mut self, settings: PathSettings) {
+        self.path = settings;
+    }
+
+    /// The seed of the random streams: renders of different seeds are independent.
+    pub fn set_seed(&mut self, seed: u32) {
+        self.seed = seed;
+    }
+
+    pub fn set_effects(&mut self, effects: Effects) {
+        self.effects = effects;
+    }
+
+    /// How the grids are reconstructed; refused where the grids' values do not fit the lookup.
+    pub fn set_lookup(&mut self, lookup: GridLookup) -> Result<(), Error> {
+        let before = std::mem::replace(&mut self.desc.medium.lookup, lookup);
+        check_lookup(&self.desc).inspect_err(|_| self.desc.medium.lookup = before)
+    }
+
+    /// How a GPU stores the grids (the backend's choice: [`crate::Backend::prepare`]).
+    pub fn set_storage(&mut self, storage: GridStorage) {
+        self.desc.medium.storage = storage;
+    }
+
+    /// The value of parameter `key` ([`PARAMS`]).
+    pub fn get(&self, key: &str) -> Result<ParamValue, Error> {
+        let d = &self.desc;
+        let m = &d.camera.to_world;
+        let column = |j: usize| [m[0][j], m[1][j], m[2][j]];
+        let depth = |d: Option<u32>| ParamValue::Int(d.map_or(-1, i64::from));
+        Ok(match key {
+            "spp" => ParamValue::Int(d.spp.into()),
+            "seed" => ParamValue::Int(self.seed.into()),
+            "max_depth" => depth(d.integrator.max_depth),
+            "rr_depth" => depth(d.integrator.rr_depth),
+            "camera.origin" => ParamValue::Vec3(column(3)),
+            "camera.target" => {
+                let (o, f) = (column(3), column(2));
+                ParamValue::Vec3([o[0] + f[0], o[1] + f[1], o[2] + f[2]])
+            }
+            "camera.up" => ParamValue::Vec3(column(1)),
+            "camera.fov" => ParamValue::Float(d.camera.fov_degrees),
+            "medium.scale" => ParamValue::Float(d.medium.scale),
+            "medium.albedo" => match &d.medium.albedo {
+                AlbedoDesc::Constant(rgb) => ParamValue::Rgb(*rgb),
+                AlbedoDesc::Grid(_) => return Err(not_here(key, "a constant albedo", "a grid")),
+            },
+            "phase.g" => ParamValue::Float(match d.medium.phase {
+                PhaseDesc::Isotropic => 0.0,
+                PhaseDesc::HenyeyGreenstein { g } => g,
+            }),
+            _ => return Err(unknown(key)),
+        })
+    }
+
+    /// Sets parameter `key` ([`PARAMS`]) to `value`. The scene is checked as a loaded one is; a
+    /// value it refuses leaves the scene as it was.
+    pub fn set(&mut self, key: &str, value: ParamValue) -> Result<(), Error> {
+        let before = self.clone_light();
+        let result = self.apply(key, value).and_then(|()| {
+            volpt_scene::numerics::check_position_resolution(&self.desc, Path::new(&self.source))?;
+            volpt_scene::validate::validate(&self.desc, &self.source)?;
+            check_lookup(&self.desc)
+        });
+        if result.is_err() {
+            self.restore_light(before);
+        }
+        result
+    }
+
+    fn apply(&mut self, key: &str, value: ParamValue) -> Result<(), Error> {
+        let wrong = |expected: &str| Error::Param {
+            key: key.to_owned(),
+            expected: expected.to_owned(),
+            found: format!("{value:?}"),
+        };
+        let int = |lo: i64, hi: i64| match value {
+            ParamValue::Int(v) if (lo..=hi).contains(&v) => Ok(v),
+            _ => Err(wrong(&format!("an integer from {lo} to {hi}"))),
+        };
+        let vec3 = || match value {
+            ParamValue::Vec3(v) | ParamValue::Rgb(v) if v.iter().all(|c| c.is_finite()) => Ok(v),
+            _ => Err(wrong("three finite numbers")),
+        };
+        let float = |ok: &dyn Fn(f32) -> bool, expected: &str| match value {
+            ParamValue::Float(v) if ok(v) => Ok(v),
+            ParamValue::Int(v) if ok(v as f32) => Ok(v as f32),
+            _ => Err(wrong(expected)),
+        };
+        let depth = |v: i64| u32::try_from(v).ok();
+        let d = &mut self.desc;
+        match key {
+            "spp" => d.spp = int(1, u32::MAX.into())? as u32,
+            "seed" => self.seed = int(0, u32::MAX.into())? as u32,
+            "max_depth" => {
+                d.integrator.max_depth = depth(int(-1, u32::MAX.into())?);
+                self.path = volpt_render::path_settings(d).with_choices_of(&self.path);
+            }
+            "rr_depth" => {
+                d.integrator.rr_depth = depth(int(-1, u32::MAX.into())?);
+                self.path = volpt_render::path_settings(d).with_choices_of(&self.path);
+            }
+            "camera.origin" | "camera.target" | "camera.up" => {
+                let value = vec3()?;
+                let [mut origin, mut target, mut up] =
+                    ["camera.origin", "camera.target", "camera.up"].map(|k| match self.get(k) {
+                        Ok(ParamValue::Vec3(v)) => v,
+                        _ => unreachable!("the camera's vectors are always there"),
+                    });
+                match key {
+                    "camera.origin" => {
+                        // Moving the camera keeps its direction.
+                        let forward = [0, 1, 2].map(|i| target[i] - origin[i]);
+                        origin = value;
+                        target = [0, 1, 2].map(|i| origin[i] + forward[i]);
+                    }
+                    "camera.target" => target = value,
+                    _ => up = value,
+                }
+                self.desc.camera.to_world = look_at(origin, target, up).ok_or_else(|| {
+                    wrong("a camera whose direction (target - origin) and up are non-zero and not parallel")
+                })?;
+            }
+            "camera.fov" => {
+                d.camera.fov_degrees = float(&|v| v > 0.0 && v < 180.0, "degrees in (0, 180)")?
+            }
+            "medium.scale" => {
+                d.medium.scale = float(&|v| v.is_finite() && v >= 0.0, "a finite number >= 0")?
+            }
+            "medium.albedo" => match &mut d.medium.albedo {
+                AlbedoDesc::Constant(rgb) => {
+                    let v = vec3()?;
+                    if !v.iter().all(|c| (0.0..=1.0).contains(c)) {
+                        return Err(wrong("RGB in [0, 1]"));
+                    }
+                    *rgb = v;
+                }
+                AlbedoDesc::Grid(_) => return Err(not_here(key, "a constant albedo", "a grid")),
+            },
+            "phase.g" => {
+                let g = float(&|g| g > -1.0 && g < 1.0, "a number in (-1, 1)")?;
+                // g = 0 stays a Henyey-Greenstein phase: the factory picks the isotropic part for
+                // it, and `volpt info` says so.
+                d.medium.phase = PhaseDesc::HenyeyGreenstein { g };
+            }
+            _ => return Err(unknown(key)),
+        }
+        Ok(())
+    }
+
+    /// The small parts [`Scene::set`] changes (never the grids), to restore on a refusal.
+    fn clone_light(&self) -> Light {
+        let d = &self.desc;
+        Light {
+            camera: d.camera,
+            spp: d.spp,
+            integrator: d.integrator,
+            scale: d.medium.scale,
+            albedo: match &d.medium.albedo {
+                AlbedoDesc::Constant(rgb) => Some(*rgb),
+                AlbedoDesc::Grid(_) => None,
+            },
+            phase: d.medium.phase,
+            path: self.path,
+            seed: self.seed,
+        }
+    }
+
+    fn restore_light(&mut self, l: Light) {
+        let d = &mut self.desc;
+        d.camera = l.camera;
+        d.spp = l.spp;
+        d.integrator = l.integrator;
+        d.medium.scale = l.scale;
+        if let (Some(rgb), AlbedoDesc::Constant(now)) = (l.albedo, &mut d.medium.albedo) {
+            *now = rgb;
+        }
+        d.medium.phase = l.phase;
+        self.path = l.path;
+        self.seed = l.seed;
+    }
+}
+
+struct Light {
+    camera: volpt_scene::CameraDesc,
+    spp: u32,
+    integrator: volpt_scene::IntegratorDesc,
+    scale: f32,
+    albedo: Option<[f32; 3]>,
+    phase: PhaseDesc,
+    path: PathSettings,
+    seed: u32,
+}
+
+/// The path settings of a changed integrator with the tracking, estimator and roulette chosen
+/// before.
+trait WithChoices {
+    fn with_choices_of(self, chosen: &PathSettings) -> PathSettings;
+}
+
+impl WithChoices for PathSettings {
+    fn with_choices_of(self, chosen: &PathSettings) -> PathSettings {
+        PathSettings {
+            max_depth: self.max_depth,
+            rr_depth: self.rr_depth,
+            ..*chosen
+        }
+    }
+}
+
+fn unknown(key: &str) -> Error {
+    let keys: Vec<_> = PARAMS.iter().map(|(k, _)| *k).collect();
+    Error::Param {
+        key: key.to_owned(),
+        expected: format!("one of {}", keys.join(", ")),
+        found: "no such parameter".into(),
+    }
+}
+
+fn not_here(key: &str, expected: &str, found: &str) -> Error {
+    Error::Param {
+        key: key.to_owned(),
+        expected: expected.to_owned(),
+        found: found.to_owned(),
+    }
+}
+
+/// Refuses a lookup the medium's grids cannot take: half-precision texels end at 65504.
+fn check_lookup(desc: &SceneDescription) -> Result<(), Error> {
+    if desc.medium.lookup != GridLookup::TextureHalf {
+        return Ok(());
+    }
+    let largest = [
+        (
+            "density",
+            match &desc.medium.density {
+                DensityDesc::Constant(v) => *v,
+                DensityDesc::Grid(grid) => grid.max_value(),
+            },
+        ),
+        (
+            "albedo",
+            match &desc.medium.albedo {
+                AlbedoDesc::Constant(rgb) => rgb.iter().copied().fold(0.0, f32::max),
+                AlbedoDesc::Grid(grid) => grid.max_value(),
+            },
+        ),
+    ];
+    for (name, largest) in largest {
+        if largest > HALF_MAX {
+            return Err(Error::Settings(format!(
+                "--lookup texture-f16: the medium's largest {name} is {largest}, above half \
+                 precision's largest value, {HALF_MAX} (use --lookup texture: f32 texels)"
+            )));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,114 @@
+//! [`RenderSettings`]: what a user overrides of a scene file's own values.
+//!
+//! Precedence: the scene file (with its `-D` parameters), then these settings. A field left `None`
+//! keeps the scene file's value; `volpt render`'s flags, the Python package's keyword arguments and
+//! the viewer's controls all fill this one type. [`crate::Scene::load`] resolves it once into the
+//! scene's description and its [`PathSettings`].
+
+use volpt_core::{Estimator, PathSettings, Roulette};
+use volpt_render::{path_settings, Effects};
+use volpt_scene::{Config, GridLookup, SceneDescription};
+
+use crate::Error;
+
+/// How a render traces and samples, over the scene file's values.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RenderSettings {
+    /// Mitsuba's `-D name=value` scene parameters, in order: later ones win.
+    pub params: Vec<(String, String)>,
+    /// Samples per pixel (the scene's sampler).
+    pub spp: Option<u32>,
+    /// Film `(width, height)`.
+    pub resolution: Option<(u32, u32)>,
+    /// Longest path (Mitsuba's `max_depth`); `Some(None)` is unlimited (-1).
+    pub max_depth: Option<Option<u32>>,
+    /// Depth from which Russian roulette starts (Mitsuba's `rr_depth`); `Some(None)` disables it.
+    pub rr_depth: Option<Option<u32>>,
+    /// One global majorant or a majorant grid (default: chosen per scene by the factory).
+    pub tracking: Option<Tracking>,
+    /// Cells of the majorant grid along the box's longest axis (1 is the global majorant).
+    pub majorant_resolution: Option<u32>,
+    /// How paths gather the environment's light (default: NEE for a lat-long map behind an
+    /// index-matched boundary, path tracing elsewhere).
+    pub estimator: Option<Estimator>,
+    /// How the medium's grids are reconstructed between samples (default: the scene's).
+    pub lookup: Option<GridLookup>,
+    /// Russian roulette's survival probability (default: Mitsuba's).
+    pub roulette: Option<Roulette>,
+    /// The variant specialised to the scene's effects (default) or the most general one.
+    pub effects: Effects,
+    /// Seed of the random streams: the same seed gives the same image on every backend.
+    pub seed: u32,
+    /// CPU worker threads (default: every core); GPUs ignore it.
+    pub threads: Option<usize>,
+}
+
+/// Delta and ratio tracking under one majorant or a grid of them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tracking {
+    /// One majorant, the densest voxel's extinction, everywhere.
+    Global,
+    /// A majorant per cell of a coarse grid, walked by a 3D DDA.
+    Grid,
+}
+
+impl RenderSettings {
+    /// The part the scene assembler applies while it builds the description.
+    pub fn config(&self) -> Config {
+        Config {
+            params: self.params.clone(),
+            spp: self.spp,
+            resolution: self.resolution,
+            max_depth: self.max_depth,
+            rr_depth: self.rr_depth,
+        }
+    }
+
+    /// The scene's integrator settings with these tracking, estimator and roulette choices.
+    pub fn path_settings(&self, desc: &SceneDescription) -> Result<PathSettings, Error> {
+        let mut settings = path_settings(desc);
+        settings.majorant_resolution = match (self.tracking, self.majorant_resolution) {
+            (Some(Tracking::Global), Some(r)) if r > 1 => {
+                return Err(Error::Settings(format!(
+                    "--tracking global uses one majorant; --majorant-resolution {r} asks for a \
+                     grid"
+                )))
+            }
+            (_, Some(0)) => {
+                return Err(Error::Settings(
+                    "--majorant-resolution: expected 1 to 1024 cells, found 0".into(),
+                ))
+            }
+            (Some(Tracking::Global), _) => 1,
+            (_, Some(r)) => r,
+            (Some(Tracking::Grid), None) if settings.majorant_resolution <= 1 => {
+                PathSettings::DEFAULT_MAJORANT_RESOLUTION
+            }
+            (_, None) => settings.majorant_resolution,
+        };
+        if let Some(roulette) = self.roulette {
+            settings.roulette = roulette;
+        }
+        if let Some(estimator) = self.estimator {
+            settings.estimator = estimator;
+        }
+        Ok(settings)
+    }
+
+    /// Refuses a thread count that is no CPU render: threads beyond the cores only cost memory and
+    /// start-up, and tens of thousands of them exhaust the system before the render starts.
+    pub fn check_threads(&self) -> Result<(), Error> {
+        let Some(threads) = self.threads else {
+            return Ok(());
+        };
+        let cores = std::thread::available_parallelism().map_or(1, usize::from);
+        let most = 4 * cores;
+        if !(1..=most).contains(&threads) {
+            return Err(Error::Settings(format!(
+                "--threads: expected 1 to {most} (4 x the {cores} cores of this machine), found \
+                 {threads}"
+            )));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,279 @@
+//! The library facade on the CPU: renders in chunks, cancelled and resumed, and split into ranges
+//! and merged equal one whole render; parameters equal a reload of the changed scene file; the
+//! fingerprint sees every part of a render and nothing else.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::time::Duration;
+
+use volpt::{
+    merge, Backend, Error, Film, Observer, ParamValue, Part, Quiet, RenderSettings, Scene,
+};
+
+fn example() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/example/cube.xml")
+}
+
+fn small() -> RenderSettings {
+    RenderSettings {
+        resolution: Some((12, 10)),
+        spp: Some(6),
+        seed: 3,
+        ..RenderSettings::default()
+    }
+}
+
+fn render(scene: &Scene, samples: std::ops::Range<u32>) -> Film {
+    let mut film = scene.film();
+    Backend::cpu()
+        .render(scene, &mut film, samples, &Quiet)
+        .unwrap();
+    film
+}
+
+/// Cancels after `after` looks, checking after every sample.
+struct CancelAfter {
+    looks: AtomicU32,
+    after: u32,
+}
+
+impl Observer for CancelAfter {
+    fn cancelled(&self) -> bool {
+        self.looks.fetch_add(1, Ordering::SeqCst) + 1 >= self.after
+    }
+    fn check_every(&self) -> Option<Duration> {
+        Some(Duration::ZERO)
+    }
+}
+
+#[test]
+fn a_cancelled_render_resumed_is_the_whole_render_bit_for_bit() {
+    let scene = Scene::load(example(), &small()).unwrap();
+    let whole = render(&scene, 0..6);
+    let mut film = scene.film();
+    let stop = CancelAfter {
+        looks: AtomicU32::new(0),
+        after: 2,
+    };
+    let backend = Backend::cpu();
+    let first = backend.render(&scene, &mut film, 0..6, &stop).unwrap();
+    assert!(first.cancelled(&(0..6)), "{:?}", first.samples);
+    assert_eq!(
+        first.samples,
+        0..2,
+        "chunks of one sample, cancelled at the second look"
+    );
+    let rest = backend
+        .render(&scene, &mut film, first.samples.end..6, &Quiet)
+        .unwrap();
+    assert_eq!(rest.samples, 2..6);
+    assert_eq!(film.sums, whole.sums);
+}
+
+#[test]
+fn ranges_merged_equal_the_whole_render_and_the_same_partition_gives_the_same_bits() {
+    let scene = Scene::load(example(), &small()).unwrap();
+    let whole = render(&scene, 0..6);
+    let part = |r: std::ops::Range<u32>| Part {
+        fingerprint: scene.fingerprint(),
+        seed: scene.seed(),
+        film: render(&scene, r.clone()),
+        samples: r,
+    };
+    let parts = vec![part(4..6), part(0..1), part(1..4)];
+    let merged = merge(parts.clone()).unwrap();
+    assert_eq!(merged.samples, 0..6);
+    for (m, w) in merged.film.sums.iter().zip(&whole.sums) {
+        for c in 0..3 {
+            // Three partial sums added instead of six samples one by one: f64 rounding only.
+            assert!(
+                (m[c] - w[c]).abs() <= 1e-12 * w[c].abs().max(1.0),
+                "{m:?} {w:?}"
+            );
+        }
+    }
+    let mut reversed = parts.clone();
+    reversed.reverse();
+    assert_eq!(merge(reversed).unwrap().film.sums, merged.film.sums);
+
+    let refused = |parts: Vec<Part>, needle: &str| match merge(parts) {
+        Err(e @ Error::Merge(_)) => assert!(e.to_string().contains(needle), "{e}"),
+        other => panic!("expected a refusal naming {needle:?}, got {other:?}"),
+    };
+    refused(vec![part(0..3), part(2..6)], "overlap");
+    refused(vec![part(0..2), part(4..6)], "samples 2..4 are in no film");
+    let mut other_seed = part(2..6);
+    other_seed.seed += 1;
+    refused(vec![part(0..2), other_seed], "seed");
+    let mut other_scene = part(2..6);
+    other_scene.fingerprint ^= 1;
+    refused(vec![part(0..2), other_scene], "fingerprint");
+    refused(vec![], "no films");
+}
+
+/// A copy of the example scene file with `edits` (text replacements) applied.
+fn edited_example(dir: &Path, edits: &[(&str, &str)]) -> PathBuf {
+    let mut text = std::fs::read_to_string(example()).unwrap();
+    for (from, to) in edits {
+        assert!(text.contains(from), "{from}");
+        text = text.replace(from, to);
+    }
+    let path = dir.join("cube.xml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn parameters_render_as_the_changed_scene_file_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut scene = Scene::load(example(), &small()).unwrap();
+    scene.set("medium.scale", ParamValue::Float(2.0)).unwrap();
+    scene.set("phase.g", ParamValue::Float(0.3)).unwrap();
+    scene
+        .set("medium.albedo", ParamValue::Rgb([0.5, 0.6, 0.7]))
+        .unwrap();
+    scene.set("max_depth", ParamValue::Int(7)).unwrap();
+    let changed = edited_example(
+        dir.path(),
+        &[
+            (r#"name="scale" value="1""#, r#"name="scale" value="2""#),
+            (r#"name="g" value="0.6""#, r#"name="g" value="0.3""#),
+            ("0.98, 0.8, 0.45", "0.5, 0.6, 0.7"),
+            (
+                r#"name="maxDepth" value="-1""#,
+                r#"name="maxDepth" value="7""#,
+            ),
+        ],
+    );
+    let reloaded = Scene::load(&changed, &small()).unwrap();
+    assert_eq!(scene.fingerprint(), reloaded.fingerprint());
+    assert_eq!(render(&scene, 0..6).sums, render(&reloaded, 0..6).sums);
+}
+
+#[test]
+fn the_camera_moves_as_a_lookat_in_the_scene_file_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut scene = Scene::load(example(), &small()).unwrap();
+    scene
+        .set("camera.target", ParamValue::Vec3([0.1, 0.0, 0.0]))
+        .unwrap();
+    scene
+        .set("camera.origin", ParamValue::Vec3([2.0, 3.0, 3.0]))
+        .unwrap();
+    scene.set("camera.fov", ParamValue::Float(25.0)).unwrap();
+    // Moving the origin kept the direction: the target moved with it.
+    let reloaded = Scene::load(
+        edited_example(
+            dir.path(),
+            &[
+                (
+                    r#"origin="3.2, 2.4, 4" target="0, -0.1, 0""#,
+                    r#"origin="2, 3, 3" target="-1.1, 0.6, -1""#,
+                ),
+                (r#"name="fov" value="30""#, r#"name="fov" value="25""#),
+            ],
+        ),
+        &small(),
+    )
+    .unwrap();
+    let (a, b) = (scene.description().camera, reloaded.description().camera);
+    assert_eq!(a.fov_degrees, b.fov_degrees);
+    for (ra, rb) in a.to_world.iter().zip(&b.to_world) {
+        for (x, y) in ra.iter().zip(rb) {
+            assert!((x - y).abs() < 1e-6, "{:?} vs {:?}", a.to_world, b.to_world);
+        }
+    }
+}
+
+#[test]
+fn bad_parameters_are_refused_by_name_and_change_nothing() {
+    let mut scene = Scene::load(example(), &small()).unwrap();
+    let before = scene.fingerprint();
+    for (key, value, needle) in [
+        ("medium.density", ParamValue::Float(1.0), "one of spp, seed"),
+        ("phase.g", ParamValue::Float(1.0), "(-1, 1)"),
+        ("medium.scale", ParamValue::Float(f32::NAN), "finite"),
+        ("medium.scale", ParamValue::Float(-1.0), ">= 0"),
+        ("medium.albedo", ParamValue::Rgb([0.5, 1.5, 0.5]), "[0, 1]"),
+        (
+            "camera.up",
+            ParamValue::Vec3([0.0, 0.0, 0.0]),
+            "not parallel",
+        ),
+        ("camera.fov", ParamValue::Float(180.0), "(0, 180)"),
+        ("spp", ParamValue::Int(0), "from 1"),
+        ("max_depth", ParamValue::Int(-2), "from -1"),
+    ] {
+        let err = scene.set(key, value).unwrap_err();
+        let text = err.to_string();
+        assert!(text.contains(key) && text.contains(needle), "{text}");
+        assert_eq!(scene.fingerprint(), before, "{key} changed the scene");
+    }
+    // A scale that makes the medium too dense for f32 positions is the loader's refusal.
+    let err = scene
+        .set("medium.scale", ParamValue::Float(1e12))
+        .unwrap_err();
+    assert!(matches!(err, Error::Scene(_)), "{err}");
+    assert_eq!(scene.fingerprint(), before);
+}
+
+#[test]
+fn the_fingerprint_sees_the_render_and_not_the_sample_count_or_seed() {
+    let scene = Scene::load(example(), &small()).unwrap();
+    let fp = |settings: RenderSettings| Scene::load(example(), &settings).unwrap().fingerprint();
+    let base = scene.fingerprint();
+    assert_eq!(
+        fp(RenderSettings {
+            spp: Some(99),
+            seed: 8,
+            ..small()
+        }),
+        base
+    );
+    for changed in [
+        RenderSettings {
+            resolution: Some((12, 11)),
+            ..small()
+        },
+        RenderSettings {
+            max_depth: Some(Some(3)),
+            ..small()
+        },
+        RenderSettings {
+            roulette: Some(volpt::Roulette::Throughput),
+            ..small()
+        },
+        RenderSettings {
+            effects: volpt::Effects::General,
+            ..small()
+        },
+        RenderSettings {
+            params: vec![("resolution".into(), "12".into())],
+            resolution: None,
+            ..small()
+        },
+    ] {
+        assert_ne!(fp(changed.clone()), base, "{changed:?}");
+    }
+    let mut bricked = scene.clone();
+    bricked.set_storage(volpt::scene_files::GridStorage::Bricked);
+    assert_ne!(bricked.fingerprint(), base, "the grid storage");
+}
+
+#[test]
+fn a_backend_that_stores_other_grids_or_a_film_of_another_size_is_refused() {
+    let scene = Scene::load(example(), &small()).unwrap();
+    let mut stored = scene.clone();
+    stored.set_storage(volpt::scene_files::GridStorage::Bricked);
+    let err = Backend::cpu()
+        .render(&stored, &mut scene.film(), 0..1, &Quiet)
+        .unwrap_err();
+    assert!(err.to_string().contains("Backend::prepare"), "{err}");
+    let err = Backend::cpu()
+        .render(&scene, &mut Film::new(3, 3), 0..1, &Quiet)
+        .unwrap_err();
+    assert!(
+        err.to_string().contains("3x3") && err.to_string().contains("12x10"),
+        "{err}"
+    );
+}
