@@ -271,6 +271,10 @@ fn normalise(path: &Path) -> PathBuf {
     out
 }
 
+/// Pages another change is writing, which may be linked before they exist (paths from the
+/// repository's root). Remove a page from here once it is in the tree.
+const PAGES_IN_PROGRESS: &[&str] = &["docs/architecture.md"];
+
 #[test]
 fn every_relative_link_of_the_readme_and_the_docs_resolves() {
     let root = normalise(&root());
@@ -281,7 +285,11 @@ fn every_relative_link_of_the_readme_and_the_docs_resolves() {
     let mut problems = Vec::new();
     for file in &files {
         let text = std::fs::read_to_string(file).expect("read a Markdown file");
-        let name = file.strip_prefix(&root).unwrap_or(file).display().to_string();
+        let name = file
+            .strip_prefix(&root)
+            .unwrap_or(file)
+            .display()
+            .to_string();
         let mut in_code = false;
         for (number, line) in text.lines().enumerate() {
             if line.trim_start().starts_with("```") {
@@ -292,10 +300,7 @@ fn every_relative_link_of_the_readme_and_the_docs_resolves() {
                 continue;
             }
             for target in link_targets(line) {
-                if target.is_empty()
-                    || target.contains("://")
-                    || target.starts_with("mailto:")
-                {
+                if target.is_empty() || target.contains("://") || target.starts_with("mailto:") {
                     continue;
                 }
                 let (path, anchor) = match target.split_once('#') {
@@ -308,6 +313,12 @@ fn every_relative_link_of_the_readme_and_the_docs_resolves() {
                     normalise(&file.parent().expect("a file's folder").join(path))
                 };
                 let at = format!("{name}:{}: {target}", number + 1);
+                let in_progress = resolved
+                    .strip_prefix(&root)
+                    .is_ok_and(|p| PAGES_IN_PROGRESS.iter().any(|q| p == Path::new(q)));
+                if !resolved.exists() && in_progress {
+                    continue;
+                }
                 if !resolved.exists() {
                     problems.push(format!("{at}: no such file"));
                     continue;
