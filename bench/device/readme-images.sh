@@ -66,7 +66,7 @@ for entry in "${SCENES[@]}"; do
     if timeout "$LIMIT" "${cmd[@]}" >"$WORK/$name.log" 2>&1; then
         t1=$(date +%s%N)
         cp "$WORK/$name.png" "$OUT/$name.png"
-        say "$name: $(((t1 - t0) / 1000000)) ms wall; $(grep -v '^\s*$' "$WORK/$name.log" | tail -n 3 | tr '\n' ' ')"
+        say "$name: $(((t1 - t0) / 1000000)) ms wall; $(sed 's/\x1b\[[0-9;]*m//g' "$WORK/$name.log" | grep 'paths/s' | tail -n 1)"
     else
         say "FAIL $name (exit $?): $(tail -n 3 "$WORK/$name.log" | tr '\n' ' ')"
         failures=$((failures + 1))
