@@ -12,7 +12,7 @@
 # Environment: OUT, WORK (default ./readme-work), SIZE (pixels per side, default 800), SPP_DIV
 # (divide every scene's spp, default 1), LIMIT (seconds per render, default 240), DATA (a folder
 # with smoke.vol and Bucky.raw; default: the bundle's data/ if it has them, else each scene's own
-# default), STRATEGY (default regeneration-sk: no calibration renders, the same choice every run),
+# default: for smoke the generated stand-in, for bucky scenes/bucky/Bucky.raw; the log says which), STRATEGY (default regeneration-sk: no calibration renders, the same choice every run),
 # BACKEND (default cuda; cpu to try the script without a GPU).
 set -uo pipefail
 cd "$(dirname "$0")"
