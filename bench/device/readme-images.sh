@@ -9,11 +9,15 @@
 # $OUT/readme-images.txt: the date, the device, and each render's command, time and summary. The
 # EXRs stay in $WORK (they are large). Copy the PNGs to docs/images/ and commit them.
 #
-# Environment: OUT, WORK (default ./readme-work), SIZE (pixels per side, default 800), SPP_DIV
-# (divide every scene's spp, default 1), LIMIT (seconds per render, default 240), DATA (a folder
-# with smoke.vol and Bucky.raw; default: the bundle's data/ if it has them, else each scene's own
-# default: for smoke the generated stand-in, for bucky scenes/bucky/Bucky.raw; the log says which), STRATEGY (default regeneration-sk: no calibration renders, the same choice every run),
-# BACKEND (default cuda; cpu to try the script without a GPU).
+# Environment:
+#   OUT, WORK   outputs (PNGs, log) and work files (EXRs, logs; default ./readme-work)
+#   SIZE        pixels per side (default 800); SPP_DIV divides every scene's spp (default 1)
+#   LIMIT       seconds per render (default 240)
+#   DATA        a folder with smoke.vol (Mitsuba's grid) and Bucky.raw; default: the bundle's data/
+#               where it has them, else each scene's own default (smoke: the generated stand-in;
+#               bucky: scenes/bucky/Bucky.raw). The log's commands show which (-Ddata=...).
+#   STRATEGY    default regeneration-sk: no calibration renders, the same choice every run
+#   BACKEND     default cuda; cpu tries the script without a GPU
 set -uo pipefail
 cd "$(dirname "$0")"
 OUT=${OUT:-$PWD/out}
