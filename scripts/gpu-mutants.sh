@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Mutants of volpt-core's GPU-only code, judged on the GPU (docs/testing.md, "GPU-only mutants").
+# Mutants of volpt-core's GPU-only code, judged on the GPU (bench/results/notes/mutation-testing.md, "GPU-only mutants").
 #
 #   scripts/gpu-mutants.sh                  # here: bundle-mutants/, one selftest PTX per mutant
 #   cargo xtask device-bundle               # bundle/ with bin/volpt and bench/device/gpu-mutants.sh

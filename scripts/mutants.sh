@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Mutation testing with cargo-mutants (docs/testing.md records the runs and explains the survivors).
+# Mutation testing with cargo-mutants (docs/testing.md; bench/results/notes/mutation-testing.md records the runs and explains the survivors).
 #
 #   scripts/mutants.sh core [cargo-mutants options, e.g. --shard 3/8 --sharding round-robin]
 #   scripts/mutants.sh loaders [cargo-mutants options]

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The thesis's strategy tables (4.1, 4.3, 6.1-6.3: rays/s and time per method on cgg-logo, ad,
-# smoke and bucky) redone with volpt's strategies on the lent GPU (docs/strategies.md, "The
-# thesis's tables"). Each scene at 400x400, 100 spp (bucky 300), `volpt bench`, median of TRIALS
+# smoke and bucky) redone with volpt's strategies on the lent GPU (docs/strategies.md, "Against
+# the thesis"). Each scene at 400x400, 100 spp (bucky 300), `volpt bench`, median of TRIALS
 # after a warm-up, with the thesis's roulette (min(1, max T) from the first bounce, on in its
 # measurements), in two configurations: exact arithmetic with trilinear lookups (volpt's default)
 # and fast arithmetic with texture lookups (the thesis read its grids through textures).

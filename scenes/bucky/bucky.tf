@@ -1,4 +1,4 @@
-# Bucky's transfer function (docs/transfer-functions.md), over density 0..40 after normalisation:
+# Bucky's transfer function (docs/guide.md, "Transfer functions"), over density 0..40 after normalisation:
 # the thin outer shell a warm orange, the denser carbon cages pale blue, the cores white.
 # density  r     g     b
 0          0.95  0.55  0.20

@@ -35,7 +35,7 @@ impl SceneBuilder for MitsubaXml {
     }
 }
 
-/// A volpt TOML scene file (`docs/scene-files.md`).
+/// A volpt TOML scene file (format: `docs/guide.md`, "volpt TOML scenes").
 pub struct TomlScene(pub PathBuf);
 
 impl SceneBuilder for TomlScene {

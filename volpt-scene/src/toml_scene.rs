@@ -1,7 +1,7 @@
 //! volpt's own scene files (`.toml`): one volume from any grid file volpt reads (raw, MetaImage,
 //! VTK, Mitsuba `.vol`), with a transfer function or a constant albedo, and the rest of the scene
 //! in a few keys. Everything but `[volume]` has a default: the thesis setup (camera at (0, 0, 100),
-//! fov 0.7, GGX alpha 0.1, IORs 1.05/1.01, 400x400 at 100 spp), so a CT volume needs four lines. The format is documented in `docs/scene-files.md`.
+//! fov 0.7, GGX alpha 0.1, IORs 1.05/1.01, 400x400 at 100 spp), so a CT volume needs four lines. The format is documented in `docs/guide.md` ("volpt TOML scenes").
 //!
 //! Paths are relative to the scene file. `$name` in a path is replaced by a parameter: the
 //! `[defaults]` table gives values, and `-D name=value` overrides them, as in Mitsuba XML.
@@ -107,7 +107,7 @@ pub enum FovAxisName {
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AlbedoSpec {
-    /// A transfer function file (docs/transfer-functions.md) applied to the normalised density.
+    /// A transfer function file (docs/guide.md, "Transfer functions") applied to the normalised density.
     pub transfer_function: Option<String>,
     /// A constant albedo, grey or RGB (default 0.9 grey, unless a transfer function is given).
     pub value: Option<OneOrThree>,

@@ -5,7 +5,7 @@
 //! it: [`TransferFunction::apply`] turns a 1-channel density grid into the 3-channel albedo grid
 //! of the same shape, so that, say, dense material scatters white and thin material red.
 //!
-//! The text file format (documented for users in `docs/transfer-functions.md`): one control point
+//! The text file format (documented for users in `docs/guide.md` ("Transfer functions")): one control point
 //! `density r g b` per line, numbers separated by whitespace; `#` starts a comment that runs to the
 //! end of the line; blank lines are ignored. Densities must be finite and strictly increasing,
 //! albedo components in `[0, 1]`, and there must be at least one point (one point is a constant

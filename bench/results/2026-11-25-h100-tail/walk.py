@@ -1,4 +1,4 @@
-"""The index-matched cube's path lengths, simulated (docs/strategies.md, "The launch's tail").
+"""The index-matched cube's path lengths, simulated (bench/results/notes/strategies.md, "The launch's tail").
 
     python3 walk.py N   # N paths that hit the cube (numpy)
 
