@@ -28,6 +28,10 @@ pub struct Scene {
     effects: Effects,
     seed: u32,
     threads: Option<usize>,
+    /// The up direction a camera move keeps (`camera.up`): the camera's own up as loaded, until
+    /// set. A look-at frame forgets the up it was built from, and re-deriving it from the frame
+    /// would roll the camera at every move.
+    up: [f32; 3],
 }
 
 /// A parameter's value ([`Scene::get`], [`Scene::set`]).
@@ -59,7 +63,11 @@ pub const PARAMS: &[(&str, &str)] = &[
         "camera.target",
         "a point the camera looks at (get: one unit ahead), a 3-vector",
     ),
-    ("camera.up", "the camera's up direction, a 3-vector"),
+    (
+        "camera.up",
+        "the up direction camera moves keep, a 3-vector (as loaded: the camera's own up; set \
+         the world's up, e.g. [0, 1, 0], to orbit without roll)",
+    ),
     (
         "camera.fov",
         "the field of view in degrees along the scene's fov axis, in (0, 180)",
@@ -94,7 +102,9 @@ impl Scene {
             desc.medium.lookup = lookup;
         }
         check_lookup(&desc)?;
+        let m = &desc.camera.to_world;
         Ok(Self {
+            up: [m[0][1], m[1][1], m[2][1]],
             source: builder.source(),
             path: settings.path_settings(&desc)?,
             effects: settings.effects,
@@ -186,20 +196,15 @@ impl Scene {
     /// The value of parameter `key` ([`PARAMS`]).
     pub fn get(&self, key: &str) -> Result<ParamValue, Error> {
         let d = &self.desc;
-        let m = &d.camera.to_world;
-        let column = |j: usize| [m[0][j], m[1][j], m[2][j]];
         let depth = |d: Option<u32>| ParamValue::Int(d.map_or(-1, i64::from));
         Ok(match key {
             "spp" => ParamValue::Int(d.spp.into()),
             "seed" => ParamValue::Int(self.seed.into()),
             "max_depth" => depth(d.integrator.max_depth),
             "rr_depth" => depth(d.integrator.rr_depth),
-            "camera.origin" => ParamValue::Vec3(column(3)),
-            "camera.target" => {
-                let (o, f) = (column(3), column(2));
-                ParamValue::Vec3([o[0] + f[0], o[1] + f[1], o[2] + f[2]])
-            }
-            "camera.up" => ParamValue::Vec3(column(1)),
+            "camera.origin" => ParamValue::Vec3(self.look_at().0),
+            "camera.target" => ParamValue::Vec3(self.look_at().1),
+            "camera.up" => ParamValue::Vec3(self.look_at().2),
             "camera.fov" => ParamValue::Float(d.camera.fov_degrees),
             "medium.scale" => ParamValue::Float(d.medium.scale),
             "medium.albedo" => match &d.medium.albedo {
@@ -212,6 +217,15 @@ impl Scene {
             }),
             _ => return Err(unknown(key)),
         })
+    }
+
+    /// The camera as a look-at: its origin, the point one unit ahead, and the up moves keep.
+    fn look_at(&self) -> ([f32; 3], [f32; 3], [f32; 3]) {
+        let m = &self.desc.camera.to_world;
+        let column = |j: usize| [m[0][j], m[1][j], m[2][j]];
+        let (origin, forward) = (column(3), column(2));
+        let target = [0, 1, 2].map(|i| origin[i] + forward[i]);
+        (origin, target, self.up)
     }
 
     /// Sets parameter `key` ([`PARAMS`]) to `value`. The scene is checked as a loaded one is; a
@@ -263,11 +277,7 @@ impl Scene {
             }
             "camera.origin" | "camera.target" | "camera.up" => {
                 let value = vec3()?;
-                let [mut origin, mut target, mut up] =
-                    ["camera.origin", "camera.target", "camera.up"].map(|k| match self.get(k) {
-                        Ok(ParamValue::Vec3(v)) => v,
-                        _ => unreachable!("the camera's vectors are always there"),
-                    });
+                let (mut origin, mut target, mut up) = self.look_at();
                 match key {
                     "camera.origin" => {
                         // Moving the camera keeps its direction.
@@ -278,6 +288,7 @@ impl Scene {
                     "camera.target" => target = value,
                     _ => up = value,
                 }
+                self.up = up;
                 self.desc.camera.to_world = look_at(origin, target, up).ok_or_else(|| {
                     wrong("a camera whose direction (target - origin) and up are non-zero and not parallel")
                 })?;
@@ -324,6 +335,7 @@ impl Scene {
             phase: d.medium.phase,
             path: self.path,
             seed: self.seed,
+            up: self.up,
         }
     }
 
@@ -339,6 +351,7 @@ impl Scene {
         d.medium.phase = l.phase;
         self.path = l.path;
         self.seed = l.seed;
+        self.up = l.up;
     }
 }
 
@@ -351,6 +364,7 @@ struct Light {
     phase: PhaseDesc,
     path: PathSettings,
     seed: u32,
+    up: [f32; 3],
 }
 
 /// The path settings of a changed integrator with the tracking, estimator and roulette chosen

@@ -155,6 +155,9 @@ fn the_camera_moves_as_a_lookat_in_the_scene_file_does() {
     let dir = tempfile::tempdir().unwrap();
     let mut scene = Scene::load(example(), &small()).unwrap();
     scene
+        .set("camera.up", ParamValue::Vec3([0.0, 1.0, 0.0]))
+        .unwrap();
+    scene
         .set("camera.target", ParamValue::Vec3([0.1, 0.0, 0.0]))
         .unwrap();
     scene
