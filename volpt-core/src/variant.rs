@@ -83,14 +83,31 @@ macro_rules! variants {
     };
 }
 
+/// The registry's names of one variant's parts: `[medium, boundary, phase, environment]`.
+pub type VariantNames = [&'static str; 4];
+
+macro_rules! registry_names {
+    (axes $axes:tt variants [$([$(($camel:ident, $snake:ident, $ty:ty))*])*]) => {
+        /// Every variant of the registry by its parts' names, in registry order: what tests and
+        /// tables enumerate instead of counting by hand.
+        pub const NAMES: &[VariantNames] = &[$([$(stringify!($snake)),*]),*];
+    };
+}
+
+variants!('static => registry_names {});
+
+/// How many variants the registry has (the product of its axes' lengths).
+pub const COUNT: usize = NAMES.len();
+
 #[cfg(test)]
 mod tests {
+    use super::COUNT;
     use crate::abi::Component;
 
     /// `(registry name, Component::NAME)` of every part of every variant.
     macro_rules! registry_facts {
         (axes $axes:tt variants [$([$(($camel:ident, $snake:ident, $ty:ty))*])*]) => {
-            fn facts() -> [[(&'static str, &'static str); 4]; 60] {
+            fn facts() -> [[(&'static str, &'static str); 4]; COUNT] {
                 [$([$((stringify!($snake), <$ty as Component>::NAME)),*]),*]
             }
         };
@@ -105,6 +122,14 @@ mod tests {
                 assert_eq!(registry, component);
             }
         }
+    }
+
+    #[test]
+    fn the_names_are_the_facts() {
+        assert_eq!(
+            super::NAMES,
+            facts().map(|parts| parts.map(|(name, _)| name))
+        );
     }
 
     #[test]

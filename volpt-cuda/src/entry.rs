@@ -105,10 +105,16 @@ mod tests {
     #[test]
     fn the_registry_has_one_entry_per_strategy_and_variant() {
         let mut entries = registry_entries();
-        assert_eq!(entries.len(), Strategy::ALL.len() * 60);
+        assert_eq!(
+            entries.len(),
+            Strategy::ALL.len() * volpt_core::variant::COUNT
+        );
         entries.sort();
         entries.dedup();
-        assert_eq!(entries.len(), Strategy::ALL.len() * 60);
+        assert_eq!(
+            entries.len(),
+            Strategy::ALL.len() * volpt_core::variant::COUNT
+        );
     }
 
     const MODULE: &str = ".version 6.0\n.shared .align 8 .b64 s[5];\n.func f(\n)\n{\n\tret;\n}\n\
