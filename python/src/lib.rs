@@ -317,11 +317,11 @@ fn param_from_py(key: &str, value: &Bound<'_, PyAny>) -> PyResult<ParamValue> {
     {
         return Err(wrong());
     }
+    // Integers: Python's and numpy's (an array has `__index__` too, and fails it).
     if value.hasattr("__index__")? {
-        return value
-            .extract::<i64>()
-            .map(ParamValue::Int)
-            .map_err(|_| wrong());
+        if let Ok(v) = value.extract::<i64>() {
+            return Ok(ParamValue::Int(v));
+        }
     }
     if let Ok(v) = value.extract::<f64>() {
         return Ok(ParamValue::Float(v as f32));

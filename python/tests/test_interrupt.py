@@ -68,7 +68,7 @@ def test_the_gil_is_released_while_rendering():
     start = time.monotonic()
     thread.start()
     try:
-        film = scene.render(spp=64)
+        film = scene.render(spp=600)
     finally:
         end = time.monotonic()
         stop.set()
