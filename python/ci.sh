@@ -18,9 +18,12 @@ start=$SECONDS
 
 rm -rf "$venv"
 "$python" -m venv "$venv"
+# maturin's build backend runs the `maturin` of the environment's PATH.
+export PATH="$PWD/$venv/bin:$PATH"
 "$venv/bin/python" -m pip install -q --upgrade pip
 "$venv/bin/python" -m pip install -q "maturin>=1.5,<2" "pytest>=7" "numpy>=1.20"
 cargo build --release -q -p volpt-cli
+echo "python/ci.sh: venv and CLI ready in $((SECONDS - start)) s"
 # In place (no isolated build environment): the workspace's target/ and its compiled crates are
 # reused, and maturin comes from the venv.
 "$venv/bin/python" -m pip install -q --no-build-isolation ./python

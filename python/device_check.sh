@@ -31,20 +31,25 @@ fi
 "$work/venv/bin/python" -m pip install -q --no-deps --no-index "$wheel"
 
 scene=scenes/example/cube.xml
-args=(--resolution 64x64 --spp 16 --seed 3 --backend cuda --strategy regeneration-sk)
+# VOLPT_CHECK_BACKEND=cpu runs the same comparison on the CPU (the script's own test, no GPU).
+backend="${VOLPT_CHECK_BACKEND:-cuda}"
+gpu=()
+[[ "$backend" == cuda ]] && gpu=(--strategy regeneration-sk)
+args=(--resolution 64x64 --spp 16 --seed 3 --backend "$backend" "${gpu[@]}")
 time "$volpt_bin" render "$scene" "${args[@]}" -o "$work/cli.exr" --checkpoint "$work/cli.ck"
 
-"$work/venv/bin/python" - "$scene" "$work" <<'PY'
+"$work/venv/bin/python" - "$scene" "$work" "$backend" <<'PY'
 import sys, time
 from pathlib import Path
 import numpy as np
 import volpt
 
-scene_file, work = sys.argv[1], Path(sys.argv[2])
+scene_file, work, backend = sys.argv[1], Path(sys.argv[2]), sys.argv[3]
+gpu = {"strategy": "regeneration-sk"} if backend == "cuda" else {}
 scene = volpt.load(scene_file, {"resolution": (64, 64)})
 start = time.monotonic()
-film = scene.render(spp=16, seed=3, backend="cuda", strategy="regeneration-sk")
-print(f"device_check: Python render {time.monotonic() - start:.3f} s (wall, first CUDA render: "
+film = scene.render(spp=16, seed=3, backend=backend, **gpu)
+print(f"device_check: Python {backend} render {time.monotonic() - start:.3f} s (wall, first CUDA render: "
       f"with the kernels' JIT), {film.elapsed:.3f} s rendering; notes: {film.notes}")
 film.write(work / "py.exr")
 cli = volpt.Film.load(work / "cli.ck", scene)
@@ -56,10 +61,10 @@ checks = {
     "same samples and seed": (cli.samples, cli.seed) == (film.samples, film.seed),
 }
 cpu = scene.render(spp=16, seed=3)
-checks["CUDA equals the CPU bit for bit (exact math)"] = np.array_equal(bits(cpu.sums), bits(film.sums))
-again = scene.render(spp=16, seed=3, backend="cuda", strategy="regeneration-sk")
-print(f"device_check: second Python CUDA render {again.elapsed:.3f} s rendering")
-checks["a second CUDA render, same bits"] = np.array_equal(bits(again.sums), bits(film.sums))
+checks[f"{backend} equals the CPU bit for bit (exact math)"] = np.array_equal(bits(cpu.sums), bits(film.sums))
+again = scene.render(spp=16, seed=3, backend=backend, **gpu)
+print(f"device_check: second Python {backend} render {again.elapsed:.3f} s rendering")
+checks[f"a second {backend} render, same bits"] = np.array_equal(bits(again.sums), bits(film.sums))
 for name, ok in checks.items():
     print(f"device_check: {'ok  ' if ok else 'FAIL'} {name}")
 sys.exit(0 if all(checks.values()) else 1)
