@@ -23,6 +23,7 @@
 //! - [`checkpoint`]: long renders saved as they go and resumed bit for bit; films of disjoint sample
 //!   ranges merged.
 //! - [`fingerprint`]: what makes two renders the same render, as one hash.
+//! - [`info`]: what a scene loads to, field by field (`volpt info`, Python's `Scene.info()`).
 //! - [`error`]: every way the above fails, as one [`Error`].
 //!
 //! The crates below this one (`volpt-core`, `volpt-scene`, `volpt-render`, `volpt-cpu`,
@@ -33,6 +34,7 @@ pub mod backend;
 pub mod checkpoint;
 pub mod error;
 pub mod fingerprint;
+pub mod info;
 pub mod observer;
 pub mod scene;
 pub mod settings;
@@ -40,6 +42,7 @@ pub mod settings;
 pub use backend::{Backend, BackendKind, BackendOptions, GpuOptions, Rendered, StrategyChoice};
 pub use checkpoint::{merge, render_checkpointed, Checkpointing, Part};
 pub use error::Error;
+pub use info::Info;
 pub use observer::{Observer, Quiet};
 pub use scene::{ParamValue, Scene, PARAMS};
 pub use settings::{RenderSettings, Tracking};

@@ -163,6 +163,11 @@ impl Scene {
         }
     }
 
+    /// What the scene loads to, field by field: `volpt info`'s text ([`crate::info`]).
+    pub fn info(&self) -> crate::Info {
+        crate::info::describe(&self.source, &self.desc, self.effects, &self.path)
+    }
+
     /// What makes two renders the same render ([`crate::fingerprint`]).
     pub fn fingerprint(&self) -> u64 {
         crate::fingerprint::fingerprint(&self.desc, &self.path, self.effects)

@@ -1,0 +1,171 @@
+"""Type stubs of ``volpt._volpt``, the Rust extension module (PyO3) behind ``volpt``."""
+
+import os
+from typing import Any, Callable, Dict, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+PARAMS: Dict[str, str]
+"""Every parameter key of ``Scene.params`` with what it is and the values it takes."""
+
+SETTINGS: Tuple[str, ...]
+"""The keys of ``volpt.load``'s ``settings``."""
+
+STRATEGIES: Tuple[str, ...]
+"""The GPU strategies ``Scene.render(strategy=...)`` takes: ``auto`` and the fixed ones."""
+
+Value = Union[int, float, Tuple[float, float, float]]
+Progress = Union[bool, Callable[[int, int], Any]]
+
+def load(path: str, settings: Optional[Dict[str, Any]], params: List[Tuple[str, str]]) -> Scene:
+    """The loader behind ``volpt.load`` (which converts its keyword parameters)."""
+
+def merge(films: Sequence[Film]) -> Film:
+    """Adds films of one render's disjoint sample ranges into the film of all their samples.
+
+    The films are added in the order of their ranges, so the same partition gives the same bits
+    whatever order they are passed in; the result equals one render of all the samples within
+    float64 rounding. Raises ``MergeError`` for films of another scene (fingerprint), seed or
+    size, for overlapping ranges and for a gap between ranges, naming the films.
+    """
+
+def read_exr(path: Union[str, os.PathLike[str]]) -> npt.NDArray[np.float32]:
+    """The first RGB layer of an OpenEXR file, float32 (H, W, 3): what ``volpt render -o`` and
+    ``Film.write`` write. Raises ``ImageError``."""
+
+class Scene:
+    """A loaded scene: its grids, its settings and the parameters that change between renders."""
+
+    @property
+    def params(self) -> SceneParameters:
+        """The scene's parameters, as a mapping (Mitsuba's ``mi.traverse``): set one and the next
+        render uses it, without reloading the grids."""
+    @property
+    def spp(self) -> int:
+        """Samples per pixel a render takes by default (``params["spp"]``)."""
+    @property
+    def seed(self) -> int:
+        """Seed of the random streams by default (``params["seed"]``)."""
+    @property
+    def resolution(self) -> Tuple[int, int]:
+        """The film's (width, height)."""
+    @property
+    def variant(self) -> str:
+        """The monomorphised variant the scene renders with (``volpt info``'s ``variant``)."""
+    @property
+    def fingerprint(self) -> int:
+        """What makes two renders the same render (scene, grids, settings; not spp or seed), as
+        a 64-bit hash: films of one fingerprint and seed merge."""
+    @property
+    def source(self) -> str:
+        """The scene file."""
+    def info(self) -> Dict[str, str]:
+        """What ``volpt info`` prints, as a dict in its order: ``scene``, ``variant``, ``film``,
+        ``camera``, ``integrator``, ``bounds``, ``boundary``, ``density``, ``majorant``,
+        ``tracking``, ``estimator``, ``albedo``, ``phase``, ``light``. A value of several lines
+        (the variant's specialisations, the tracking's default) has them joined by ``\\n``."""
+    def render(
+        self,
+        *,
+        spp: Optional[int] = None,
+        seed: Optional[int] = None,
+        samples: Optional[Union[range, Tuple[int, int]]] = None,
+        backend: str = "cpu",
+        strategy: Optional[str] = None,
+        math: Optional[str] = None,
+        progress: Optional[Progress] = None,
+    ) -> Film:
+        """Renders samples ``samples`` of every pixel (default: ``range(0, spp)``, with ``spp``
+        the scene's unless given; give one of the two) with ``seed`` (default: the scene's).
+
+        Sample ``s`` of pixel ``p`` is the same path on every backend and in every range, so the
+        image equals ``volpt render``'s bit for bit for the same scene, seed and backend, and
+        films of disjoint ranges merge (``volpt.merge``) into the whole render's.
+
+        ``backend``: ``"cpu"`` (every core) or ``"cuda"`` (GPU 0; opened once per process and
+        reused). ``strategy`` (``STRATEGIES``; default: ``auto``'s cached choice or
+        regeneration-sk, as ``volpt render``) and ``math`` (``"exact"``, the CPU's bits, or
+        ``"fast"``) are the GPU's; the CPU refuses them.
+
+        ``progress``: ``True`` draws a bar on stderr; a callable is called ``progress(done,
+        total)`` (paths) between chunks of samples, on the calling thread; an exception it raises
+        stops the render and propagates.
+
+        The GIL is released while rendering. Ctrl-C (``KeyboardInterrupt``) stops the render
+        within about 0.1 s on the CPU (0.5 s on a GPU): the render runs in chunks of samples and
+        looks at Python's signals between them. Raises ``SettingsError`` for a bad argument,
+        ``RenderError`` if the backend fails (no GPU, a build without GPU kernels).
+        """
+
+class SceneParameters:
+    """``scene.params``: the parameters of a scene that change between renders, as a mapping.
+
+    Keys (``volpt.PARAMS`` says each one's range): ``spp``, ``seed``, ``max_depth``,
+    ``rr_depth`` (int; -1 unlimited / never), ``camera.origin``, ``camera.target``,
+    ``camera.up`` (3 floats), ``camera.fov`` (degrees), ``medium.scale`` (float),
+    ``medium.albedo`` (RGB; scenes with a constant albedo), ``phase.g`` (float in (-1, 1)).
+
+    Values are ints, floats and tuples of three floats; a set value is checked as a loaded scene
+    is, and a refusal (``ParamError``, a ``ValueError``; ``UnknownParamError``, a ``KeyError``,
+    for a key that is no parameter) leaves the scene unchanged.
+    """
+
+    def __getitem__(self, key: str) -> Value: ...
+    def __setitem__(self, key: str, value: Union[int, float, Sequence[float], npt.ArrayLike]) -> None: ...
+    def __contains__(self, key: object) -> bool: ...
+    def __iter__(self) -> Iterator[str]: ...
+    def __len__(self) -> int: ...
+    def keys(self) -> List[str]: ...
+    def values(self) -> List[Value]: ...
+    def items(self) -> List[Tuple[str, Value]]: ...
+    def get(self, key: str, default: Optional[Value] = None) -> Optional[Value]: ...
+    def update(self, values: Optional[Mapping[str, Any]] = None, **kwargs: Any) -> None:
+        """Sets several parameters: all of them, or on a refusal none."""
+    def describe(self) -> Dict[str, str]:
+        """Each key this scene has, with what it is and the values it takes."""
+
+class Film:
+    """The per-pixel sums of one render's samples ``samples``, with the render's fingerprint and
+    seed."""
+
+    @property
+    def sums(self) -> npt.NDArray[np.float64]:
+        """The per-pixel sums of the film's samples, float64 (H, W, 3) (a copy)."""
+    @property
+    def samples(self) -> range:
+        """The samples of every pixel the film holds."""
+    @property
+    def seed(self) -> int: ...
+    @property
+    def fingerprint(self) -> int:
+        """The rendered scene's fingerprint (``Scene.fingerprint``)."""
+    @property
+    def width(self) -> int: ...
+    @property
+    def height(self) -> int: ...
+    @property
+    def elapsed(self) -> float:
+        """Seconds the render took (summed over merged films; 0 for a loaded film)."""
+    @property
+    def paths(self) -> int:
+        """Paths traced (summed over merged films; 0 for a loaded film)."""
+    @property
+    def notes(self) -> List[str]:
+        """What the render said (on a GPU: ``auto``'s calibration and choice)."""
+    def image(self) -> npt.NDArray[np.float32]:
+        """The image, float32 (H, W, 3), linear RGB, top row first: each pixel's sums over the
+        number of samples, rounded to float32, as ``volpt render`` writes it."""
+    def write(self, path: Union[str, os.PathLike[str]]) -> None:
+        """Writes the image as OpenEXR (``.exr``, float32, what ``volpt render -o`` writes) or
+        PNG (``.png``, the CLI's sRGB preview). Raises ``ImageError``."""
+    def save(self, path: Union[str, os.PathLike[str]]) -> None:
+        """Saves the film in volpt's checkpoint format (``volpt render --checkpoint``'s; ``volpt
+        render --resume`` continues it). The format holds samples ``0..n``: a film of a range that
+        starts later raises ``CheckpointError`` (merge it with the films before it first)."""
+    @staticmethod
+    def load(path: Union[str, os.PathLike[str]], scene: Optional[Scene] = None) -> Film:
+        """Reads a film saved by ``Film.save`` or ``volpt render --checkpoint``. With ``scene``,
+        refuses a film of another scene or size (``CheckpointError``, naming the field)."""

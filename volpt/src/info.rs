@@ -1,0 +1,243 @@
+//! What a scene loads to, in words: `volpt info`'s lines, and `Scene.info()` in Python, as one
+//! list of fields.
+
+use std::fmt::{self, Write};
+
+use volpt_core::{Estimator, PathSettings};
+use volpt_render::factory::{
+    default_majorants, tracking_cost, BoundaryKind, Derived, Effects, EnvironmentKind,
+    MajorantChoice, MajorantRule, MediumKind, Parts,
+};
+use volpt_scene::{
+    AlbedoDesc, BsdfDesc, DensityDesc, EnvironmentDesc, GridDesc, PhaseDesc, SceneDescription,
+};
+
+/// A scene described field by field, in `volpt info`'s order: `scene`, `variant`, `film`,
+/// `camera`, `integrator`, `bounds`, `boundary`, `density`, `majorant`, `tracking`, `estimator`,
+/// `albedo`, `phase`, `light`. A value of several lines (the variant's specialisations, the
+/// tracking's default rule) has them separated by `\n`. [`fmt::Display`] writes `volpt info`'s
+/// text: each key in a column of 11 characters, later lines of a value indented to it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Info {
+    pub fields: Vec<(&'static str, String)>,
+}
+
+impl Info {
+    /// The value of field `key`.
+    pub fn get(&self, key: &str) -> Option<&str> {
+        self.fields
+            .iter()
+            .find(|(k, _)| *k == key)
+            .map(|(_, v)| v.as_str())
+    }
+}
+
+impl fmt::Display for Info {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (key, value) in &self.fields {
+            let mut lines = value.split('\n');
+            writeln!(f, "{key:<10} {}", lines.next().unwrap_or_default())?;
+            for line in lines {
+                writeln!(f, "{:11}{line}", "")?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The scene `desc` from `source`, rendered with `effects` and `settings`, described.
+pub fn describe(
+    source: &str,
+    desc: &SceneDescription,
+    effects: Effects,
+    settings: &PathSettings,
+) -> Info {
+    let mut fields = Vec::new();
+    let mut field = |key: &'static str, value: String| fields.push((key, value));
+    let b = &desc.boundary.bounds;
+    let m = &desc.medium;
+    field("scene", source.to_owned());
+    let parts = Parts::of(desc, effects);
+    let mut variant = parts.variant().to_string();
+    if effects == Effects::General {
+        variant.push_str("\n(--general: every axis at its most general part)");
+    }
+    for rule in &parts.simplifications {
+        let _ = write!(variant, "\nspecialised: {rule}");
+    }
+    field("variant", variant);
+    field(
+        "film",
+        format!("{}x{}, {} spp", desc.film.width, desc.film.height, desc.spp),
+    );
+    field(
+        "camera",
+        format!(
+            "origin {:?}, fov {} deg along {:?}",
+            [
+                desc.camera.to_world[0][3],
+                desc.camera.to_world[1][3],
+                desc.camera.to_world[2][3]
+            ],
+            desc.camera.fov_degrees,
+            desc.camera.fov_axis
+        ),
+    );
+    let depth = |d: Option<u32>| d.map_or("unlimited".to_owned(), |d| d.to_string());
+    field(
+        "integrator",
+        format!(
+            "volpath, max depth {}, roulette from depth {}",
+            depth(desc.integrator.max_depth),
+            depth(desc.integrator.rr_depth)
+        ),
+    );
+    field("bounds", format!("{:?} .. {:?}", b.min, b.max));
+    let boundary = match desc.boundary.bsdf {
+        BsdfDesc::Null => "index-matched (null)".to_owned(),
+        BsdfDesc::Dielectric { int_ior, ext_ior } => {
+            format!("smooth dielectric, int IOR {int_ior}, ext IOR {ext_ior}")
+        }
+        BsdfDesc::RoughDielectric {
+            alpha,
+            int_ior,
+            ext_ior,
+        } => format!("GGX rough dielectric, alpha {alpha}, int IOR {int_ior}, ext IOR {ext_ior}"),
+    };
+    field("boundary", boundary);
+    let grid = |g: &GridDesc| {
+        let (lo, hi) = g
+            .data
+            .iter()
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &v| {
+                (lo.min(v), hi.max(v))
+            });
+        format!(
+            "grid {}x{}x{}x{}, {:?}-centred, bounds {:?} .. {:?}, values {lo} .. {hi}",
+            g.resolution[0],
+            g.resolution[1],
+            g.resolution[2],
+            g.channels,
+            g.convention,
+            g.bounds.min,
+            g.bounds.max
+        )
+    };
+    let (density, majorant) = match &m.density {
+        DensityDesc::Constant(d) => (format!("constant {d}"), m.scale * d),
+        DensityDesc::Grid(g) => (grid(g), m.scale * g.max_value()),
+    };
+    field("density", format!("{density}, scale {}", m.scale));
+    field("majorant", format!("{majorant} per unit length"));
+    field("tracking", tracking(desc, &parts, settings));
+    field("estimator", estimator(&parts, settings).to_owned());
+    let albedo = match &m.albedo {
+        AlbedoDesc::Constant(rgb) => format!("constant {rgb:?}"),
+        AlbedoDesc::Grid(g) => grid(g),
+    };
+    field("albedo", albedo);
+    let phase = match m.phase {
+        PhaseDesc::Isotropic => "isotropic".to_owned(),
+        PhaseDesc::HenyeyGreenstein { g } => format!("Henyey-Greenstein, g {g}"),
+    };
+    field("phase", phase);
+    let light = match &desc.environment {
+        EnvironmentDesc::Constant(rgb) => format!("constant environment, radiance {rgb:?}"),
+        EnvironmentDesc::LatLong(map) => format!(
+            "lat-long environment map {}x{}, scale {}, rows {:?}",
+            map.width, map.height, map.scale, map.rows
+        ),
+    };
+    field("light", light);
+    Info { fields }
+}
+
+/// The majorants delta and ratio tracking use, and what they cost along camera rays.
+fn tracking(desc: &SceneDescription, parts: &Parts<'_>, settings: &PathSettings) -> String {
+    if parts.medium.kind() == MediumKind::Homogeneous {
+        return "homogeneous: every tentative collision is real".to_owned();
+    }
+    let bounds = &desc.boundary.bounds;
+    let derived = Derived::of(
+        parts,
+        volpt_core::Aabb::new(bounds.min.into(), bounds.max.into()),
+        settings,
+    );
+    let how = match derived.majorant_resolution() {
+        Some([x, y, z]) => format!("majorant grid {x}x{y}x{z}, DDA"),
+        None if settings.majorant_resolution > 1 => {
+            "one global majorant (every cell of a majorant grid would have it)".to_owned()
+        }
+        None => "one global majorant".to_owned(),
+    };
+    let cost = match tracking_cost(desc, *settings) {
+        Some(c) => format!(
+            "{how}; majorant / extinction along camera rays {:.2} (global majorant {:.2}), cells \
+             crossed per real collision {:.2}",
+            c.majorant_ratio, c.global_ratio, c.crossings_ratio
+        ),
+        None => format!("{how}; camera rays see no extinction"),
+    };
+    format!(
+        "{cost}\ndefault: {}",
+        majorant_rule(&default_majorants(desc))
+    )
+}
+
+/// The factory's choice of majorants, the rule that fired and its input.
+fn majorant_rule(choice: &MajorantChoice) -> String {
+    let margin = MajorantChoice::GRID_MARGIN;
+    let rule = match choice.rule {
+        MajorantRule::Homogeneous => return "the extinction is one value: no grid".to_owned(),
+        MajorantRule::NoExtinction => {
+            return "the global majorant (camera rays see no extinction to weigh a grid with)"
+                .to_owned()
+        }
+        MajorantRule::NoTighterGrid => {
+            "the global majorant: no grid has a cell below its bound".to_owned()
+        }
+        MajorantRule::GridSavesEnough => format!(
+            "a grid of {} cells: the least work per real collision, at most 1/{margin} of the \
+             global majorant's",
+            choice.resolution
+        ),
+        MajorantRule::GridSavesTooLittle => format!(
+            "the global majorant: no grid does less than 1/{margin} of its work per real collision"
+        ),
+    };
+    let costs: Vec<String> = choice
+        .costs
+        .iter()
+        .map(|(r, c)| match r {
+            1 => format!("global {c:.2}"),
+            r => format!("{r} cells {c:.2}"),
+        })
+        .collect();
+    format!(
+        "{rule} (tentative collisions + cell crossings per real collision: {}; \
+         --tracking, --majorant-resolution override)",
+        costs.join(", ")
+    )
+}
+
+/// The estimator the paths use, and why.
+fn estimator(parts: &Parts<'_>, settings: &PathSettings) -> &'static str {
+    let index_matched = parts.boundary.kind() == BoundaryKind::IndexMatched;
+    match (settings.estimator, index_matched) {
+        (_, false) => {
+            "path tracing: the dielectric boundary reflects and refracts, so no straight shadow ray \
+             reaches the environment (next-event estimation needs an index-matched boundary)"
+        }
+        (Estimator::NextEvent, true) => {
+            "next-event estimation of the environment (ratio tracking, MIS with the phase function)"
+        }
+        (Estimator::PathTracing, true) => {
+            if parts.environment.kind() == EnvironmentKind::Constant {
+                "path tracing (next-event estimation of a constant environment costs more than its \
+                 lower variance saves; --estimator nee)"
+            } else {
+                "path tracing (--estimator nee samples the map)"
+            }
+        }
+    }
+}
