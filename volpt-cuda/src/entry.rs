@@ -5,6 +5,8 @@
 use volpt_core::abi::SceneAbi;
 use volpt_device::Strategy;
 
+use crate::kernels::layout;
+
 /// The entry point that renders scenes of type `S` with `strategy`.
 pub fn entry_name<S: SceneAbi>(strategy: Strategy) -> String {
     let [m, b, p, e] = S::names();
@@ -30,10 +32,7 @@ pub fn registry_entries() -> Vec<String> {
 
 /// The names of the `.entry` directives of a PTX module.
 pub fn ptx_entries(ptx: &str) -> Vec<&str> {
-    ptx.lines()
-        .filter_map(|line| line.split_once(".entry ").map(|(_, rest)| rest))
-        .map(|rest| rest.trim_end_matches(['(', ' ']).trim())
-        .collect()
+    ptx.lines().filter_map(layout::entry_name).collect()
 }
 
 /// The module `ptx` reduced to one kernel, `entry`, with everything it may use (the header, globals,
@@ -42,44 +41,17 @@ pub fn ptx_entries(ptx: &str) -> Vec<&str> {
 ///
 /// With `max_registers`, the entry gets a `.maxnreg` directive: the JIT caps its registers per thread
 /// there (spilling what does not fit), the register cap of the thesis's occupancy study.
+///
+/// The embedded kernels are cut the same way, from their pack ([`crate::kernels::KernelPack::kernel`]).
 pub fn single_kernel_ptx(ptx: &str, entry: &str, max_registers: Option<u32>) -> Option<String> {
-    let mut out = String::with_capacity(ptx.len() / 8);
-    let mut found = false;
-    let mut lines = ptx.lines();
-    while let Some(line) = lines.next() {
-        let Some((_, rest)) = line.split_once(".entry ") else {
-            out.push_str(line);
-            out.push('\n');
-            continue;
-        };
-        let name = rest.trim_end_matches(['(', ' ']).trim();
-        let keep = name == entry;
-        found |= keep;
-        if keep {
-            out.push_str(line);
-            out.push('\n');
-        }
-        // The entry's parameter list ends at the line `)`, its body at the line `}`.
-        let mut in_body = false;
-        for line in lines.by_ref() {
-            if keep {
-                if !in_body && line == "{" {
-                    if let Some(n) = max_registers {
-                        out.push_str(&format!(".maxnreg {n}\n"));
-                    }
-                }
-                out.push_str(line);
-                out.push('\n');
-            }
-            if line == "{" {
-                in_body = true;
-            }
-            if in_body && line == "}" {
-                break;
-            }
-        }
-    }
-    found.then_some(out)
+    let split = layout::split(ptx);
+    let kept = split.entries.iter().find(|e| e.name == entry)?;
+    Some(layout::assemble(
+        &split.common,
+        kept.at,
+        kept.text,
+        max_registers,
+    ))
 }
 
 #[cfg(test)]

@@ -13,6 +13,14 @@ pub enum CudaError {
          and installs the rust-src component if needed), then rebuild volpt"
     )]
     NoKernels(volpt_device::Math),
+    #[error(
+        "this volpt's embedded {math} kernels cannot be read ({source}): rebuild it (`cargo xtask \
+         ptx`, then `cargo build`)"
+    )]
+    CorruptKernels {
+        math: volpt_device::Math,
+        source: crate::kernels::PackError,
+    },
     #[error("cannot read the kernels' PTX from {path} (VOLPT_PTX): {source}")]
     PtxFile {
         path: std::path::PathBuf,

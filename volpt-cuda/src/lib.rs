@@ -3,6 +3,7 @@
 //!
 //! - [`renderer`]: device volumes, the device film, launching a strategy's kernel for a scene type.
 //! - [`entry`]: the kernel entry point of a scene type, derived from its parts' names.
+//! - [`kernels`]: the kernels this build embeds, compressed, each decompressed on first use.
 //! - [`Strategy`]: the GPU scheduling strategies, selectable at run time (`volpt_device`), and
 //!   [`Math`]: exact or fast kernels.
 //! - [`selftest`]: the strategies' collective building blocks, texture lookups and the kernels' math
@@ -14,6 +15,7 @@
 
 pub mod entry;
 pub mod error;
+pub mod kernels;
 pub mod renderer;
 pub mod selftest;
 
@@ -21,20 +23,7 @@ pub use error::CudaError;
 pub use renderer::{CudaRenderer, Schedule, DEFAULT_REFILL_AT};
 pub use volpt_device::{Math, Strategy};
 
-/// The kernels' PTX, if `cargo xtask ptx` wrote it before this crate was built.
-mod ptx {
-    include!(concat!(env!("OUT_DIR"), "/ptx.rs"));
-}
-
-/// The PTX of the workspace's kernels built for `math`, if this build carries it.
-pub fn kernels_ptx(math: Math) -> Option<&'static str> {
-    match math {
-        Math::Exact => ptx::EXACT,
-        Math::Fast => ptx::FAST,
-    }
-}
-
 /// Whether this build carries GPU kernels.
 pub fn has_kernels() -> bool {
-    ptx::EXACT.is_some()
+    kernels::is_embedded(Math::Exact)
 }

@@ -27,6 +27,7 @@ use volpt_zerocopy::{VolumePlacer, VolumePolicy};
 
 use crate::entry::{entry_name, single_kernel_ptx};
 use crate::error::{CudaError, Doing};
+use crate::kernels::{self, KernelPack};
 
 /// How a render is scheduled on the GPU.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -67,11 +68,39 @@ impl From<Strategy> for Schedule {
 /// A compiled kernel: its entry point and register cap.
 type KernelKey = (String, Option<u32>);
 
+/// Where a renderer's kernels come from.
+enum Kernels {
+    /// A whole PTX module (`VOLPT_PTX`, a library user's kernels crate).
+    Module(String),
+    /// The kernels this build embeds, packed.
+    Embedded {
+        math: Math,
+        pack: KernelPack<'static>,
+    },
+}
+
+impl Kernels {
+    /// The PTX of the kernel `entry` alone, under the register cap `max_registers`.
+    fn single_kernel(&self, entry: &str, max_registers: Option<u32>) -> Result<String, CudaError> {
+        let ptx = match self {
+            Self::Module(ptx) => single_kernel_ptx(ptx, entry, max_registers),
+            Self::Embedded { math, pack } => {
+                pack.kernel(entry, max_registers)
+                    .map_err(|source| CudaError::CorruptKernels {
+                        math: *math,
+                        source,
+                    })?
+            }
+        };
+        ptx.ok_or_else(|| CudaError::MissingKernel(entry.to_owned()))
+    }
+}
+
 /// One GPU and volpt's kernels, each JIT-compiled on first use.
 pub struct CudaRenderer {
     ctx: Arc<CudaContext>,
     stream: Arc<CudaStream>,
-    ptx: String,
+    kernels: Kernels,
     /// The modules compiled so far, one kernel each, by entry point and register cap.
     modules: Mutex<HashMap<KernelKey, Arc<CudaModule>>>,
     device_name: String,
@@ -80,26 +109,35 @@ pub struct CudaRenderer {
 }
 
 impl CudaRenderer {
-    /// Opens GPU `ordinal` and loads the workspace's kernels built for `math` (the driver
-    /// JIT-compiles the PTX for this GPU on first use and caches the result).
+    /// Opens GPU `ordinal` with the workspace's kernels built for `math` (each JIT-compiled for
+    /// this GPU on first use, and cached by the driver).
     pub fn new(ordinal: usize, math: Math) -> Result<Self, CudaError> {
         // `VOLPT_PTX=file.ptx` runs other kernels with this binary: A/B measurements of a kernel
         // change in one device session.
-        let ptx = match std::env::var_os("VOLPT_PTX") {
-            Some(path) => std::fs::read_to_string(&path).map_err(|source| CudaError::PtxFile {
-                path: path.into(),
-                source,
-            })?,
-            None => crate::kernels_ptx(math)
-                .ok_or(CudaError::NoKernels(math))?
-                .to_owned(),
+        let kernels = match std::env::var_os("VOLPT_PTX") {
+            Some(path) => Kernels::Module(std::fs::read_to_string(&path).map_err(|source| {
+                CudaError::PtxFile {
+                    path: path.into(),
+                    source,
+                }
+            })?),
+            None => Kernels::Embedded {
+                math,
+                pack: kernels::embedded(math)
+                    .map_err(|source| CudaError::CorruptKernels { math, source })?
+                    .ok_or(CudaError::NoKernels(math))?,
+            },
         };
-        Self::with_ptx(ordinal, ptx)
+        Self::open(ordinal, kernels)
     }
 
     /// Opens GPU `ordinal` with kernels of the caller's own, e.g. a library user's kernels crate
     /// that exports its scene types with `volpt_device::export_kernels!`.
     pub fn with_ptx(ordinal: usize, ptx: String) -> Result<Self, CudaError> {
+        Self::open(ordinal, Kernels::Module(ptx))
+    }
+
+    fn open(ordinal: usize, kernels: Kernels) -> Result<Self, CudaError> {
         // SAFETY: only probes whether the driver library can be opened.
         if !unsafe { sys::is_culib_present() } {
             return Err(CudaError::NoDriver);
@@ -112,7 +150,7 @@ impl CudaRenderer {
         Ok(Self {
             stream: ctx.default_stream(),
             ctx,
-            ptx,
+            kernels,
             modules: Mutex::default(),
             device_name,
             multiprocessors,
@@ -132,14 +170,14 @@ impl CudaRenderer {
         let module = match modules.get(&key) {
             Some(module) => module.clone(),
             None => {
-                let ptx = single_kernel_ptx(&self.ptx, entry, max_registers)
-                    .ok_or_else(|| CudaError::MissingKernel(entry.to_owned()))?;
                 let started = Instant::now();
+                let ptx = self.kernels.single_kernel(entry, max_registers)?;
+                let cut = started.elapsed();
                 let module = self
                     .ctx
                     .load_module(Ptx::from_src(ptx))
                     .doing("compiling the kernel's PTX")?;
-                tracing::debug!(entry, ?max_registers, elapsed = ?started.elapsed(), "loaded kernel");
+                tracing::debug!(entry, ?max_registers, ?cut, jit = ?(started.elapsed() - cut), "loaded kernel");
                 modules.insert(key, module.clone());
                 module
             }

@@ -1,5 +1,6 @@
 //! The kernels this build embeds are exactly the registry's: every variant has an entry point for
-//! every strategy, and the PTX holds no entry point that no variant uses.
+//! every strategy, and the PTX holds no entry point that no variant uses; and the pack they are
+//! embedded in gives back every kernel alone, and the whole PTX it was made of.
 //!
 //! CI builds the PTX (`cargo xtask ptx`) and sets `VOLPT_REQUIRE_PTX=1`, so a missing PTX fails
 //! there; on a machine that never built the kernels the test says so and checks nothing.
@@ -7,6 +8,7 @@
 use std::collections::BTreeSet;
 
 use volpt_cuda::entry::{ptx_entries, registry_entries};
+use volpt_cuda::kernels::{self, KernelPack, PackError};
 use volpt_cuda::Math;
 
 #[test]
@@ -19,8 +21,10 @@ fn the_fast_ptx_exports_exactly_the_registry() {
     exports_exactly_the_registry(Math::Fast);
 }
 
-fn exports_exactly_the_registry(math: Math) {
-    let Some(ptx) = volpt_cuda::kernels_ptx(math) else {
+/// The embedded kernels built for `math`, or `None` (after saying so) if this build has none.
+fn embedded(math: Math) -> Option<KernelPack<'static>> {
+    let pack = kernels::embedded(math).unwrap_or_else(|e| panic!("the {math} kernels: {e}"));
+    if pack.is_none() {
         assert!(
             std::env::var_os("VOLPT_REQUIRE_PTX").is_none(),
             "VOLPT_REQUIRE_PTX is set but this build embeds no {math} PTX: run `cargo xtask ptx` first"
@@ -28,9 +32,15 @@ fn exports_exactly_the_registry(math: Math) {
         eprintln!(
             "SKIPPED: this build embeds no {math} PTX (run `cargo xtask ptx`, then test again)"
         );
+    }
+    pack
+}
+
+fn exports_exactly_the_registry(math: Math) {
+    let Some(pack) = embedded(math) else {
         return;
     };
-    let exported: BTreeSet<&str> = ptx_entries(ptx).into_iter().collect();
+    let exported: BTreeSet<&str> = pack.entries().collect();
     let registry = registry_entries();
     let registry: BTreeSet<&str> = registry
         .iter()
@@ -43,24 +53,82 @@ fn exports_exactly_the_registry(math: Math) {
     assert!(unused.is_empty(), "kernels no variant uses: {unused:?}");
 }
 
-/// Every kernel of the registry can be cut out of the module on its own (the renderer JIT-compiles
-/// one kernel at a time), and the cut keeps exactly that entry.
+/// The pack gives back the PTX that `cargo xtask ptx` wrote, byte for byte, with the pack's
+/// entries in the module's order.
+#[test]
+fn the_packs_hold_the_ptx_they_were_made_of() {
+    for math in Math::ALL.iter().copied() {
+        let Some(pack) = embedded(math) else {
+            continue;
+        };
+        let module = pack.module().unwrap_or_else(|e| panic!("{math}: {e}"));
+        assert!(
+            ptx_entries(&module).into_iter().eq(pack.entries()),
+            "{math}"
+        );
+        let file = match math {
+            Math::Exact => "volpt_kernels.ptx",
+            Math::Fast => "volpt_kernels_fast.ptx",
+        };
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("ptx")
+            .join(file);
+        // The build script packed this file; a change to it rebuilds the pack before the test.
+        if let Ok(ptx) = std::fs::read_to_string(&path) {
+            assert!(
+                module == ptx,
+                "{math}: the pack differs from {}",
+                path.display()
+            );
+        }
+    }
+}
+
+/// Every kernel of the registry comes out of the pack on its own (the renderer JIT-compiles one
+/// kernel at a time): exactly that entry, the module's text of it, and the common text.
 #[test]
 fn every_kernel_compiles_alone() {
     for math in Math::ALL.iter().copied() {
-        let Some(ptx) = volpt_cuda::kernels_ptx(math) else {
+        let Some(pack) = embedded(math) else {
             continue;
         };
+        let module = pack.module().unwrap_or_else(|e| panic!("{math}: {e}"));
         for entry in registry_entries() {
-            let alone = volpt_cuda::entry::single_kernel_ptx(ptx, &entry, Some(96))
+            let alone = pack
+                .kernel(&entry, Some(96))
+                .unwrap_or_else(|e| panic!("{math}: {entry}: {e}"))
                 .unwrap_or_else(|| panic!("{math}: {entry} not in the PTX"));
             assert_eq!(ptx_entries(&alone), [entry.as_str()]);
+            assert_eq!(alone.matches(".maxnreg 96\n").count(), 1, "{entry}");
             assert!(
-                alone.len() < ptx.len() / 10,
+                alone.len() < module.len() / 10,
                 "{entry}: {} bytes",
                 alone.len()
             );
         }
+    }
+}
+
+/// A pack damaged after the build fails with an error that says where, not with a panic or other
+/// PTX: the middle byte of the embedded pack, in one of its frames, flipped.
+#[test]
+fn a_damaged_pack_says_so() {
+    for math in Math::ALL.iter().copied() {
+        let Some(bytes) = kernels::embedded_pack(math) else {
+            continue;
+        };
+        let mut damaged = bytes.to_vec();
+        damaged[bytes.len() / 2] ^= 0x20;
+        let pack = KernelPack::parse(&damaged).unwrap_or_else(|e| panic!("{math}: {e}"));
+        let error = pack.module().expect_err("a damaged frame decompresses");
+        assert!(
+            matches!(
+                error,
+                PackError::Decompress { .. } | PackError::Length { .. }
+            ),
+            "{math}: {error}"
+        );
+        assert!(error.to_string().contains("frame `"), "{math}: {error}");
     }
 }
 
@@ -80,12 +148,14 @@ fn no_kernel_keeps_the_scene_in_local_memory() {
     // regeneration-2p-sk kernel of both builds, 2026-11-24).
     const TWO_PATH_ARRAY_BYTES: usize = 256;
     for math in Math::ALL.iter().copied() {
-        let Some(ptx) = volpt_cuda::kernels_ptx(math) else {
+        let Some(pack) = embedded(math) else {
             continue;
         };
         let mut heavy = Vec::new();
         for entry in registry_entries() {
-            let alone = volpt_cuda::entry::single_kernel_ptx(ptx, &entry, None)
+            let alone = pack
+                .kernel(&entry, None)
+                .unwrap_or_else(|e| panic!("{math}: {entry}: {e}"))
                 .unwrap_or_else(|| panic!("{math}: {entry} not in the PTX"));
             let depot = local_depot_bytes(&alone);
             let allowed = if entry.starts_with("regeneration_2p_sk__") {

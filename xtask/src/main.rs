@@ -1,8 +1,9 @@
 //! Project automation: `cargo xtask <task>`.
 //!
 //! - `ptx [PACKAGE]`: compiles a kernels crate with rustc's NVPTX backend. By default the workspace's
-//!   (`volpt-kernels`), written to `volpt-cuda/ptx/volpt_kernels.ptx` and, built with fast math,
-//!   `volpt_kernels_fast.ptx`, which `volpt-cuda` embeds at its next build; any other kernels crate of the workspace (a library user's, see
+//!   (`volpt-kernels`), both builds at once, written to `volpt-cuda/ptx/volpt_kernels.ptx` and,
+//!   built with fast math, `volpt_kernels_fast.ptx`, which `volpt-cuda` packs and embeds at its
+//!   next build; any other kernels crate of the workspace (a library user's, see
 //!   `docs/extending.md`) to `<its directory>/ptx/<crate>.ptx`.
 //! - `ptx-selftests DIR`: only the selftest kernels of `volpt-kernels` (`--cfg
 //!   volpt_selftests_only`), fast math, to `DIR/selftests_fast.ptx`: what `volpt selftest` needs
@@ -28,6 +29,7 @@ fn main() -> Result<()> {
             let Some(dir) = std::env::args().nth(2) else {
                 bail!("usage: cargo xtask ptx-selftests DIR");
             };
+            ensure_rust_src()?;
             let built = ptx_build(KERNELS, Flavour::Fast, Only::Selftests)?;
             let dir = PathBuf::from(dir);
             std::fs::create_dir_all(&dir)?;
@@ -81,11 +83,21 @@ const EXAMPLE_KERNELS: &str = "volpt-example-smooth-ball-kernels";
 
 /// Builds the kernels crate `package` and returns the path of its PTX; the workspace's kernels
 /// crate is built twice, exact and fast (`--math fast`), and the path of the exact PTX returned.
+///
+/// The two builds run at once: each spends most of its time in one LLVM thread (fat LTO, one
+/// codegen unit) and peaks near 1 GB, so on two cores they take little longer than one.
 fn ptx(package: &str) -> Result<PathBuf> {
-    if package == KERNELS {
-        ptx_build(package, Flavour::Fast, Only::All)?;
+    ensure_rust_src()?;
+    if package != KERNELS {
+        return ptx_build(package, Flavour::Exact, Only::All);
     }
-    ptx_build(package, Flavour::Exact, Only::All)
+    std::thread::scope(|scope| {
+        let fast = scope.spawn(|| ptx_build(package, Flavour::Fast, Only::All));
+        let exact = ptx_build(package, Flavour::Exact, Only::All);
+        let fast = fast.join().expect("the fast build's thread does not panic");
+        fast.context("the fast build")?;
+        exact.context("the exact build")
+    })
 }
 
 /// Which kernels of the crate: all, or (`volpt-kernels` only) the selftests alone, built apart
@@ -103,16 +115,18 @@ enum Flavour {
     Fast,
 }
 
-/// Builds the kernels crate `package` in `flavour` and returns the path of its PTX.
+/// Builds the kernels crate `package` in `flavour` and returns the path of its PTX (the rust-src
+/// component must be installed: [`ensure_rust_src`]).
 ///
 /// Stable rustc with `RUSTC_BOOTSTRAP=1` (the `abi_ptx` feature); no linker is needed, because with
-/// fat LTO `--emit=asm` writes the whole linked module as PTX. A separate target directory per
-/// flavour keeps host builds, and the other flavour, from rebuilding `core`.
+/// fat LTO `--emit=asm` writes the whole linked module as PTX. Only the kernels crate is asked for
+/// assembly (`cargo rustc`): its dependencies, `core` among them, go into the module as bitcode, and
+/// their own assembly would be written and never read. A separate target directory per flavour
+/// keeps host builds, and the other flavour, from rebuilding `core`.
 ///
 /// The fast flavour sets `volpt_fast_math` (approximate `lg2`, `ex2`, `sqrt` in `volpt_core::math`)
 /// and lets LLVM's NVPTX backend use approximate division and square roots and fuse multiply-adds.
 fn ptx_build(package: &str, flavour: Flavour, only: Only) -> Result<PathBuf> {
-    ensure_rust_src()?;
     let root = root();
     let (target_dir, flags, suffix) = match flavour {
         Flavour::Exact => (root.join("target-ptx"), "", ""),
@@ -132,17 +146,18 @@ fn ptx_build(package: &str, flavour: Flavour, only: Only) -> Result<PathBuf> {
         .env("RUSTC_BOOTSTRAP", "1")
         .env(
             "CARGO_TARGET_NVPTX64_NVIDIA_CUDA_RUSTFLAGS",
-            format!("-C target-cpu=sm_70 --emit=asm{flags}{only_flag}"),
+            format!("-C target-cpu=sm_70{flags}{only_flag}"),
         )
         .env("CARGO_TARGET_NVPTX64_NVIDIA_CUDA_LINKER", "/bin/true")
         .args([
-            "build",
+            "rustc",
             "-Zbuild-std=core",
             "--target",
             "nvptx64-nvidia-cuda",
         ])
-        .args(["--profile", "nvptx", "-p", package, "--target-dir"])
-        .arg(&target_dir))?;
+        .args(["--profile", "nvptx", "-p", package, "--lib", "--target-dir"])
+        .arg(&target_dir)
+        .args(["--", "--emit=asm"]))?;
     let crate_name = package.replace('-', "_");
     let built = target_dir.join(format!("nvptx64-nvidia-cuda/nvptx/deps/{crate_name}.s"));
     let ptx =
