@@ -282,8 +282,7 @@ fn a_backend_that_stores_other_grids_or_a_film_of_another_size_is_refused() {
 }
 
 #[test]
-fn a_resolution_set_renders_as_a_scene_loaded_at_that_resolution_and_a_refused_one_changes_nothing(
-) {
+fn a_set_resolution_renders_as_a_load_at_it_and_a_refused_one_changes_nothing() {
     let mut scene = Scene::load(example(), &small()).unwrap();
     scene.set_resolution(6, 5).unwrap();
     let loaded = Scene::load(
