@@ -76,7 +76,7 @@ def main():
         page.mouse.move(cx, cy)
         page.mouse.down()
         for i in range(1, 11):
-            page.mouse.move(cx + 15 * i, cy + 4 * i)
+            page.mouse.move(cx + 8 * i, cy + 2 * i)
             time.sleep(0.03)
         page.mouse.up()
         wait_for(page, converged(f"v.header.epoch > {epoch}"), "a converged frame after the drag")
