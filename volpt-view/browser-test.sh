@@ -20,7 +20,7 @@ fi
 # The binary as `cargo test --release --workspace` builds it (CI's step before this one, so a
 # no-op there): a plain `cargo build -p volpt-cli` unifies other dependency features and would
 # rebuild the workspace.
-cargo test --release --workspace --no-run -q 2>/dev/null
+cargo test --release --workspace --no-run -q
 
 log=$(mktemp)
 target/release/volpt view scenes/example/cube.xml --resolution 240x240 --spp 16 --threads 2 \
