@@ -184,7 +184,10 @@ impl Viewer {
     /// flight), and waits for both.
     pub async fn shutdown(mut self) -> Result<(), ViewError> {
         let _ = self.shutdown.send(true);
-        let _ = self.commands.send(Command::Shutdown);
+        // A full queue drains within a batch: retry until the command is in or the thread gone.
+        while let Err(ViewError::Busy) = self.commands.send(Command::Shutdown) {
+            tokio::time::sleep(std::time::Duration::from_millis(10)).await;
+        }
         let served = (&mut self.server).await;
         if let Some(thread) = self.render.take() {
             tokio::task::spawn_blocking(move || thread.join())
@@ -302,14 +305,13 @@ async fn page() -> impl IntoResponse {
     )
 }
 
-/// The latest frame, or 503 before the first.
-fn latest(state: &AppState) -> Result<Arc<render::Frame>, Response> {
-    state
-        .shared
-        .frames
-        .borrow()
-        .clone()
-        .ok_or_else(|| (StatusCode::SERVICE_UNAVAILABLE, "no frame yet\n").into_response())
+/// The latest frame; `None` before the first.
+fn latest(state: &AppState) -> Option<Arc<render::Frame>> {
+    state.shared.frames.borrow().clone()
+}
+
+fn no_frame() -> Response {
+    (StatusCode::SERVICE_UNAVAILABLE, "no frame yet\n").into_response()
 }
 
 fn download(bytes: Vec<u8>, mime: &'static str, name: &'static str) -> Response {
@@ -321,9 +323,8 @@ fn download(bytes: Vec<u8>, mime: &'static str, name: &'static str) -> Response 
 
 /// The latest frame's linear image as OpenEXR.
 async fn snapshot_exr(State(state): State<Arc<AppState>>) -> Response {
-    let frame = match latest(&state) {
-        Ok(f) => f,
-        Err(r) => return r,
+    let Some(frame) = latest(&state) else {
+        return no_frame();
     };
     match tokio::task::spawn_blocking(move || encode::exr(&frame.linear)).await {
         Ok(Ok(bytes)) => download(
@@ -338,9 +339,8 @@ async fn snapshot_exr(State(state): State<Arc<AppState>>) -> Response {
 
 /// The latest frame as shown (exposure, sRGB) as PNG.
 async fn snapshot_png(State(state): State<Arc<AppState>>) -> Response {
-    let frame = match latest(&state) {
-        Ok(f) => f,
-        Err(r) => return r,
+    let Some(frame) = latest(&state) else {
+        return no_frame();
     };
     let png = tokio::task::spawn_blocking(move || frame.png().map(<[u8]>::to_vec)).await;
     match png {
