@@ -63,6 +63,9 @@ enum Command {
         #[arg(long, value_enum, default_value_t = volpt_cuda::Math::Exact)]
         math: volpt_cuda::Math,
     },
+    /// Serve an interactive viewer as a web page: orbit, pan and zoom, progressive refinement,
+    /// parameters, snapshots (open the printed URL; over SSH, `ssh -L PORT:localhost:PORT HOST`).
+    View(ViewArgs),
     /// Plot a `volpt converge` run again from the converge.csv in DIR (SVG and PNG).
     Plot {
         dir: PathBuf,
@@ -314,6 +317,22 @@ struct RenderArgs {
 }
 
 #[derive(Args)]
+struct ViewArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    #[command(flatten)]
+    sampling: SamplingArgs,
+    /// Address and port to serve on. A non-loopback address requires the random token printed in
+    /// the URL on every request; port 0 picks a free one.
+    #[arg(long, value_name = "ADDR:PORT", default_value = "127.0.0.1:8765")]
+    bind: std::net::SocketAddr,
+    /// Require the token on a loopback bind too (on a shared machine, every user reaches its
+    /// loopback ports).
+    #[arg(long)]
+    token: bool,
+}
+
+#[derive(Args)]
 struct BenchArgs {
     #[command(flatten)]
     scene: SceneArgs,
@@ -426,6 +445,18 @@ fn main() -> Result<()> {
             Ok(())
         }
         Command::Compare(args) => compare::run(&args),
+        Command::View(args) => {
+            let scene = args.scene.load(Some(&args.sampling))?;
+            let options = volpt_view::ViewOptions {
+                bind: args.bind,
+                token: args.token,
+                backend: BackendOptions {
+                    kind: args.sampling.backend.into(),
+                    gpu: args.sampling.gpu.options(&args.sampling.volumes),
+                },
+            };
+            Ok(volpt_view::serve(scene, options)?)
+        }
         Command::Converge(args) => converge::run(&args),
         Command::Selftest { math } => selftest(math),
         Command::Plot { dir, title } => {

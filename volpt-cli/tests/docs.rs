@@ -18,6 +18,7 @@ use std::process::Command;
 const COMMANDS: &[&str] = &[
     "render",
     "bench",
+    "view",
     "info",
     "scene generate",
     "scene export",

@@ -198,6 +198,19 @@ impl Scene {
         self.desc.medium.storage = storage;
     }
 
+    /// Renders `width` x `height` pixels from now on, without reloading the grids (an
+    /// interactive viewer's reduced resolution while the view moves). The field of view stays
+    /// along the scene's fov axis, so a size of the same aspect ratio frames the same picture.
+    /// Refused, leaving the scene as it was, where the film does not fit the memory limit.
+    pub fn set_resolution(&mut self, width: u32, height: u32) -> Result<(), Error> {
+        let before = self.desc.film;
+        self.desc.film.width = width;
+        self.desc.film.height = height;
+        volpt_scene::validate::validate(&self.desc, &self.source)
+            .map_err(Error::from)
+            .inspect_err(|_| self.desc.film = before)
+    }
+
     /// The value of parameter `key` ([`PARAMS`]).
     pub fn get(&self, key: &str) -> Result<ParamValue, Error> {
         let d = &self.desc;

@@ -280,3 +280,20 @@ fn a_backend_that_stores_other_grids_or_a_film_of_another_size_is_refused() {
         "{err}"
     );
 }
+
+#[test]
+fn a_set_resolution_renders_as_a_load_at_it_and_a_refused_one_changes_nothing() {
+    let mut scene = Scene::load(example(), &small()).unwrap();
+    scene.set_resolution(6, 5).unwrap();
+    let loaded = Scene::load(
+        example(),
+        &RenderSettings {
+            resolution: Some((6, 5)),
+            ..small()
+        },
+    )
+    .unwrap();
+    assert_eq!(render(&scene, 0..2).sums, render(&loaded, 0..2).sums);
+    assert!(scene.set_resolution(0, 5).is_err());
+    assert_eq!(scene.resolution(), (6, 5));
+}

@@ -242,6 +242,15 @@ fn device_bundle() -> Result<()> {
         "--example",
         "render",
     ]))?;
+    // `volpt view`'s scripted client (bench/device/viewer.sh).
+    run(Command::new(env!("CARGO")).current_dir(&root).args([
+        "build",
+        "--release",
+        "-p",
+        "volpt-view",
+        "--example",
+        "viewer_bench",
+    ]))?;
     let bundle = root.join("bundle");
     if bundle.exists() {
         std::fs::remove_dir_all(&bundle)?;
@@ -254,8 +263,16 @@ fn device_bundle() -> Result<()> {
         target.join("release/examples/render"),
         bundle.join("bin/smooth-ball"),
     )?;
+    std::fs::copy(
+        target.join("release/examples/viewer_bench"),
+        bundle.join("bin/viewer-bench"),
+    )?;
     // Debug info is most of the binaries; the device carries at most 64 MiB.
-    run(Command::new("strip").args([bundle.join("bin/volpt"), bundle.join("bin/smooth-ball")]))?;
+    run(Command::new("strip").args([
+        bundle.join("bin/volpt"),
+        bundle.join("bin/smooth-ball"),
+        bundle.join("bin/viewer-bench"),
+    ]))?;
     // The binary embeds both kernel builds; the scripts' ptxas reports read these copies,
     // compressed (the device carries at most 64 MiB).
     for file in ["volpt_kernels.ptx", "volpt_kernels_fast.ptx"] {

@@ -1,0 +1,108 @@
+#!/usr/bin/env bash
+# `volpt view` measured end to end (render + tone map + JPEG + send, as a page receives it) by a
+# scripted client, for the included scenes, CPU and GPU, at 800x800 and 1920x1080. Run on the
+# device machine from the bundle (`cargo xtask device-bundle`, which carries bin/viewer-bench):
+#
+#   bash bundle/viewer.sh                  # $OUT/viewer.md (a table) and $OUT/viewer.jsonl
+#   SCENES="example-cube" BACKENDS=cuda SECONDS_PER_PHASE=2 bash bundle/viewer.sh   # a quick look
+#
+# Each run starts `volpt view SCENE --backend B --resolution R --bind 127.0.0.1:0`, runs
+# bin/viewer-bench against it (see volpt-view/examples/viewer_bench.rs: the time from a still
+# camera move to its first frame, frames/s of the still refinement, frames/s and move-to-frame time
+# while orbiting at 60 moves/s), and stops the server with Ctrl-C (SIGINT), which must end it.
+#
+# Environment:
+#   OUT                 outputs (default ./out)
+#   SCENES, BACKENDS, RESOLUTIONS   space-separated subsets of the lists below
+#   SECONDS_PER_PHASE   seconds of the still and orbit phases each (default 3)
+#   LIMIT               seconds per run before it is killed and reported (default 90)
+#   STRATEGY, MATH      the GPU's (default regeneration-sk: no calibration; exact)
+#   DATA                a folder with smoke.vol and Bucky.raw (default: the bundle's data/)
+set -uo pipefail
+cd "$(dirname "$0")"
+OUT=${OUT:-$PWD/out}
+SECONDS_PER_PHASE=${SECONDS_PER_PHASE:-3}
+LIMIT=${LIMIT:-90}
+STRATEGY=${STRATEGY:-regeneration-sk}
+MATH=${MATH:-exact}
+BACKENDS=${BACKENDS:-cuda cpu}
+RESOLUTIONS=${RESOLUTIONS:-800x800 1920x1080}
+VOLPT=bin/volpt
+CLIENT=bin/viewer-bench
+mkdir -p "$OUT"
+MD=$OUT/viewer.md
+JSONL=$OUT/viewer.jsonl
+: >"$JSONL"
+say() { echo "$*" | tee -a "$MD"; }
+[ -x "$CLIENT" ] || { echo "viewer.sh: $CLIENT is missing (cargo build --release -p volpt-view --example viewer_bench; copy target/release/examples/viewer_bench there)"; exit 1; }
+
+data_param() { # data_param FILE: prints -Ddata=DIR if DIR/FILE exists
+    local dir=${DATA:-$PWD/data}
+    if [ -f "$dir/$1" ]; then echo "-Ddata=$dir"; fi
+}
+declare -A FILES=(
+    [example-cube]="scenes/example/cube.xml"
+    [homogeneous-cube]="scenes/homogeneous-cube/scene.xml"
+    [cgg-logo]="scenes/cgg-logo/scene.xml"
+    [ad]="scenes/ad/scene.xml"
+    [envmap-cube]="scenes/envmap-cube/scene.xml"
+    [smoke]="scenes/smoke/scene.xml $(data_param smoke.vol)"
+    [bucky]="scenes/bucky/scene.toml $(data_param Bucky.raw)"
+)
+SCENES=${SCENES:-example-cube homogeneous-cube cgg-logo ad envmap-cube smoke bucky}
+
+: >"$MD"
+say "# volpt view, end to end, $(date -u +%Y-%m-%dT%H:%MZ)"
+say ""
+say "device: $(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null | head -n 1); CPU: $(nproc) threads of $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)"
+say "volpt: $($VOLPT --version 2>/dev/null); GPU strategy $STRATEGY, math $MATH; phases of $SECONDS_PER_PHASE s"
+say ""
+say "move->frame: a still camera move to its first frame (1 spp, full resolution), median of 10. still: frames/s of the refinement and the spp reached. orbit: 60 interactive moves/s; frames/s showing a move, move->frame median, the resolution the renderer chose, and the mean render / tone map / JPEG ms per frame."
+say ""
+say "| scene | backend | resolution | move->frame ms | still frames/s | still spp after | orbit frames/s | orbit move->frame ms | orbit at | orbit render / tone / jpeg ms |"
+say "|---|---|---|---|---|---|---|---|---|---|"
+"$VOLPT" scene generate scenes >"$OUT/viewer-generate.log" 2>&1 || echo "viewer.sh: volpt scene generate failed (see viewer-generate.log)"
+
+num() { python3 -c "import json,sys; v=json.loads(sys.argv[1]).get(sys.argv[2]); print('-' if v is None else (f'{v:.1f}' if isinstance(v,float) else v))" "$1" "$2"; }
+failures=0
+for scene in $SCENES; do
+  for backend in $BACKENDS; do
+    for res in $RESOLUTIONS; do
+      gpu=()
+      [ "$backend" = cuda ] && gpu=(--strategy "$STRATEGY" --math "$MATH")
+      log=$OUT/viewer-$scene-$backend-$res.log
+      # shellcheck disable=SC2086 # FILES holds the scene file and its -D parameter
+      "$VOLPT" view ${FILES[$scene]} --backend "$backend" "${gpu[@]}" --resolution "$res" \
+          --bind 127.0.0.1:0 >"$log" 2>&1 &
+      server=$!
+      url=
+      for _ in $(seq 600); do
+          url=$(sed -n 's/^volpt view: open http/ws/p' "$log")
+          [ -n "$url" ] && break
+          kill -0 "$server" 2>/dev/null || break
+          sleep 0.1
+      done
+      if [ -z "$url" ]; then
+          say "| $scene | $backend | $res | FAIL: no server ($(tail -n 1 "$log")) |"
+          failures=$((failures + 1)); kill "$server" 2>/dev/null; wait "$server" 2>/dev/null; continue
+      fi
+      json=$(timeout "$LIMIT" "$CLIENT" "${url}ws" "$SECONDS_PER_PHASE" 2>>"$log")
+      rc=$?
+      kill -INT "$server"; 
+      for _ in $(seq 100); do kill -0 "$server" 2>/dev/null || break; sleep 0.1; done
+      if kill -0 "$server" 2>/dev/null; then
+          echo "viewer.sh: $scene $backend $res: the server ignored SIGINT" | tee -a "$log"; kill -9 "$server"; failures=$((failures + 1))
+      fi
+      wait "$server" 2>/dev/null
+      if [ $rc -ne 0 ] || [ -z "$json" ]; then
+          say "| $scene | $backend | $res | FAIL: client rc $rc ($(tail -n 1 "$log")) |"
+          failures=$((failures + 1)); continue
+      fi
+      echo "{\"scene\":\"$scene\",\"resolution\":\"$res\",\"result\":$json}" >>"$JSONL"
+      say "| $scene | $backend | $res | $(num "$json" still_move_to_frame_ms_median) | $(num "$json" still_frames_per_s) | $(num "$json" still_spp_after) | $(num "$json" orbit_frames_per_s) | $(num "$json" orbit_move_to_frame_ms_median) | $(num "$json" orbit_resolution) | $(num "$json" orbit_render_ms_mean) / $(num "$json" orbit_tonemap_ms_mean) / $(num "$json" orbit_encode_ms_mean) |"
+    done
+  done
+done
+say ""
+say "failures: $failures"
+exit $((failures > 0))

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# The viewer in a real browser (CI): installs Debian's chromium and Playwright for Python (in a
+# venv; Playwright's own browser download is never used), starts `volpt view` on 127.0.0.1 with
+# the CPU backend and a small scene, and runs volpt-view/browser_test.py against it. The screenshot
+# goes to docs/viewer.png (argument 1 overrides).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+screenshot=${1:-docs/viewer.png}
+started=$SECONDS
+
+if [[ ! -x /usr/bin/chromium ]]; then
+    apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null
+fi
+venv=target/browser-test-venv
+if ! "$venv/bin/python" -c 'import playwright' 2>/dev/null; then
+    python3 -m venv "$venv"
+    "$venv/bin/pip" install -q playwright
+fi
+# The binary as `cargo test --release --workspace` builds it (CI's step before this one, so a
+# no-op there): a plain `cargo build -p volpt-cli` unifies other dependency features and would
+# rebuild the workspace.
+cargo test --release --workspace --no-run -q
+
+log=$(mktemp)
+target/release/volpt view scenes/example/cube.xml --resolution 240x240 --spp 16 --threads 2 \
+    --bind 127.0.0.1:0 >"$log" 2>&1 &
+server=$!
+trap 'kill "$server" 2>/dev/null || true; rm -f "$log"' EXIT
+url=
+for _ in $(seq 100); do
+    url=$(sed -n 's/^volpt view: open //p' "$log")
+    [[ -n $url ]] && break
+    kill -0 "$server" 2>/dev/null || { cat "$log"; echo "browser test: volpt view exited"; exit 1; }
+    sleep 0.1
+done
+[[ -n $url ]] || { cat "$log"; echo "browser test: no URL from volpt view"; exit 1; }
+
+"$venv/bin/python" volpt-view/browser_test.py "$url" "$screenshot"
+# Ctrl-C ends the server cleanly: SIGINT, then it must exit 0 by itself.
+kill -INT "$server"
+wait "$server"
+trap 'rm -f "$log"' EXIT
+echo "browser test: $((SECONDS - started)) s in all (installs and build included)"

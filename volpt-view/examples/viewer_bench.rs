@@ -1,0 +1,214 @@
+//! A scripted viewer client that measures `volpt view` end to end: render + tone map + encode +
+//! send, as a page sees it. Used by `bench/device/viewer.sh`.
+//!
+//! Usage: viewer_bench WS_URL [SECONDS]
+//!
+//! Three phases, each timed on this side of the socket, every frame acknowledged at once:
+//! 1. latency: ten still camera moves, one at a time: the time from sending the move to the first
+//!    frame of the new epoch (one sample at full resolution);
+//! 2. still: frames/s of the progressive refinement of one view for SECONDS (default 3);
+//! 3. orbit: camera moves at 60 Hz (interactive, as a drag sends them) for SECONDS: frames/s of
+//!    frames showing a move, the time from a move to the frame showing it, and the resolution.
+//!
+//! Prints one JSON object.
+
+use std::time::{Duration, Instant};
+
+use futures_util::{SinkExt, StreamExt};
+use serde_json::{json, Value};
+use tokio_tungstenite::tungstenite::Message;
+use volpt_view::protocol::split_frame;
+
+type Ws =
+    tokio_tungstenite::WebSocketStream<tokio_tungstenite::MaybeTlsStream<tokio::net::TcpStream>>;
+
+fn vec3(v: &Value) -> [f64; 3] {
+    let a = |i: usize| v[i].as_f64().unwrap_or(0.0);
+    [a(0), a(1), a(2)]
+}
+
+/// `origin` turned by `angle` radians around the axis `up` through `target` (Rodrigues).
+fn orbit(origin: [f64; 3], target: [f64; 3], up: [f64; 3], angle: f64) -> [f64; 3] {
+    let n = (up[0] * up[0] + up[1] * up[1] + up[2] * up[2]).sqrt();
+    let k = up.map(|c| c / n);
+    let v = [0, 1, 2].map(|i| origin[i] - target[i]);
+    let kv = [
+        k[1] * v[2] - k[2] * v[1],
+        k[2] * v[0] - k[0] * v[2],
+        k[0] * v[1] - k[1] * v[0],
+    ];
+    let kdv = k[0] * v[0] + k[1] * v[1] + k[2] * v[2];
+    let (s, c) = angle.sin_cos();
+    [0, 1, 2].map(|i| target[i] + v[i] * c + kv[i] * s + k[i] * kdv * (1.0 - c))
+}
+
+async fn send(ws: &mut Ws, message: Value) {
+    ws.send(Message::Text(message.to_string().into()))
+        .await
+        .expect("sending");
+}
+
+/// The next frame (acknowledged), or `None` at `deadline`.
+async fn next_frame(ws: &mut Ws, deadline: Instant) -> Option<(Value, usize)> {
+    loop {
+        let message = tokio::time::timeout_at(deadline.into(), ws.next())
+            .await
+            .ok()??;
+        match message.ok()? {
+            Message::Binary(b) => {
+                let (header, image) = split_frame(&b)?;
+                send(ws, json!({"type": "ack", "frame": header["frame"]})).await;
+                return Some((header, image.len()));
+            }
+            Message::Text(t) => eprintln!("viewer_bench: server says {t}"),
+            Message::Close(_) => return None,
+            _ => {}
+        }
+    }
+}
+
+fn median(mut v: Vec<f64>) -> Option<f64> {
+    v.sort_by(|a, b| a.total_cmp(b));
+    (!v.is_empty()).then(|| v[v.len() / 2])
+}
+
+fn mean(v: &[f64]) -> Option<f64> {
+    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+}
+
+#[tokio::main(flavor = "current_thread")]
+async fn main() {
+    let mut args = std::env::args().skip(1);
+    let url = args.next().expect("usage: viewer_bench WS_URL [SECONDS]");
+    let seconds: f64 = args.next().map_or(3.0, |s| s.parse().expect("SECONDS"));
+    let (mut ws, _) = tokio_tungstenite::connect_async(&url)
+        .await
+        .expect("connecting");
+    let hello: Value = match ws.next().await {
+        Some(Ok(Message::Text(t))) => serde_json::from_str(&t).expect("hello"),
+        other => panic!("expected hello, got {other:?}"),
+    };
+    let initial = &hello["initial"];
+    let (origin, target, up) = (
+        vec3(&initial["origin"]),
+        vec3(&initial["target"]),
+        vec3(&initial["up"]),
+    );
+    // Refinement must not stop within a phase.
+    send(
+        &mut ws,
+        json!({"type": "set", "key": "spp", "value": 1 << 20}),
+    )
+    .await;
+    let far = Instant::now() + Duration::from_secs(120);
+    let (first, _) = next_frame(&mut ws, far).await.expect("a first frame");
+    let mut epoch = first["epoch"].as_u64().unwrap_or(0);
+
+    // 1. Latency of a still move: send, wait for the new epoch's first frame.
+    let mut latency = Vec::new();
+    let mut first_frames = Vec::new();
+    for i in 0..10 {
+        let o = orbit(origin, target, up, 0.05 * f64::from(i + 1));
+        let sent = Instant::now();
+        send(
+            &mut ws,
+            json!({"type": "camera", "origin": o, "target": target}),
+        )
+        .await;
+        while let Some((h, bytes)) = next_frame(&mut ws, sent + Duration::from_secs(60)).await {
+            if h["epoch"].as_u64() > Some(epoch) {
+                epoch = h["epoch"].as_u64().unwrap_or(epoch);
+                latency.push(sent.elapsed().as_secs_f64() * 1e3);
+                first_frames.push((h, bytes));
+                break;
+            }
+        }
+    }
+
+    // 2. Still: the refinement's frame rate.
+    let started = Instant::now();
+    let mut still_frames = 0u32;
+    let mut last_still = Value::Null;
+    while let Some((h, _)) = next_frame(&mut ws, started + Duration::from_secs_f64(seconds)).await {
+        if h["epoch"].as_u64() == Some(epoch) {
+            still_frames += 1;
+            last_still = h;
+        }
+    }
+    let still_s = started.elapsed().as_secs_f64();
+
+    // 3. Orbit: interactive moves at 60 Hz, as a drag sends them.
+    let started = Instant::now();
+    let end = started + Duration::from_secs_f64(seconds);
+    let mut tick = tokio::time::interval(Duration::from_micros(16_667));
+    let mut sent: Vec<([f64; 3], Instant)> = Vec::new();
+    let (mut frames, mut move_latency, mut widths) = (0u32, Vec::new(), Vec::new());
+    let (mut render, mut tonemap, mut encode, mut bytes) = (vec![], vec![], vec![], vec![]);
+    let mut angle = 0.6;
+    loop {
+        tokio::select! {
+            _ = tick.tick() => {
+                if Instant::now() >= end { break; }
+                angle += 0.02;
+                let o = orbit(origin, target, up, angle);
+                sent.push((o, Instant::now()));
+                send(&mut ws, json!({"type": "camera", "origin": o, "target": target,
+                                     "interactive": true})).await;
+            }
+            frame = next_frame(&mut ws, end) => {
+                let Some((h, size)) = frame else { break };
+                if h["interactive"] != true { continue; }
+                frames += 1;
+                let shown = vec3(&h["view"]["origin"]);
+                // The move this frame shows: the server echoes the origin as f32.
+                if let Some((_, at)) = sent.iter().rev().find(|(o, _)| {
+                    (0..3).all(|i| (o[i] - shown[i]).abs() <= 1e-5 * (1.0 + o[i].abs()))
+                }) {
+                    move_latency.push(at.elapsed().as_secs_f64() * 1e3);
+                }
+                widths.push(format!("{}x{}", h["width"], h["height"]));
+                render.push(h["render_ms"].as_f64().unwrap_or(0.0));
+                tonemap.push(h["tonemap_ms"].as_f64().unwrap_or(0.0));
+                encode.push(h["encode_ms"].as_f64().unwrap_or(0.0));
+                bytes.push(size as f64);
+            }
+        }
+    }
+    let orbit_s = started.elapsed().as_secs_f64();
+    send(
+        &mut ws,
+        json!({"type": "camera", "origin": origin, "target": target}),
+    )
+    .await;
+    widths.sort();
+    let common = widths
+        .chunk_by(|a, b| a == b)
+        .max_by_key(|c| c.len())
+        .map(|c| c[0].clone());
+    let first_render: Vec<f64> = first_frames
+        .iter()
+        .map(|(h, _)| h["render_ms"].as_f64().unwrap_or(0.0))
+        .collect();
+    let first_encode: Vec<f64> = first_frames
+        .iter()
+        .map(|(h, _)| {
+            h["tonemap_ms"].as_f64().unwrap_or(0.0) + h["encode_ms"].as_f64().unwrap_or(0.0)
+        })
+        .collect();
+    let report = json!({
+        "backend": hello["backend"], "device": hello["device"], "strategy": hello["strategy"],
+        "math": hello["math"], "width": hello["width"], "height": hello["height"],
+        "still_move_to_frame_ms_median": median(latency.clone()),
+        "still_move_to_frame_ms_all": latency,
+        "still_first_frame_render_ms_median": median(first_render),
+        "still_first_frame_tonemap_encode_ms_median": median(first_encode),
+        "still_frames_per_s": f64::from(still_frames) / still_s,
+        "still_spp_after": last_still["spp"], "still_paths_per_s": last_still["paths_per_s"],
+        "orbit_frames_per_s": f64::from(frames) / orbit_s,
+        "orbit_move_to_frame_ms_median": median(move_latency),
+        "orbit_resolution": common,
+        "orbit_render_ms_mean": mean(&render), "orbit_tonemap_ms_mean": mean(&tonemap),
+        "orbit_encode_ms_mean": mean(&encode), "orbit_jpeg_bytes_mean": mean(&bytes),
+    });
+    println!("{report}");
+}

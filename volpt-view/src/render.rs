@@ -1,0 +1,547 @@
+//! The render thread: it alone owns the backend, the scene and the accumulation film. It refines
+//! the current view progressively and starts a new accumulation (a new epoch) when the view or a
+//! parameter changes. Frames go out through a `watch` channel, which keeps only the latest:
+//! a client that falls behind skips frames instead of queueing them.
+//!
+//! Invariants: `film` holds samples `0..done` of `scene` as it is now, at the scene's current
+//! resolution; every published frame's `epoch` names the scene state it was rendered from.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::mpsc::{Receiver, RecvTimeoutError, SyncSender, TrySendError};
+use std::sync::{Arc, OnceLock};
+use std::time::{Duration, Instant};
+
+use tokio::sync::{broadcast, mpsc, oneshot, watch};
+use volpt::{Backend, BackendOptions, Film, Image, ParamValue, Scene};
+
+use crate::encode;
+use crate::protocol::{FrameHeader, Hello, ImageFormat, Params, ServerMessage, View};
+use crate::ViewError;
+
+/// A client's queue of text messages (error replies), bounded: a reply that does not fit is
+/// dropped rather than block the render thread.
+pub type Outbox = mpsc::Sender<String>;
+
+/// What clients ask of the render thread.
+pub enum Command {
+    Camera {
+        origin: [f32; 3],
+        target: [f32; 3],
+        fov: Option<f32>,
+        interactive: bool,
+        reply: Outbox,
+    },
+    Set {
+        key: String,
+        value: ParamValue,
+        reply: Outbox,
+    },
+    Exposure(f32),
+    Reset,
+    /// A client connected: render if the thread was idle for want of clients.
+    Wake,
+    Shutdown,
+}
+
+/// Commands queued at most; a client that sends faster than the renderer drains gets "busy".
+const QUEUE: usize = 1024;
+
+/// The sending side of the render thread's queue.
+#[derive(Clone)]
+pub struct Commands(SyncSender<Command>);
+
+impl Commands {
+    pub fn send(&self, command: Command) -> Result<(), ViewError> {
+        self.0.try_send(command).map_err(|e| match e {
+            TrySendError::Full(_) => ViewError::Busy,
+            TrySendError::Disconnected(_) => ViewError::Stopped,
+        })
+    }
+}
+
+/// One rendered, tone-mapped and encoded image.
+pub struct Frame {
+    pub header: FrameHeader,
+    /// The linear image (EXR snapshots).
+    pub linear: Image,
+    /// 8-bit sRGB after exposure (PNG snapshots and frames).
+    pub rgb: Vec<u8>,
+    pub jpeg: Vec<u8>,
+    png: OnceLock<Result<Vec<u8>, String>>,
+}
+
+impl Frame {
+    /// The frame as PNG, encoded once on first request.
+    pub fn png(&self) -> Result<&[u8], ViewError> {
+        let (w, h) = (self.header.width, self.header.height);
+        self.png
+            .get_or_init(|| encode::png(&self.rgb, w, h).map_err(|e| e.to_string()))
+            .as_deref()
+            .map_err(|e| ViewError::Encode(e.clone()))
+    }
+
+    pub fn image(&self, format: ImageFormat) -> Result<&[u8], ViewError> {
+        match format {
+            ImageFormat::Jpeg => Ok(&self.jpeg),
+            ImageFormat::Png => self.png(),
+        }
+    }
+}
+
+/// What the render thread and the connections share.
+pub struct Shared {
+    pub frames: watch::Sender<Option<Arc<Frame>>>,
+    /// Server-wide notices (a failed render, auto's choice), as `error` or `notice` JSON.
+    pub notices: broadcast::Sender<String>,
+    pub clients: AtomicUsize,
+}
+
+/// While the user drags, the renderer aims at this frame time (30 frames/s with a margin).
+const INTERACTIVE_BUDGET: f64 = 0.030;
+/// Reduced resolutions while dragging: the full one divided by these.
+const SCALES: [f32; 9] = [1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0];
+/// A drag whose last move is this old is over (a lost or never-sent release).
+const STILL_AFTER: Duration = Duration::from_millis(300);
+/// JPEG quality of frames.
+const QUALITY: u8 = 85;
+
+struct Renderer {
+    scene: Scene,
+    backend: Backend,
+    film: Film,
+    shared: Arc<Shared>,
+    full: (u32, u32),
+    view: View,
+    initial: View,
+    epoch: u64,
+    done: u32,
+    interactive: bool,
+    last_move: Instant,
+    epoch_started: Instant,
+    epoch_render: Duration,
+    epoch_paths: u64,
+    exposure: f32,
+    /// Index into [`SCALES`] used while dragging, adapted to the measured frame time.
+    scale: usize,
+    /// Seconds per pixel-sample of the latest render, to size the next batch.
+    sample_time: Option<f64>,
+    /// The latest frame needs tone mapping again (the exposure changed).
+    retone: bool,
+    next_frame: u64,
+}
+
+/// Starts the render thread: opens the backend there (a GPU context stays on its thread) and
+/// answers with what the page is told on connection.
+pub fn spawn(
+    scene: Scene,
+    options: BackendOptions,
+    shared: Arc<Shared>,
+) -> (
+    std::thread::JoinHandle<()>,
+    Commands,
+    oneshot::Receiver<Result<Hello, ViewError>>,
+) {
+    let (tx, rx) = std::sync::mpsc::sync_channel(QUEUE);
+    let (ready, ready_rx) = oneshot::channel();
+    let thread = std::thread::Builder::new()
+        .name("volpt-view render".into())
+        .spawn(move || match Renderer::open(scene, &options, shared) {
+            Ok((renderer, hello)) => {
+                let _ = ready.send(Ok(hello));
+                renderer.run(rx);
+            }
+            Err(e) => {
+                let _ = ready.send(Err(e));
+            }
+        })
+        .expect("spawning the render thread");
+    (thread, Commands(tx), ready_rx)
+}
+
+impl Renderer {
+    fn open(
+        mut scene: Scene,
+        options: &BackendOptions,
+        shared: Arc<Shared>,
+    ) -> Result<(Self, Hello), ViewError> {
+        let backend = Backend::open(options)?;
+        backend.prepare(&mut scene);
+        let view = initial_view(&mut scene)?;
+        let full = scene.resolution();
+        let hello = Hello {
+            scene: scene.source().to_owned(),
+            backend: format!("{:?}", backend.kind()).to_lowercase(),
+            device: backend.device_name(),
+            strategy: backend.strategy().map(|s| s.to_string()),
+            math: backend.math().map(|m| m.name().to_owned()),
+            width: full.0,
+            height: full.1,
+            initial: view,
+            max_message_bytes: crate::protocol::MAX_MESSAGE_BYTES,
+            max_in_flight: crate::protocol::MAX_IN_FLIGHT,
+        };
+        let now = Instant::now();
+        let renderer = Self {
+            film: scene.film(),
+            scene,
+            backend,
+            shared,
+            full,
+            view,
+            initial: view,
+            epoch: 0,
+            done: 0,
+            interactive: false,
+            last_move: now,
+            epoch_started: now,
+            epoch_render: Duration::ZERO,
+            epoch_paths: 0,
+            exposure: 0.0,
+            scale: 2,
+            sample_time: None,
+            retone: false,
+            next_frame: 0,
+        };
+        Ok((renderer, hello))
+    }
+
+    /// Samples per pixel this epoch refines to: one while dragging, else the scene's.
+    fn cap(&self) -> u32 {
+        if self.interactive {
+            1
+        } else {
+            self.scene.spp()
+        }
+    }
+
+    fn run(mut self, rx: Receiver<Command>) {
+        loop {
+            let clients = self.shared.clients.load(Ordering::SeqCst);
+            let work = clients > 0 && (self.done < self.cap() || self.retone);
+            let mut commands = Vec::new();
+            // Block for a command only with nothing to render; a drag's end is a timeout.
+            if !work {
+                let first = if clients > 0 && self.interactive {
+                    match rx.recv_timeout(STILL_AFTER.saturating_sub(self.last_move.elapsed())) {
+                        Ok(c) => Some(c),
+                        Err(RecvTimeoutError::Timeout) => None,
+                        Err(RecvTimeoutError::Disconnected) => return,
+                    }
+                } else {
+                    match rx.recv() {
+                        Ok(c) => Some(c),
+                        Err(_) => return,
+                    }
+                };
+                commands.extend(first);
+            }
+            commands.extend(rx.try_iter());
+            let mut restart = false;
+            for command in commands {
+                match command {
+                    Command::Shutdown => return,
+                    Command::Wake => {}
+                    Command::Exposure(stops) => {
+                        self.exposure = stops;
+                        self.retone = true;
+                    }
+                    Command::Reset => {
+                        self.apply_view(self.initial, None)
+                            .unwrap_or_else(|e| tracing::error!("reset: {e}"));
+                        self.interactive = false;
+                        restart = true;
+                    }
+                    Command::Camera {
+                        origin,
+                        target,
+                        fov,
+                        interactive,
+                        reply,
+                    } => {
+                        let view = View {
+                            origin,
+                            target,
+                            ..self.view
+                        };
+                        match self.apply_view(view, fov) {
+                            Ok(()) => {
+                                self.interactive = interactive;
+                                if interactive {
+                                    self.last_move = Instant::now();
+                                }
+                                restart = true;
+                            }
+                            Err(e) => refuse(&reply, format!("camera: {e}")),
+                        }
+                    }
+                    Command::Set { key, value, reply } => match self.scene.set(&key, value) {
+                        // More samples per pixel continue the accumulation; anything else
+                        // renders another image.
+                        Ok(()) if key == "spp" => {}
+                        Ok(()) => {
+                            if key == "camera.fov" {
+                                if let Ok(ParamValue::Float(f)) = self.scene.get(&key) {
+                                    self.view.fov = f;
+                                }
+                            }
+                            restart = true;
+                        }
+                        Err(e) => refuse(&reply, e.to_string()),
+                    },
+                }
+            }
+            if self.interactive && self.last_move.elapsed() >= STILL_AFTER {
+                self.interactive = false;
+                restart = true;
+            }
+            if restart {
+                self.new_epoch();
+            }
+            if self.shared.clients.load(Ordering::SeqCst) == 0 {
+                continue;
+            }
+            if self.done < self.cap() {
+                self.render_batch();
+            } else if self.retone && self.done > 0 {
+                self.publish(Duration::ZERO);
+            }
+            self.retone = false;
+        }
+    }
+
+    /// Moves the camera to `view` (and `fov`); on a refusal the camera stays where it was.
+    fn apply_view(&mut self, view: View, fov: Option<f32>) -> Result<(), volpt::Error> {
+        let before = self.view;
+        let mut set = |v: &View, fov: Option<f32>| -> Result<(), volpt::Error> {
+            self.scene
+                .set("camera.origin", ParamValue::Vec3(v.origin))?;
+            self.scene
+                .set("camera.target", ParamValue::Vec3(v.target))?;
+            if let Some(fov) = fov {
+                self.scene.set("camera.fov", ParamValue::Float(fov))?;
+            }
+            Ok(())
+        };
+        match set(&view, fov.or(Some(view.fov))) {
+            Ok(()) => {
+                self.view = View {
+                    fov: fov.unwrap_or(view.fov),
+                    ..view
+                };
+                Ok(())
+            }
+            Err(e) => {
+                // The view before was accepted, so setting it again succeeds.
+                let _ = set(&before, Some(before.fov));
+                Err(e)
+            }
+        }
+    }
+
+    /// A new accumulation: at a reduced resolution while dragging, else the full one.
+    fn new_epoch(&mut self) {
+        self.epoch += 1;
+        let (w, h) = self.full;
+        let (w, h) = if self.interactive {
+            let s = SCALES[self.scale];
+            let reduce = |n: u32| ((n as f32 / s).round() as u32).max(1);
+            (reduce(w), reduce(h))
+        } else {
+            (w, h)
+        };
+        if self.scene.resolution() != (w, h) {
+            if let Err(e) = self.scene.set_resolution(w, h) {
+                tracing::error!("resolution {w}x{h}: {e}");
+            }
+        }
+        self.film = self.scene.film();
+        self.done = 0;
+        self.epoch_started = Instant::now();
+        self.epoch_render = Duration::ZERO;
+        self.epoch_paths = 0;
+    }
+
+    /// Samples for the next frame: one while dragging or for an epoch's first frame, then as
+    /// many as fit a frame time that grows with the epoch's age (4 to 33 frames/s).
+    fn batch(&self) -> u32 {
+        let left = self.cap().saturating_sub(self.done);
+        if self.interactive || self.done == 0 {
+            return left.min(1);
+        }
+        let (w, h) = self.scene.resolution();
+        let Some(per_sample) = self.sample_time.map(|t| t * f64::from(w) * f64::from(h)) else {
+            return left.min(1);
+        };
+        let budget = (0.25 * self.epoch_started.elapsed().as_secs_f64()).clamp(0.03, 0.25);
+        ((budget / per_sample.max(1e-9)) as u32).clamp(1, left.max(1))
+    }
+
+    fn render_batch(&mut self) {
+        let k = self.batch();
+        let samples = self.done..self.done + k;
+        let started = Instant::now();
+        let result =
+            self.backend
+                .render(&self.scene, &mut self.film, samples.clone(), &volpt::Quiet);
+        let elapsed = started.elapsed();
+        match result {
+            Ok(rendered) => {
+                self.done = rendered.samples.end;
+                let (w, h) = self.scene.resolution();
+                let pixel_samples = u64::from(w) * u64::from(h) * u64::from(k);
+                self.sample_time = Some(elapsed.as_secs_f64() / pixel_samples.max(1) as f64);
+                self.epoch_render += elapsed;
+                self.epoch_paths += pixel_samples;
+                let frame_time = self.publish(elapsed);
+                if self.interactive {
+                    self.adapt_scale(frame_time);
+                }
+            }
+            Err(e) => {
+                // Nothing more of this epoch: the next change tries again.
+                tracing::error!("render: {e}");
+                let message = ServerMessage::Error {
+                    message: format!("render failed: {e}"),
+                }
+                .to_json();
+                let _ = self.shared.notices.send(message);
+                self.done = self.cap();
+            }
+        }
+    }
+
+    /// Steps the drag resolution down when frames are slower than the budget, up when they are
+    /// well within it (the gap between the thresholds keeps it from flapping).
+    fn adapt_scale(&mut self, frame_time: f64) {
+        if frame_time > 1.2 * INTERACTIVE_BUDGET && self.scale + 1 < SCALES.len() {
+            self.scale += 1;
+        } else if frame_time < 0.4 * INTERACTIVE_BUDGET && self.scale > 0 {
+            self.scale -= 1;
+        }
+    }
+
+    /// Tone maps, encodes and publishes the film; returns the frame's seconds (render included).
+    fn publish(&mut self, render: Duration) -> f64 {
+        let t0 = Instant::now();
+        let linear = self.film.image(self.done);
+        let rgb = encode::tone_map(&linear, self.exposure);
+        let tonemap = t0.elapsed();
+        let t1 = Instant::now();
+        let jpeg = match encode::jpeg(&rgb, linear.width, linear.height, QUALITY) {
+            Ok(jpeg) => jpeg,
+            Err(e) => {
+                tracing::error!("{e}");
+                return render.as_secs_f64();
+            }
+        };
+        let encode = t1.elapsed();
+        let ms = |d: Duration| d.as_secs_f64() * 1e3;
+        let render_s = self.epoch_render.as_secs_f64();
+        self.next_frame += 1;
+        let header = FrameHeader {
+            frame: self.next_frame,
+            epoch: self.epoch,
+            format: ImageFormat::Jpeg,
+            width: linear.width,
+            height: linear.height,
+            spp: self.done,
+            spp_target: self.cap(),
+            interactive: self.interactive,
+            render_ms: ms(render),
+            tonemap_ms: ms(tonemap),
+            encode_ms: ms(encode),
+            paths_per_s: if render_s > 0.0 {
+                self.epoch_paths as f64 / render_s
+            } else {
+                0.0
+            },
+            elapsed_s: self.epoch_started.elapsed().as_secs_f64(),
+            exposure: self.exposure,
+            variant: self.scene.variant().to_string(),
+            view: self.view,
+            params: self.params(),
+        };
+        self.shared.frames.send_replace(Some(Arc::new(Frame {
+            header,
+            linear,
+            rgb,
+            jpeg,
+            png: OnceLock::new(),
+        })));
+        (render + tonemap + encode).as_secs_f64()
+    }
+
+    fn params(&self) -> Params {
+        let float = |key| match self.scene.get(key) {
+            Ok(ParamValue::Float(f)) => f,
+            _ => 0.0,
+        };
+        Params {
+            spp: self.scene.spp(),
+            max_depth: match self.scene.get("max_depth") {
+                Ok(ParamValue::Int(d)) => d,
+                _ => -1,
+            },
+            medium_scale: float("medium.scale"),
+            medium_albedo: match self.scene.get("medium.albedo") {
+                Ok(ParamValue::Rgb(rgb)) => Some(rgb),
+                _ => None,
+            },
+            phase_g: float("phase.g"),
+        }
+    }
+}
+
+fn refuse(reply: &Outbox, message: String) {
+    let _ = reply.try_send(ServerMessage::Error { message }.to_json());
+}
+
+/// The loaded camera as an orbit: the target is the point of the view ray nearest the medium's
+/// centre (a scene file's target is forgotten once loaded), and the up is the world axis nearest
+/// the camera's up, so that orbiting keeps the horizon level.
+fn initial_view(scene: &mut Scene) -> Result<View, ViewError> {
+    let vec3 = |v| match v {
+        Ok(ParamValue::Vec3(v)) => Ok(v),
+        other => Err(ViewError::Encode(format!("camera: {other:?}"))),
+    };
+    let origin = vec3(scene.get("camera.origin"))?;
+    let ahead = vec3(scene.get("camera.target"))?;
+    let up = vec3(scene.get("camera.up"))?;
+    let fov = match scene.get("camera.fov") {
+        Ok(ParamValue::Float(f)) => f,
+        _ => 40.0,
+    };
+    let sub = |a: [f32; 3], b: [f32; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let dot = |a: [f32; 3], b: [f32; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let forward = sub(ahead, origin);
+    let bounds = scene.description().boundary.bounds;
+    let centre = [0, 1, 2].map(|i| 0.5 * (bounds.min[i] + bounds.max[i]));
+    let to_centre = sub(centre, origin);
+    let distance = dot(to_centre, forward);
+    // A medium behind the camera: orbit around a point as far ahead as the medium is away.
+    let distance = if distance > 1e-4 {
+        distance
+    } else {
+        dot(to_centre, to_centre).sqrt().max(1.0)
+    };
+    let target = [0, 1, 2].map(|i| origin[i] + forward[i] * distance);
+    let mut snapped = up;
+    if let Some(axis) = (0..3).find(|&i| up[i].abs() > 0.9) {
+        snapped = [0.0; 3];
+        snapped[axis] = up[axis].signum();
+    }
+    // Looking along the world axis, the snapped up would be parallel to the view: keep the
+    // camera's own up then.
+    if scene.set("camera.up", ParamValue::Vec3(snapped)).is_err() {
+        scene.set("camera.up", ParamValue::Vec3(up))?;
+        snapped = up;
+    }
+    let view = View {
+        origin,
+        target,
+        up: snapped,
+        fov,
+    };
+    scene.set("camera.target", ParamValue::Vec3(target))?;
+    Ok(view)
+}
