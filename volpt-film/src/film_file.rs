@@ -262,7 +262,6 @@ impl FilmFile {
         );
         // A checkpoint has no range list: its last header field is its sample count.
         let range_bytes = if checkpoint { 0 } else { 8 * u64::from(count) };
-        let sum_bytes = u64::from(width) * u64::from(height) * 24;
         // width * height fits a u64 for any u32 header; 24 times it may not, hence checked.
         let expected = (u64::from(width) * u64::from(height))
             .checked_mul(24)
@@ -287,6 +286,8 @@ impl FilmFile {
                 ))
             }
         }
+        // The length matched, so this product did not overflow.
+        let sum_bytes = u64::from(width) * u64::from(height) * 24;
         if sum_bytes > limit {
             return Err(FilmFileError::TooLarge {
                 path: path.to_owned(),
@@ -468,7 +469,7 @@ mod tests {
     fn ranges_out_of_order_or_overlapping_are_refused_even_with_a_good_checksum() {
         let dir = tempfile::tempdir().unwrap();
         let (path, bytes) = written(dir.path());
-        for (a, b) in [(9u32, 12u32), (3, 6), (4, 6), (12, 12)] {
+        for (a, b) in [(1u32, 2u32), (3, 6), (4, 6), (12, 12)] {
             let mut bad = bytes.clone();
             bad[40..44].copy_from_slice(&a.to_le_bytes());
             bad[44..48].copy_from_slice(&b.to_le_bytes());
