@@ -12,14 +12,18 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
-const SMALL: [&str; 4] = ["--resolution", "16x12", "--seed", "4"];
-
-/// `volpt render` of the example with `extra`, in `dir` (where a default `out.exr` would land).
+/// `volpt render` of the example, small, seed 4 unless `extra` names one, with `extra`; in `dir`
+/// (where a default `out.exr` would land).
 fn render(dir: &Path, extra: &[&str]) -> Output {
+    let seed: &[&str] = if extra.contains(&"--seed") {
+        &[]
+    } else {
+        &["--seed", "4"]
+    };
     Command::new(env!("CARGO_BIN_EXE_volpt"))
         .current_dir(dir)
-        .args(["render", &example()])
-        .args(SMALL)
+        .args(["render", &example(), "--resolution", "16x12"])
+        .args(seed)
         .args(extra)
         .env("RUST_LOG", "warn")
         .output()
