@@ -526,6 +526,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
         width = scene.resolution().0,
         height = scene.resolution().1,
         spp,
+        samples = ?args.samples,
         device = %backend.device_name(),
         strategy = ?backend.strategy(),
         math = ?backend.math(),

@@ -321,6 +321,8 @@ impl FilmFile {
         }
         let fingerprint = u64::from_le_bytes(payload[8..16].try_into().expect("8 bytes"));
         let seed = u32_at(payload, 24);
+        // A list of sample ranges that holds one (not the range's samples).
+        #[allow(clippy::single_range_in_vec_init)]
         let ranges: Vec<Range<u32>> = if checkpoint {
             vec![0..count]
         } else {
@@ -356,6 +358,8 @@ impl FilmFile {
 }
 
 #[cfg(test)]
+// Lists of sample ranges, some of one range.
+#[allow(clippy::single_range_in_vec_init)]
 mod tests {
     use super::*;
     use crate::checkpoint::Checkpoint;

@@ -637,7 +637,7 @@ impl SceneVisitor for Render<'_> {
             let chunk_paths = pixels * u64::from(range.end - range.start);
             // Backends report their own counts of this chunk; scaled to paths of the whole range.
             let report = |d: u64, t: u64| {
-                let part = if t == 0 { 0 } else { d * chunk_paths / t };
+                let part = (d * chunk_paths).checked_div(t).unwrap_or(0);
                 observer.progress(before + part, total);
             };
             let started = Instant::now();

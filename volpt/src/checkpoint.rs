@@ -32,7 +32,7 @@ pub fn render_checkpointed(
     checkpointing: &Checkpointing,
     observer: &dyn Observer,
 ) -> Result<(Film, Rendered), Error> {
-    if !(checkpointing.interval.as_secs_f64() > 0.0) {
+    if checkpointing.interval.is_zero() {
         return Err(Error::Settings(
             "--checkpoint-interval must be a positive number of seconds".into(),
         ));

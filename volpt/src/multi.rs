@@ -178,7 +178,7 @@ pub(crate) fn render_shared(
                     };
                     let batch_paths = pixels * u64::from(batch.end - batch.start);
                     let progress = |p: u64, t: u64| {
-                        let part = if t == 0 { 0 } else { p * batch_paths / t };
+                        let part = (p * batch_paths).checked_div(t).unwrap_or(0);
                         in_flight[d].store(part, Ordering::Relaxed);
                         report();
                     };

@@ -3,6 +3,9 @@
 //! are refused by name; and the multi-device scheduler (`--gpus`, here with the CPU as devices)
 //! equals one device, repeats bit for bit, and cancels, checkpoints and resumes as one device does.
 
+// Lists of sample ranges, some of one range.
+#![allow(clippy::single_range_in_vec_init)]
+
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU32, Ordering};
