@@ -45,8 +45,8 @@ fn to_py(error: Error) -> PyErr {
         Error::Param { found, .. } if found == "no such parameter" => "UnknownParamError",
         Error::Param { .. } => "ParamError",
         Error::Cpu(_) | Error::Cuda(_) => "RenderError",
-        Error::Checkpoint(_) => "CheckpointError",
-        Error::Merge(_) => "MergeError",
+        Error::Checkpoint(_) | Error::FilmFile(_) => "CheckpointError",
+        Error::Merge(_) | Error::Films(_) => "MergeError",
         Error::Image(_) => "ImageError",
     };
     raise(class, message(&error))

@@ -87,6 +87,11 @@ pub struct GpuArgs {
     /// other (the thesis's tiling study: smaller launches, more tails; docs/strategies.md).
     #[arg(long, value_name = "COLUMNS,ROWS")]
     pub tiles: Option<Tiles>,
+    /// Render on several GPUs at once: `all`, or GPU numbers separated by commas (`0,1`). Each GPU
+    /// pulls batches of samples from one queue (a faster GPU takes more) into a film of its own;
+    /// the films are added in batch order (default: GPU 0 alone).
+    #[arg(long, value_name = "all|0,1,...")]
+    pub gpus: Option<volpt::Gpus>,
 }
 
 /// `--tiles COLUMNS,ROWS`, each from 1 to 4096.
@@ -123,6 +128,7 @@ impl GpuArgs {
             volume_memory: volumes.volume_memory,
             device_memory_budget: volumes.device_memory_budget,
             bricked: volumes.bricked,
+            gpus: self.gpus.unwrap_or_default(),
         }
     }
 }

@@ -41,8 +41,13 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render a scene to OpenEXR, with a PNG preview beside it.
+    /// Render a scene to OpenEXR, with a PNG preview beside it; or some of its samples to a film
+    /// file (--samples A..B --film FILE), to merge with the others' (`volpt merge`).
     Render(RenderArgs),
+    /// Add up the film files of one render's sample ranges (rendered anywhere) into its image, in
+    /// a fixed order: the same films give the same bits. Films of another scene, settings, seed or
+    /// size, and films holding the same samples, are refused; samples in no film are reported.
+    Merge(MergeArgs),
     /// Time repeated renders of a scene (the first trial is a discarded warm-up).
     Bench(BenchArgs),
     /// Print what a scene file loads to, and the variant it renders with.
@@ -301,8 +306,19 @@ struct RenderArgs {
     sampling: SamplingArgs,
     /// Output OpenEXR file, named `.exr`; the PNG preview gets the same name with `.png`. A path
     /// that exists and is not a regular file (`/dev/null`, a pipe) gets the EXR and no preview.
-    #[arg(short, long, default_value = "out.exr")]
-    output: PathBuf,
+    /// [default: out.exr, or no image with --film]
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Render only samples A..B (A included, B not) of every pixel: one part of a render split
+    /// across processes, machines or cluster tasks. The scene's own sample count is then unused;
+    /// the image, if written, averages these samples.
+    #[arg(long, value_name = "A..B", value_parser = parse_samples,
+          conflicts_with_all = ["spp", "checkpoint", "resume"])]
+    samples: Option<std::ops::Range<u32>>,
+    /// Write the film (every pixel's sums, the sample range, the scene's fingerprint, the seed) to
+    /// FILE, for `volpt merge`. With --film, the image is written only if -o names it.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["checkpoint", "resume"])]
+    film: Option<PathBuf>,
     /// Save the render's progress to FILE periodically and on Ctrl-C, to continue it with
     /// --resume FILE.
     #[arg(long, value_name = "FILE")]
@@ -330,6 +346,27 @@ struct ViewArgs {
     /// loopback ports).
     #[arg(long)]
     token: bool,
+}
+
+#[derive(Args)]
+struct MergeArgs {
+    /// Film files of one render (`volpt render --samples A..B --film FILE`), or its checkpoints.
+    #[arg(required = true, value_name = "FILMS")]
+    parts: Vec<PathBuf>,
+    /// Output OpenEXR file, named `.exr`, with its PNG preview beside it.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Write the merged film to FILE (it lists its sample ranges): to merge again later, or keep.
+    #[arg(long, value_name = "FILE")]
+    film: Option<PathBuf>,
+    /// The render's samples per pixel: samples of 0..N that no film holds are gaps, and a film
+    /// holding samples from N on is refused [default: up to the last sample held].
+    #[arg(long, value_name = "N")]
+    spp: Option<u32>,
+    /// Merge despite gaps: the image averages the samples held (unbiased but noisier than the
+    /// whole render), and --film lists the ranges held.
+    #[arg(long)]
+    allow_gaps: bool,
 }
 
 #[derive(Args)]
@@ -379,6 +416,20 @@ fn parse_bytes(s: &str) -> Result<u64, String> {
         })
 }
 
+/// `--samples A..B`: a non-empty range of sample indices.
+fn parse_samples(s: &str) -> Result<std::ops::Range<u32>, String> {
+    let parsed = s
+        .split_once("..")
+        .and_then(|(a, b)| Some((a.trim().parse::<u32>().ok()?, b.trim().parse::<u32>().ok()?)));
+    match parsed {
+        Some((a, b)) if a < b => Ok(a..b),
+        Some((a, b)) => Err(format!(
+            "expected A..B with A below B (samples A to B-1), found {a}..{b}, which holds none"
+        )),
+        None => Err(format!("expected A..B, e.g. 0..256, found {s:?}")),
+    }
+}
+
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
     let parsed = s
         .split_once('x')
@@ -412,6 +463,7 @@ fn main() -> Result<()> {
     volpt_scene::limits::set_memory_limit(cli.memory_limit);
     match cli.command {
         Command::Render(args) => render_command(args),
+        Command::Merge(args) => merge_command(args),
         Command::Bench(args) => bench_command(args),
         Command::Info(args) => {
             let scene = args.load(None)?;
@@ -483,8 +535,17 @@ fn export_name(scene: &Path) -> String {
 }
 
 fn render_command(args: RenderArgs) -> Result<()> {
+    // With --film, an image only where -o asks for one.
+    let output = match (&args.output, &args.film) {
+        (Some(output), _) => Some(output.clone()),
+        (None, Some(_)) => None,
+        (None, None) => Some(PathBuf::from("out.exr")),
+    };
     // Before the render, so that a bad name costs nothing.
-    let preview = preview_for(&args.output)?;
+    let preview = match &output {
+        Some(output) => preview_for(output)?,
+        None => None,
+    };
     let mut scene = args.scene.load(Some(&args.sampling))?;
     let backend = args.sampling.open()?;
     backend.prepare(&mut scene);
@@ -496,19 +557,42 @@ fn render_command(args: RenderArgs) -> Result<()> {
         width = scene.resolution().0,
         height = scene.resolution().1,
         spp,
+        samples = ?args.samples,
         device = %backend.device_name(),
         strategy = ?backend.strategy(),
         math = ?backend.math(),
         "rendering"
     );
     let save = checkpoint::save_path(args.checkpoint.as_deref(), args.resume.as_deref());
-    let (image, stats) = match save {
+    let (image, stats, spp) = match save {
         None => {
+            let samples = args.samples.clone().unwrap_or(0..spp);
             let terminal = Terminal::new(true);
             let mut film = scene.film();
-            let rendered = backend.render(&scene, &mut film, 0..spp, &terminal)?;
+            let rendered = backend.render(&scene, &mut film, samples.clone(), &terminal)?;
             terminal.finish();
-            (film.image(spp), rendered.stats)
+            let count = samples.end - samples.start;
+            if let Some(path) = &args.film {
+                let file = volpt::FilmFile {
+                    fingerprint: scene.fingerprint(),
+                    seed: scene.seed(),
+                    ranges: vec![samples.clone()],
+                    film,
+                };
+                file.write(path)
+                    .with_context(|| format!("writing the film {}", path.display()))?;
+                println!(
+                    "wrote {}: samples {}..{} of render {:016x} (seed {})",
+                    path.display(),
+                    samples.start,
+                    samples.end,
+                    file.fingerprint,
+                    file.seed
+                );
+                (file.image(), rendered.stats, count)
+            } else {
+                (film.image(count), rendered.stats, count)
+            }
         }
         Some(save) => {
             if !(args.checkpoint_interval.is_finite() && args.checkpoint_interval > 0.0) {
@@ -533,24 +617,77 @@ fn render_command(args: RenderArgs) -> Result<()> {
                 );
                 std::process::exit(130);
             }
-            (film.image(spp), rendered.stats)
+            (film.image(spp), rendered.stats, spp)
         }
     };
-    image
-        .write_exr(&args.output)
-        .with_context(|| format!("writing {}", args.output.display()))?;
     println!("{}", summary(&image, spp, &stats, variant));
+    match output {
+        Some(output) => write_image(&image, &output, preview.as_deref()),
+        None => Ok(()),
+    }
+}
+
+/// Writes `image` to `output` (OpenEXR) and its preview, if any, and says so.
+fn write_image(image: &Image, output: &Path, preview: Option<&Path>) -> Result<()> {
+    image
+        .write_exr(output)
+        .with_context(|| format!("writing {}", output.display()))?;
     match preview {
         Some(preview) => {
-            image.write_png(&preview)?;
-            println!("wrote {} and {}", args.output.display(), preview.display());
+            image.write_png(preview)?;
+            println!("wrote {} and {}", output.display(), preview.display());
         }
-        None => println!(
-            "wrote {} (no preview for a non-file)",
-            args.output.display()
-        ),
+        None => println!("wrote {} (no preview for a non-file)", output.display()),
     }
     Ok(())
+}
+
+fn merge_command(args: MergeArgs) -> Result<()> {
+    if args.output.is_none() && args.film.is_none() {
+        bail!("nothing to write: name the image with -o IMAGE.exr, the merged film with --film FILE, or both");
+    }
+    let preview = match &args.output {
+        Some(output) => preview_for(output)?,
+        None => None,
+    };
+    let mut films = Vec::with_capacity(args.parts.len());
+    for path in &args.parts {
+        films.push((path.display().to_string(), volpt::read_film(path)?));
+    }
+    let count = films.len();
+    let merged = volpt::merge_films(films, args.spp)?;
+    let film = if args.allow_gaps {
+        if !merged.missing.is_empty() {
+            eprintln!(
+                "warning: samples {} are in no film; the image averages the {} samples per pixel \
+                 held ({})",
+                volpt::film::film_file::format_ranges(&merged.missing),
+                merged.film.samples(),
+                volpt::film::film_file::format_ranges(&merged.film.ranges)
+            );
+        }
+        merged.film
+    } else {
+        merged.complete()?
+    };
+    println!(
+        "merged {count} films of render {:016x} (seed {}, {}x{}): samples {}, {} per pixel",
+        film.fingerprint,
+        film.seed,
+        film.film.width,
+        film.film.height,
+        volpt::film::film_file::format_ranges(&film.ranges),
+        film.samples()
+    );
+    if let Some(path) = &args.film {
+        film.write(path)
+            .with_context(|| format!("writing the film {}", path.display()))?;
+        println!("wrote {}", path.display());
+    }
+    match &args.output {
+        Some(output) => write_image(&film.image(), output, preview.as_deref()),
+        None => Ok(()),
+    }
 }
 
 /// Where the preview goes: beside the EXR with `.png`, or nowhere when the output is not a file

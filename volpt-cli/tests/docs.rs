@@ -17,6 +17,7 @@ use std::process::Command;
 /// Every subcommand, as typed after `volpt`.
 const COMMANDS: &[&str] = &[
     "render",
+    "merge",
     "bench",
     "view",
     "info",

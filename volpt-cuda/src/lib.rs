@@ -27,3 +27,14 @@ pub use volpt_device::{Math, Strategy};
 pub fn has_kernels() -> bool {
     kernels::is_embedded(Math::Exact)
 }
+
+/// How many GPUs the CUDA driver sees (`--gpus all`); [`CudaError::NoDriver`] without a driver.
+pub fn device_count() -> Result<usize, CudaError> {
+    use error::Doing;
+    // SAFETY: only probes whether the driver library can be opened.
+    if !unsafe { cudarc::driver::sys::is_culib_present() } {
+        return Err(CudaError::NoDriver);
+    }
+    let count = cudarc::driver::CudaContext::device_count().doing("counting the GPUs")?;
+    Ok(usize::try_from(count).unwrap_or(0))
+}

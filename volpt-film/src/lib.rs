@@ -5,8 +5,10 @@
 //! - [`RenderStats`]: time and path counters, with the throughputs reported from them.
 //! - [`RenderOptions`]: how many samples, with which seed.
 //! - [`checkpoint`]: a render's sums saved to a file, to resume it bit for bit.
+//! - [`film_file`]: the sums of any sample ranges of a render, to merge with the other ranges'.
 
 pub mod checkpoint;
+pub mod film_file;
 pub mod image;
 
 use std::ops::Range;
@@ -16,6 +18,7 @@ use thiserror::Error;
 use volpt_core::PathCounters;
 
 pub use checkpoint::{Checkpoint, CheckpointError};
+pub use film_file::{FilmFile, FilmFileError};
 pub use image::{preview_path, Image, ImageError};
 
 /// How many samples per pixel to trace, with which seed: the same seed gives the same paths on

@@ -16,7 +16,7 @@ use volpt_scene::GridStorage;
 use volpt_zerocopy::{VolumeMemory, VolumePolicy};
 
 use crate::auto::{self, AutoCache};
-use crate::{Error, Observer, Scene};
+use crate::{multi, Error, Observer, Scene};
 
 /// The kind of machine a render runs on.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -66,6 +66,73 @@ pub struct GpuOptions {
     pub device_memory_budget: Option<u64>,
     /// Grids in 8^3 bricks on the GPU (the same image bit for bit).
     pub bricked: bool,
+    /// The GPUs to render on together (default: GPU 0 alone).
+    pub gpus: Gpus,
+}
+
+/// Which GPUs a CUDA backend renders on. With more than one, every GPU pulls batches of samples
+/// from one queue into films of its own, added up in batch order ([`crate::multi`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Gpus {
+    /// GPU 0 alone: one GPU's render, as without `--gpus`.
+    #[default]
+    First,
+    /// Every GPU the driver sees.
+    All,
+    /// The GPUs whose ordinals are the set bits (`--gpus 0,2`: `0b101`).
+    List(u64),
+}
+
+impl Gpus {
+    /// The ordinals of these GPUs on a machine of `count` GPUs; a named GPU it lacks is refused.
+    pub fn ordinals(&self, count: usize) -> Result<Vec<usize>, Error> {
+        match *self {
+            Gpus::First => Ok(vec![0]),
+            Gpus::All if count == 0 => Err(Error::Settings(
+                "--gpus all: the CUDA driver sees no GPU on this machine".into(),
+            )),
+            Gpus::All => Ok((0..count).collect()),
+            Gpus::List(0) => Err(Error::Settings(
+                "--gpus: expected at least one GPU, found none".into(),
+            )),
+            Gpus::List(mask) => {
+                let ordinals: Vec<usize> = (0..64).filter(|i| mask & (1 << i) != 0).collect();
+                match ordinals.iter().find(|&&o| o >= count) {
+                    Some(o) => Err(Error::Settings(format!(
+                        "--gpus {self}: expected GPUs numbered 0 to {}, found GPU {o} (the CUDA \
+                         driver sees {count} GPUs)",
+                        count.saturating_sub(1)
+                    ))),
+                    None => Ok(ordinals),
+                }
+            }
+        }
+    }
+}
+
+impl std::fmt::Display for Gpus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Gpus::First => f.write_str("0"),
+            Gpus::All => f.write_str("all"),
+            Gpus::List(mask) => {
+                let names: Vec<String> = (0..64)
+                    .filter(|i| mask & (1u64 << i) != 0)
+                    .map(|i: u32| i.to_string())
+                    .collect();
+                f.write_str(&names.join(","))
+            }
+        }
+    }
+}
+
+impl std::str::FromStr for Gpus {
+    type Err = String;
+
+    /// `all`, or GPU ordinals separated by commas (`0,1`).
+    fn from_str(s: &str) -> Result<Self, String> {
+        crate::multi::parse_gpus(s)
+    }
 }
 
 /// What [`Backend::open`] opens.
@@ -91,8 +158,13 @@ pub struct Backend(Inner);
 #[allow(clippy::large_enum_variant)]
 enum Inner {
     Cpu,
+    /// The CPU as `n` devices pulling batches from one queue, as several GPUs do: the multi-GPU
+    /// scheduler, tested where there is no GPU ([`Backend::cpu_as_devices`]).
+    CpuDevices(usize),
     Cuda {
-        renderer: CudaRenderer,
+        /// One per GPU, in ordinal order; at least one. With one, renders run as they always
+        /// have (one film, samples added in order); with more, through [`crate::multi`].
+        renderers: Vec<CudaRenderer>,
         /// A fixed schedule, or `None` for `auto`.
         schedule: Option<Schedule>,
         /// `auto` by default (no strategy named): calibrates only a render that repays it.
@@ -126,6 +198,14 @@ impl Backend {
         Backend(Inner::Cpu)
     }
 
+    /// The CPU as `devices` devices that pull batches of samples from one queue and add them up in
+    /// batch order, exactly as several GPUs do (`--gpus`): the multi-GPU scheduling, cancellation
+    /// and checkpoints, tested and shown without GPUs. Each device uses every core.
+    #[doc(hidden)]
+    pub fn cpu_as_devices(devices: usize) -> Self {
+        Backend(Inner::CpuDevices(devices.max(1)))
+    }
+
     /// Opens the backend `options` name; options that do not apply to it are refused.
     pub fn open(options: &BackendOptions) -> Result<Self, Error> {
         let gpu = &options.gpu;
@@ -139,8 +219,12 @@ impl Backend {
                 let schedule = schedule(gpu)?;
                 let knobs =
                     gpu.tiles.is_some() || gpu.refill_at.is_some() || gpu.max_registers.is_some();
-                let mut renderer = CudaRenderer::new(0, math)?;
-                renderer.set_volume_policy(VolumePolicy {
+                let ordinals = match gpu.gpus {
+                    // Without --gpus, GPU 0 as always (no device count asked of the driver).
+                    Gpus::First => vec![0],
+                    gpus => gpus.ordinals(volpt_cuda::device_count()?)?,
+                };
+                let policy = VolumePolicy {
                     memory: gpu.volume_memory.unwrap_or(VolumeMemory::Auto),
                     layout: if gpu.bricked {
                         GridLayout::Bricked
@@ -148,9 +232,17 @@ impl Backend {
                         GridLayout::Dense
                     },
                     budget: gpu.device_memory_budget,
-                });
+                };
+                let renderers = ordinals
+                    .into_iter()
+                    .map(|ordinal| {
+                        let mut renderer = CudaRenderer::new(ordinal, math)?;
+                        renderer.set_volume_policy(policy);
+                        Ok(renderer)
+                    })
+                    .collect::<Result<Vec<_>, Error>>()?;
                 Ok(Backend(Inner::Cuda {
-                    renderer,
+                    renderers,
                     schedule,
                     implicit_auto: gpu.strategy.is_none() && !knobs,
                     math,
@@ -173,7 +265,7 @@ impl Backend {
 
     fn storage(&self) -> GridStorage {
         match &self.0 {
-            Inner::Cpu => GridStorage::Dense,
+            Inner::Cpu | Inner::CpuDevices(_) => GridStorage::Dense,
             Inner::Cuda { storage, .. } => *storage,
         }
     }
@@ -185,13 +277,33 @@ impl Backend {
                 "CPU, {} threads",
                 std::thread::available_parallelism().map_or(1, |n| n.get())
             ),
-            Inner::Cuda { renderer, .. } => renderer.device_name().to_owned(),
+            Inner::CpuDevices(n) => format!(
+                "CPU as {n} devices, {} threads",
+                std::thread::available_parallelism().map_or(1, |n| n.get())
+            ),
+            Inner::Cuda { renderers, .. } => {
+                let names: Vec<&str> = renderers.iter().map(|r| r.device_name()).collect();
+                if names.len() > 1 && names.iter().all(|n| *n == names[0]) {
+                    format!("{} x{}", names[0], names.len())
+                } else {
+                    names.join(" + ")
+                }
+            }
+        }
+    }
+
+    /// How many devices render together (1 but for `--gpus` of several).
+    pub fn devices(&self) -> usize {
+        match &self.0 {
+            Inner::Cpu => 1,
+            Inner::CpuDevices(n) => *n,
+            Inner::Cuda { renderers, .. } => renderers.len(),
         }
     }
 
     pub fn kind(&self) -> BackendKind {
         match &self.0 {
-            Inner::Cpu => BackendKind::Cpu,
+            Inner::Cpu | Inner::CpuDevices(_) => BackendKind::Cpu,
             Inner::Cuda { .. } => BackendKind::Cuda,
         }
     }
@@ -199,7 +311,7 @@ impl Backend {
     /// The strategy asked for (`auto` or a fixed one); `None` on the CPU.
     pub fn strategy(&self) -> Option<StrategyChoice> {
         match &self.0 {
-            Inner::Cpu => None,
+            Inner::Cpu | Inner::CpuDevices(_) => None,
             Inner::Cuda { schedule, .. } => {
                 Some(schedule.map_or(StrategyChoice::Auto, |s| StrategyChoice::Fixed(s.strategy)))
             }
@@ -209,16 +321,17 @@ impl Backend {
     /// The GPU's kernels; `None` on the CPU.
     pub fn math(&self) -> Option<Math> {
         match &self.0 {
-            Inner::Cpu => None,
+            Inner::Cpu | Inner::CpuDevices(_) => None,
             Inner::Cuda { math, .. } => Some(*math),
         }
     }
 
-    /// The GPU renderer, for what the facade does not wrap (self tests); `None` on the CPU.
+    /// The (first) GPU renderer, for what the facade does not wrap (self tests); `None` on the
+    /// CPU.
     pub fn cuda(&self) -> Option<&CudaRenderer> {
         match &self.0 {
-            Inner::Cpu => None,
-            Inner::Cuda { renderer, .. } => Some(renderer),
+            Inner::Cpu | Inner::CpuDevices(_) => None,
+            Inner::Cuda { renderers, .. } => renderers.first(),
         }
     }
 
@@ -263,7 +376,7 @@ impl Backend {
         }
         let visitor = Render {
             backend: self,
-            auto_key: self.auto_key(scene),
+            auto_keys: self.auto_keys(scene),
             options: scene.options(),
             film,
             samples,
@@ -275,9 +388,27 @@ impl Backend {
 
     /// The key of a scene's `auto` choice: the GPU, the math and the scene as rendered.
     fn auto_key(&self, scene: &Scene) -> String {
+        self.auto_key_on(&self.device_name(), scene)
+    }
+
+    /// Each GPU's `auto` key (one GPU: [`Backend::auto_key`]'s). Per GPU, because the fastest
+    /// strategy is a property of the GPU model: GPUs of one model share one calibration (the
+    /// second finds the first's choice cached), GPUs of different models each get their own.
+    fn auto_keys(&self, scene: &Scene) -> Vec<String> {
+        match &self.0 {
+            Inner::Cuda { renderers, .. } if renderers.len() > 1 => renderers
+                .iter()
+                .map(|r| self.auto_key_on(r.device_name(), scene))
+                .collect(),
+            _ => vec![self.auto_key(scene)],
+        }
+    }
+
+    /// The `auto` key of `scene` on the GPU named `device`.
+    fn auto_key_on(&self, device: &str, scene: &Scene) -> String {
         format!(
             "{}|{}|{:016x}",
-            self.device_name(),
+            device,
             self.math().map_or("-", |m| m.name()),
             scene.fingerprint()
         )
@@ -315,6 +446,13 @@ fn refuse_on_cpu(gpu: &GpuOptions) -> Result<(), Error> {
         return refuse(format!(
             "--math {math} chooses the GPU's kernels; the CPU backend always computes exactly \
              (use --backend cuda, or drop --math)"
+        ));
+    }
+    if gpu.gpus != Gpus::First {
+        return refuse(format!(
+            "--gpus {} renders on GPUs; the CPU backend uses every core already (use --backend \
+             cuda, or drop --gpus)",
+            gpu.gpus
         ));
     }
     if gpu.volume_memory.is_some() || gpu.device_memory_budget.is_some() || gpu.bricked {
@@ -378,7 +516,8 @@ fn schedule(gpu: &GpuOptions) -> Result<Option<Schedule>, Error> {
 /// One render, handed the monomorphised scene by the factory.
 struct Render<'a> {
     backend: &'a Backend,
-    auto_key: String,
+    /// One per GPU ([`Backend::auto_keys`]).
+    auto_keys: Vec<String>,
     options: RenderOptions,
     film: &'a mut Film,
     samples: Range<u32>,
@@ -392,7 +531,7 @@ impl SceneVisitor for Render<'_> {
     fn visit<S: RenderScene>(self, scene: &S) -> Self::Output {
         let Render {
             backend,
-            auto_key,
+            auto_keys,
             options,
             film,
             samples,
@@ -402,29 +541,86 @@ impl SceneVisitor for Render<'_> {
         let camera = scene.camera();
         let pixels = u64::from(camera.width) * u64::from(camera.height);
         let total = pixels * u64::from(samples.end - samples.start);
-        // Once for the whole range, so that `auto` weighs the whole render against a calibration.
-        let schedule = match &backend.0 {
-            Inner::Cpu => None,
+        // Once for the whole range, so that `auto` weighs the whole render against a calibration;
+        // per GPU, one calibration per GPU model (the others find it cached).
+        let schedules: Vec<Option<Schedule>> = match &backend.0 {
+            Inner::Cpu | Inner::CpuDevices(_) => vec![None],
             Inner::Cuda {
+                renderers,
                 schedule: Some(schedule),
                 ..
-            } => Some(*schedule),
+            } => vec![Some(*schedule); renderers.len()],
             Inner::Cuda {
-                renderer,
+                renderers,
                 schedule: None,
                 implicit_auto,
                 auto,
                 ..
-            } => Some(auto_schedule(
-                renderer,
-                auto,
-                &auto_key,
-                scene,
-                &options,
-                *implicit_auto && !auto::repays_calibration(total),
-                observer,
-            )?),
+            } => {
+                let mut chosen: Vec<(&str, Schedule)> = Vec::new();
+                let mut schedules = Vec::with_capacity(renderers.len());
+                for (renderer, key) in renderers.iter().zip(&auto_keys) {
+                    let schedule = match chosen.iter().find(|(k, _)| k == key) {
+                        Some((_, schedule)) => *schedule,
+                        None => {
+                            let schedule = auto_schedule(
+                                renderer,
+                                auto,
+                                key,
+                                scene,
+                                &options,
+                                *implicit_auto && !auto::repays_calibration(total),
+                                observer,
+                            )?;
+                            chosen.push((key, schedule));
+                            schedule
+                        }
+                    };
+                    schedules.push(Some(schedule));
+                }
+                schedules
+            }
         };
+
+        // Several devices: batches from one queue, added in batch order.
+        let devices: Vec<multi::Device<'_>> = match &backend.0 {
+            Inner::CpuDevices(n) => (0..*n)
+                .map(|_| -> multi::Device<'_> {
+                    Box::new(
+                        |film: &mut Film, range: Range<u32>, report: &(dyn Fn(u64, u64) + Sync)| {
+                            Ok(render_samples(scene, film, range, &options, report)?)
+                        },
+                    )
+                })
+                .collect(),
+            Inner::Cuda { renderers, .. } if renderers.len() > 1 => renderers
+                .iter()
+                .zip(&schedules)
+                .map(|(renderer, schedule)| -> multi::Device<'_> {
+                    let schedule = schedule.expect("every GPU has a schedule");
+                    let options = &options;
+                    Box::new(
+                        move |film: &mut Film,
+                              range: Range<u32>,
+                              report: &(dyn Fn(u64, u64) + Sync)| {
+                            Ok(renderer
+                                .render_samples(scene, schedule, film, range, options, report)?)
+                        },
+                    )
+                })
+                .collect(),
+            _ => Vec::new(),
+        };
+        if !devices.is_empty() {
+            let (stats, done) =
+                multi::render_shared(&devices, film, samples.clone(), observer, after_chunk)?;
+            return Ok(Rendered {
+                stats,
+                samples: samples.start..done,
+                schedule: schedules[0],
+            });
+        }
+        let schedule = schedules[0];
 
         let mut stats = RenderStats {
             elapsed: Duration::ZERO,
@@ -447,17 +643,12 @@ impl SceneVisitor for Render<'_> {
                 observer.progress(before + part, total);
             };
             let started = Instant::now();
-            let chunk_stats = match (&backend.0, schedule) {
-                (Inner::Cuda { renderer, .. }, Some(schedule)) => renderer.render_samples(
-                    scene,
-                    schedule,
-                    film,
-                    range.clone(),
-                    &options,
-                    &report,
-                )?,
-                _ => render_samples(scene, film, range.clone(), &options, &report)?,
-            };
+            let chunk_stats =
+                match (&backend.0, schedule) {
+                    (Inner::Cuda { renderers, .. }, Some(schedule)) => renderers[0]
+                        .render_samples(scene, schedule, film, range.clone(), &options, &report)?,
+                    _ => render_samples(scene, film, range.clone(), &options, &report)?,
+                };
             stats.elapsed += chunk_stats.elapsed;
             stats.counters = stats.counters.merge(chunk_stats.counters);
             done = range.end;

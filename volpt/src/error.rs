@@ -30,6 +30,12 @@ pub enum Error {
     /// Films that do not add up to one render.
     #[error("{0}")]
     Merge(String),
+    /// A film file that cannot be read or written ([`crate::films`]).
+    #[error(transparent)]
+    FilmFile(#[from] volpt_film::FilmFileError),
+    /// Film files that do not add up to one render, naming the files ([`crate::films`]).
+    #[error(transparent)]
+    Films(#[from] crate::films::MergeError),
     /// An image that cannot be written or read.
     #[error(transparent)]
     Image(#[from] volpt_film::ImageError),

@@ -22,6 +22,8 @@
 //! - [`auto`]: the `auto` strategy: calibration renders, a cache per scene and GPU.
 //! - [`checkpoint`]: long renders saved as they go and resumed bit for bit; films of disjoint sample
 //!   ranges merged.
+//! - [`films`]: films of sample ranges rendered anywhere, read from their files and merged.
+//! - [`multi`]: several GPUs in one render, pulling batches of samples from one queue.
 //! - [`fingerprint`]: what makes two renders the same render, as one hash.
 //! - [`info`]: what a scene loads to, field by field (`volpt info`, Python's `Scene.info()`).
 //! - [`error`]: every way the above fails, as one [`Error`].
@@ -33,16 +35,21 @@ pub mod auto;
 pub mod backend;
 pub mod checkpoint;
 pub mod error;
+pub mod films;
 pub mod fingerprint;
 pub mod info;
+pub mod multi;
 pub mod observer;
 pub mod scene;
 pub mod settings;
 
-pub use backend::{Backend, BackendKind, BackendOptions, GpuOptions, Rendered, StrategyChoice};
+pub use backend::{
+    Backend, BackendKind, BackendOptions, GpuOptions, Gpus, Rendered, StrategyChoice,
+};
 pub use checkpoint::{merge, render_checkpointed, Checkpointing, Part};
 pub use error::Error;
 pub use info::Info;
+pub use films::{merge_films, read_film, FilmFile, MergeError, Merged};
 pub use observer::{Observer, Quiet};
 pub use scene::{ParamValue, Scene, PARAMS};
 pub use settings::{RenderSettings, Tracking};
