@@ -25,6 +25,10 @@ pub struct Series {
 /// Width of the SVG, and of the axes part's height; the legend adds rows below.
 const WIDTH: u32 = 720;
 const AXES_HEIGHT: u32 = 480;
+/// The axes' margin, and the heights of the x axis' labels and widths of the y axis' labels.
+const MARGIN: u32 = 12;
+const X_LABEL_AREA: u32 = 40;
+const Y_LABEL_AREA: u32 = 64;
 /// Height of one legend row, and the legend's margins above and below its rows.
 const LEGEND_ROW: u32 = 20;
 const LEGEND_PAD: u32 = 8;
@@ -141,9 +145,9 @@ where
     let (axes, legend) = root.split_vertically(AXES_HEIGHT * k);
     let mut chart = ChartBuilder::on(&axes)
         .caption(title, text(15))
-        .margin(12 * k)
-        .x_label_area_size(40 * k)
-        .y_label_area_size(64 * k)
+        .margin(MARGIN * k)
+        .x_label_area_size(X_LABEL_AREA * k)
+        .y_label_area_size(Y_LABEL_AREA * k)
         .build_cartesian_2d(
             (decade(x0, LOWER)..decade(x1, UPPER)).log_scale(),
             (decade(y0, LOWER)..decade(y1, UPPER)).log_scale(),
@@ -175,7 +179,7 @@ where
 
     // The legend: a line in the curve's colour and its name, a row each, left-aligned under the
     // axes' plotting area.
-    let left = (12 + 64) as i32 * k as i32;
+    let left = ((MARGIN + Y_LABEL_AREA) * k) as i32;
     for (i, s) in series.iter().enumerate() {
         let colour = COLOURS[i % COLOURS.len()];
         let y = ((LEGEND_PAD + LEGEND_ROW * i as u32 + LEGEND_ROW / 2) * k) as i32;
@@ -271,15 +275,12 @@ mod tests {
         let (sw, sh) = size(&series(&names));
         assert_eq!((w, h), (2 * sw as usize, 2 * sh as usize));
         let c = COLOURS[0];
-        assert!(pixels.iter().any(|p| *p == [c.0, c.1, c.2]));
+        assert!(pixels.contains(&[c.0, c.1, c.2]));
         let rows = |from: u32, to: u32| &pixels[(from * 2) as usize * w..(to * 2) as usize * w];
         assert!(rows(0, 28).iter().any(is_dark), "no title text");
         let legend = rows(AXES_HEIGHT, sh);
         assert!(legend.iter().any(is_dark), "no legend text");
-        assert!(
-            legend.iter().any(|p| *p == [c.0, c.1, c.2]),
-            "no legend line"
-        );
+        assert!(legend.contains(&[c.0, c.1, c.2]), "no legend line");
     }
 
     /// A name far wider than the old legend column (40+ characters) ends inside the picture: the
