@@ -22,7 +22,8 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
 }
 
-/// Width of the SVG, and of the axes part's height; the legend adds rows below.
+/// The SVG's least width (a legend name too long for it widens the picture), and the height of
+/// its axes part; the legend adds rows below.
 const WIDTH: u32 = 720;
 const AXES_HEIGHT: u32 = 480;
 /// The axes' margin, and the heights of the x axis' labels and widths of the y axis' labels.
@@ -32,6 +33,13 @@ const Y_LABEL_AREA: u32 = 64;
 /// Height of one legend row, and the legend's margins above and below its rows.
 const LEGEND_ROW: u32 = 20;
 const LEGEND_PAD: u32 = 8;
+/// A legend entry's line length, and where its name starts, from the entry's left edge.
+const LEGEND_LINE: u32 = 24;
+const LEGEND_TEXT: u32 = 32;
+/// The size of every label and legend name, and of the axes' descriptions and the title.
+const LABEL_SIZE: u32 = 12;
+const DESC_SIZE: u32 = 13;
+const TITLE_SIZE: u32 = 15;
 /// Distinguishable on white, in the order curves are drawn.
 const COLOURS: [RGBColor; 8] = [
     RGBColor(0x1f, 0x77, 0xb4),
@@ -68,14 +76,29 @@ fn register_font() -> Result<()> {
         .map_err(|e| anyhow!(e))
 }
 
-/// The picture's size in SVG units: the axes and a legend row per series.
+/// A font of `size` pixels (at `k` times the SVG's scale) in the embedded family. `plotters` sizes
+/// a font by its line height, 1.24 em (the SVG's `font-size` is the size over 1.24).
+fn font(size: u32, k: u32) -> FontDesc<'static> {
+    (FAMILY, f64::from(size * k) * 1.24).into_font()
+}
+
+/// The picture's size in SVG units: the axes and a legend row per series, at least [`WIDTH`] wide
+/// and wide enough for the longest legend name (measured with the embedded font, which must be
+/// registered).
 fn size(series: &[Series]) -> (u32, u32) {
     let legend = if series.is_empty() {
         0
     } else {
         2 * LEGEND_PAD + LEGEND_ROW * series.len() as u32
     };
-    (WIDTH, AXES_HEIGHT + legend)
+    let label = font(LABEL_SIZE, 1);
+    let longest = series
+        .iter()
+        .map(|s| label.box_size(&s.name).map_or(0, |(w, _)| w))
+        .max()
+        .unwrap_or(0);
+    let width = WIDTH.max(MARGIN + Y_LABEL_AREA + LEGEND_TEXT + longest + MARGIN);
+    (width, AXES_HEIGHT + legend)
 }
 
 /// The decades `10^lo ..= 10^hi` that hold every value `f` picks from `points`, at least one
@@ -137,14 +160,12 @@ where
     let all: Vec<(f64, f64)> = curves.iter().flatten().copied().collect();
     let (x0, x1) = decades(&all, |p| p.0);
     let (y0, y1) = decades(&all, |p| p.1);
-    // `plotters` sizes a font by its line height, 1.24 em (the SVG's `font-size` is the size over
-    // 1.24): `text(12)` is a 12-pixel font.
-    let text = |size: u32| (FAMILY, f64::from(size * k) * 1.24).into_font();
+    let text = |size: u32| font(size, k);
 
     root.fill(&WHITE).map_err(fail)?;
     let (axes, legend) = root.split_vertically(AXES_HEIGHT * k);
     let mut chart = ChartBuilder::on(&axes)
-        .caption(title, text(15))
+        .caption(title, text(TITLE_SIZE))
         .margin(MARGIN * k)
         .x_label_area_size(X_LABEL_AREA * k)
         .y_label_area_size(Y_LABEL_AREA * k)
@@ -163,8 +184,8 @@ where
         .y_label_formatter(&|v| tick(*v))
         .x_desc(x_label)
         .y_desc(y_label)
-        .label_style(text(12))
-        .axis_desc_style(text(13))
+        .label_style(text(LABEL_SIZE))
+        .axis_desc_style(text(DESC_SIZE))
         .axis_style(BLACK.stroke_width(k))
         .bold_line_style(RGBColor(0xcc, 0xcc, 0xcc).stroke_width(k))
         .light_line_style(RGBColor(0xf0, 0xf0, 0xf0).stroke_width(k))
@@ -185,13 +206,17 @@ where
         let y = ((LEGEND_PAD + LEGEND_ROW * i as u32 + LEGEND_ROW / 2) * k) as i32;
         legend
             .draw(&PathElement::new(
-                vec![(left, y), (left + 24 * k as i32, y)],
+                vec![(left, y), (left + (LEGEND_LINE * k) as i32, y)],
                 colour.stroke_width(2 * k),
             ))
             .map_err(fail)?;
-        let style = TextStyle::from(text(12)).pos(Pos::new(HPos::Left, VPos::Center));
+        let style = TextStyle::from(text(LABEL_SIZE)).pos(Pos::new(HPos::Left, VPos::Center));
         legend
-            .draw(&Text::new(s.name.clone(), (left + 32 * k as i32, y), style))
+            .draw(&Text::new(
+                s.name.clone(),
+                (left + (LEGEND_TEXT * k) as i32, y),
+                style,
+            ))
             .map_err(fail)?;
     }
     root.present().map_err(fail)
@@ -283,23 +308,28 @@ mod tests {
         assert!(legend.contains(&[c.0, c.1, c.2]), "no legend line");
     }
 
-    /// A name far wider than the old legend column (40+ characters) ends inside the picture: the
-    /// rightmost dark pixel of the legend's rows is left of the right edge.
+    /// Legend names end inside the picture: one of 41 characters (the longest in docs/accuracy) in
+    /// the default width, and one of 200 characters in a picture widened for it. The rightmost
+    /// dark pixel of the legend's rows is left of the right edge.
     #[test]
     fn long_legend_names_fit_inside_the_png() {
-        let long = "strategy=regeneration-sk lookup=trilinear";
-        let bytes = log_log_png("t", "x", "y", &series(&[long, long, long])).unwrap();
-        let (pixels, w, _) = decode(&bytes);
-        let legend = &pixels[(AXES_HEIGHT * PNG_SCALE) as usize * w..];
-        let rightmost = legend
-            .chunks_exact(w)
-            .filter_map(|row| row.iter().rposition(is_dark))
-            .max()
-            .expect("legend text");
-        assert!(
-            rightmost < w - 20,
-            "legend text reaches column {rightmost} of {w}"
-        );
+        let typical = "strategy=regeneration-sk lookup=trilinear";
+        let huge = "estimator=pt max_depth=2 ".repeat(8);
+        for (names, widened) in [(vec![typical; 3], false), (vec![typical, &huge], true)] {
+            let bytes = log_log_png("t", "x", "y", &series(&names)).unwrap();
+            let (pixels, w, _) = decode(&bytes);
+            assert_eq!(w > (WIDTH * PNG_SCALE) as usize, widened, "width {w}");
+            let legend = &pixels[(AXES_HEIGHT * PNG_SCALE) as usize * w..];
+            let rightmost = legend
+                .chunks_exact(w)
+                .filter_map(|row| row.iter().rposition(is_dark))
+                .max()
+                .expect("legend text");
+            assert!(
+                rightmost < w - 10,
+                "legend text reaches column {rightmost} of {w}"
+            );
+        }
     }
 
     /// The SVG draws each series' colour twice (its curve and its legend line), holds each legend
