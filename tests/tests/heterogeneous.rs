@@ -4,6 +4,7 @@
 //! grid and with NEE, and on the thesis scenes grid vs global and nee vs pt give statistically
 //! equal images, with a test that would see a 1% bias.
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use volpt_core::majorant::{build_majorants, MajorantGrid};
@@ -341,7 +342,10 @@ fn mitsuba_smoke_data() -> Option<PathBuf> {
     if data.join("smoke.vol").is_file() {
         return Some(data);
     }
-    eprintln!(
+    // Straight to stderr, past the test harness's capture of `eprintln!`, so that a passing run
+    // shows the skip too.
+    let _ = writeln!(
+        std::io::stderr(),
         "skipped: smoke on Mitsuba's smoke.vol: {} is absent (put Mitsuba's hetvol smoke.vol there \
          to run it; the generated stand-in ran instead)",
         data.join("smoke.vol").display()

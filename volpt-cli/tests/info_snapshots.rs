@@ -2,6 +2,7 @@
 //! to (sizes, bounds, density range, majorant, boundary, phase, light, and the render variant).
 //! A loader change that alters any loaded value shows up here as a diff to review.
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -34,7 +35,10 @@ fn mitsuba_smoke_data() -> Option<PathBuf> {
     if data.join("smoke.vol").is_file() {
         return Some(data);
     }
-    eprintln!(
+    // Straight to stderr, past the test harness's capture of `eprintln!`, so that a passing run
+    // shows the skip too.
+    let _ = writeln!(
+        std::io::stderr(),
         "skipped: the smoke snapshot on Mitsuba's smoke.vol: {} is absent (put Mitsuba's hetvol \
          smoke.vol there to run it; the generated stand-in's snapshot ran instead)",
         data.join("smoke.vol").display()

@@ -2,6 +2,7 @@
 // Each test file uses its own part of these helpers.
 #![allow(dead_code)]
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -58,7 +59,10 @@ pub fn skipped_without_kernels(test: &str, err: &str) -> bool {
         "{test}: VOLPT_REQUIRE_PTX is set but this volpt has no GPU kernels: run `cargo xtask ptx` \
          before building: {err}"
     );
-    eprintln!(
+    // Straight to stderr, past the test harness's capture of `eprintln!`, so that a passing run
+    // shows the skip too.
+    let _ = writeln!(
+        std::io::stderr(),
         "skipped: {test} past the kernels' check: this volpt was built without GPU kernels; run \
          `cargo xtask ptx`, then the test again"
     );
