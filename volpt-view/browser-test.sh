@@ -17,10 +17,10 @@ if ! "$venv/bin/python" -c 'import playwright' 2>/dev/null; then
     python3 -m venv "$venv"
     "$venv/bin/pip" install -q playwright
 fi
-# The binary as `cargo test --release --workspace` builds it (CI's step before this one, so a
+# The binary as the README's `cargo test --release` builds it (CI's step before this one, so a
 # no-op there): a plain `cargo build -p volpt-cli` unifies other dependency features and would
 # rebuild the workspace.
-cargo test --release --workspace --no-run -q
+cargo test --release --no-run -q
 
 log=$(mktemp)
 target/release/volpt view scenes/example/cube.xml --resolution 240x240 --spp 16 --threads 2 \

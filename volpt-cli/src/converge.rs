@@ -597,7 +597,7 @@ fn write_plots(dir: &Path, title: &str, results: &[(String, Vec<Row>)]) -> Resul
     let mut written = Vec::new();
     for (name, y_label, y) in plots {
         let series = series(y);
-        let svg = log_log_svg(title, "render time (s)", y_label, &series);
+        let svg = log_log_svg(title, "render time (s)", y_label, &series)?;
         written.push(write(dir, &format!("{name}.svg"), svg.as_bytes())?);
         let png = log_log_png(title, "render time (s)", y_label, &series)?;
         written.push(write(dir, &format!("{name}.png"), &png)?);

@@ -83,7 +83,7 @@ enum Command {
 #[derive(Subcommand)]
 enum SceneCommand {
     /// Write the generated inputs of the included scenes (the grids of cgg-logo and ad, the sky map
-    /// of envmap-cube) under DIR.
+    /// of envmap-cube, smoke's stand-in grid) under DIR.
     Generate {
         /// The `scenes/` directory of a volpt checkout or bundle.
         #[arg(default_value = "scenes")]

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 mod common;
-use common::{assert_clean_error, assert_success, example, stderr, volpt};
+use common::{assert_clean_error, assert_success, example, skipped_without_kernels, stderr, volpt};
 
 use volpt_scene::vol::{write_vol, VolGrid};
 use volpt_scene::Bounds;
@@ -205,10 +205,11 @@ fn cuda_backend_without_a_gpu_is_a_clear_error() {
     }
     let err = stderr(&out);
     assert!(!err.contains("panicked"), "panicked: {err}");
+    if skipped_without_kernels("cuda_backend_without_a_gpu_is_a_clear_error", &err) {
+        return;
+    }
     assert!(
-        err.contains("no CUDA driver found")
-            || err.contains("without GPU kernels")
-            || err.contains("CUDA driver call failed"),
+        err.contains("no CUDA driver found") || err.contains("CUDA driver call failed"),
         "unclear error: {err}"
     );
 }

@@ -5,7 +5,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{assert_clean_error, example_arg, stderr, volpt};
+use common::{assert_clean_error, example_arg, skipped_without_kernels, stderr, volpt};
 
 #[test]
 fn volume_flags_on_the_cpu_are_a_clear_error() {
@@ -102,8 +102,11 @@ fn every_placement_renders_the_same_image() {
     if !out.status.success() {
         let err = stderr(&out);
         assert!(!err.contains("panicked"), "panicked: {err}");
+        if skipped_without_kernels("every_placement_renders_the_same_image", &err) {
+            return;
+        }
         assert!(
-            err.contains("no CUDA driver found") || err.contains("without GPU kernels"),
+            err.contains("no CUDA driver found"),
             "unexpected error: {err}"
         );
         return;

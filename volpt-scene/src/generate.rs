@@ -5,6 +5,10 @@
 //! print. The letters come from a 5x7 bitmap font, scaled to span most of the face.
 //!
 //! `envmap-cube` is lit by a small procedural sky ([`SKY`]), written as an OpenEXR lat-long map.
+//!
+//! `smoke` reads a procedural plume ([`SMOKE`]) of the shape, box and density statistics of Mitsuba's
+//! `smoke.vol`, which may not be redistributed: a widening column of fractal noise rising through
+//! the box. The real grid stays usable with `-D data=DIR`.
 
 use std::path::{Path, PathBuf};
 
@@ -136,7 +140,7 @@ impl PrintedBlock {
 }
 
 /// Generates the inputs of the included scenes under `scenes_dir`: the grids of `cgg-logo/` and
-/// `ad/`, and the sky map of `envmap-cube/`.
+/// `ad/`, the sky map of `envmap-cube/` and the stand-in density grid of `smoke/`.
 pub fn generate_scene_inputs(scenes_dir: &Path) -> Result<Vec<PathBuf>, SceneError> {
     let unit = Bounds {
         min: [-0.5; 3],
@@ -150,6 +154,7 @@ pub fn generate_scene_inputs(scenes_dir: &Path) -> Result<Vec<PathBuf>, SceneErr
     written.extend(CGG_LOGO.write(&scenes_dir.join("cgg-logo"), unit)?);
     written.extend(AD.write(&scenes_dir.join("ad"), slab)?);
     written.push(SKY.write(&scenes_dir.join("envmap-cube"))?);
+    written.push(SMOKE.write(&scenes_dir.join("smoke"))?);
     Ok(written)
 }
 
@@ -228,6 +233,135 @@ impl Sky {
                 f16::from_f32(rgb[i + 2]),
             )
         })?;
+        Ok(path)
+    }
+}
+
+/// A smoke plume on a vertex-centred grid: density is fractal value noise inside a column that
+/// rises along +y from a fifth of the box's height, bending in x and z and widening as it rises,
+/// squared above a threshold so that most of the plume is thin wisps with a few dense cores
+/// (clamped at 1).
+///
+/// Only `+`, `*`, `/`, `floor` and integer hashing go into a value, all exact or correctly rounded
+/// in IEEE arithmetic, so the grid is the same bit for bit on every machine.
+#[derive(Clone, Copy, Debug)]
+pub struct Plume {
+    pub resolution: [u32; 3],
+    pub bounds: Bounds,
+}
+
+/// The stand-in for Mitsuba's `smoke.vol` in `scenes/smoke`: the same 128 x 128 x 50 samples and
+/// box, density 0..1; about 13% of its samples are non-zero (the real grid: 38%), 4% exceed 0.1
+/// (3.5%) and its mean is about 0.014 (0.012).
+pub const SMOKE: Plume = Plume {
+    resolution: [128, 128, 50],
+    bounds: Bounds {
+        min: [-0.5, -0.5, -0.1953125],
+        max: [0.5, 0.5, 0.1953125],
+    },
+};
+
+/// A well-mixed 32-bit hash of a lattice point and an octave, uniform on `[0, 1]`.
+fn lattice_value(p: [i64; 3], octave: u32) -> f64 {
+    let mut h = (p[0] as u32)
+        .wrapping_mul(0x8da6_b343)
+        .wrapping_add((p[1] as u32).wrapping_mul(0xd816_3841))
+        .wrapping_add((p[2] as u32).wrapping_mul(0xcb1a_b31f))
+        .wrapping_add(octave.wrapping_mul(0x1656_67b1));
+    h ^= h >> 15;
+    h = h.wrapping_mul(0x2c1b_3c6d);
+    h ^= h >> 12;
+    h = h.wrapping_mul(0x297a_2d39);
+    h ^= h >> 15;
+    f64::from(h) / f64::from(u32::MAX)
+}
+
+/// Value noise: the lattice values around `p` blended with smoothstep weights; in `[0, 1]`.
+fn value_noise(p: [f64; 3], octave: u32) -> f64 {
+    let cell = p.map(f64::floor);
+    let t = [0, 1, 2].map(|a| {
+        let f = p[a] - cell[a];
+        f * f * (3.0 - 2.0 * f)
+    });
+    let mut sum = 0.0;
+    for corner in 0..8 {
+        let mut weight = 1.0;
+        let mut lattice = [0i64; 3];
+        for a in 0..3 {
+            let up = corner >> a & 1 == 1;
+            lattice[a] = cell[a] as i64 + i64::from(up);
+            weight *= if up { t[a] } else { 1.0 - t[a] };
+        }
+        sum += weight * lattice_value(lattice, octave);
+    }
+    sum
+}
+
+/// Four octaves of value noise, 6 cells per unit length at the first, normalised to `[0, 1]`.
+fn fractal_noise(p: [f64; 3]) -> f64 {
+    let (mut sum, mut amplitude, mut frequency) = (0.0, 0.5, 6.0);
+    for octave in 0..4 {
+        sum += amplitude * value_noise(p.map(|c| c * frequency), octave);
+        amplitude *= 0.5;
+        frequency *= 2.0;
+    }
+    sum / 0.9375
+}
+
+impl Plume {
+    /// The density at world position `p` in the unit-sized box's frame (`y` in `[-0.5, 0.5]`).
+    fn density(p: [f64; 3]) -> f64 {
+        // Height from the box's floor, 0..1; the plume starts at 0.2 and fades in over 0.08.
+        let height = p[1] + 0.5;
+        if height < 0.2 {
+            return 0.0;
+        }
+        let u = (height - 0.2) / 0.8;
+        let centre_x = 0.25 - 0.55 * u + 0.7 * u * u * (1.0 - u);
+        let centre_z = 0.16 * (1.0 - 2.0 * u) * u;
+        let radius = 0.06 + 0.22 * u;
+        let (dx, dz) = (p[0] - centre_x, p[2] - centre_z);
+        let r2 = (dx * dx + dz * dz) / (radius * radius);
+        if r2 >= 1.0 {
+            return 0.0;
+        }
+        let envelope = (1.0 - r2) * (1.0 - r2);
+        let fade = ((height - 0.2) / 0.08).min(1.0);
+        let wisp = (fractal_noise(p) - 0.42).max(0.0);
+        (12.0 * envelope * fade * wisp * wisp).min(1.0)
+    }
+
+    /// The density grid: sample `(i, j, k)` at the box's corner plus `(i, j, k) / (resolution - 1)`
+    /// of its size (vertex-centred, as Mitsuba 0.6 reads `smoke.vol`).
+    pub fn grid(&self) -> VolGrid {
+        let [w, h, d] = self.resolution;
+        let (min, max) = (self.bounds.min, self.bounds.max);
+        let at = |i: u32, n: u32, a: usize| {
+            f64::from(min[a])
+                + f64::from(max[a] - min[a]) * f64::from(i) / f64::from(n.saturating_sub(1).max(1))
+        };
+        let mut data = Vec::with_capacity((w * h * d) as usize);
+        for k in 0..d {
+            for j in 0..h {
+                for i in 0..w {
+                    let p = [at(i, w, 0), at(j, h, 1), at(k, d, 2)];
+                    data.push(Self::density(p) as f32);
+                }
+            }
+        }
+        VolGrid {
+            resolution: self.resolution,
+            channels: 1,
+            bbox: self.bounds,
+            data,
+        }
+    }
+
+    /// Writes `smoke.vol` into `dir`, returning its path.
+    pub fn write(&self, dir: &Path) -> Result<PathBuf, SceneError> {
+        create_dir(dir)?;
+        let path = dir.join("smoke.vol");
+        write_vol(&path, &self.grid())?;
         Ok(path)
     }
 }

@@ -1,11 +1,12 @@
 //! The generated inputs of the included scenes (`volpt scene generate`), read back: the printed
 //! text's letters centred and upright on the face the camera sees, the ink only in the front
 //! layers, the sky's sun where its elevation puts it over a zenith, horizon and ground of the
-//! documented colours, and every file written holding what the generator made.
+//! documented colours, the smoke plume in smoke.vol's box with its documented statistics, and every
+//! file written holding what the generator made.
 
 use std::path::Path;
 
-use volpt_scene::generate::{generate_scene_inputs, PrintedBlock, AD, CGG_LOGO, INKS, SKY};
+use volpt_scene::generate::{generate_scene_inputs, PrintedBlock, AD, CGG_LOGO, INKS, SKY, SMOKE};
 use volpt_scene::read_vol;
 
 /// The test's own copy of the 5x7 letters the blocks print (row 0 at the top).
@@ -251,7 +252,8 @@ fn generated_files_hold_what_the_generator_made() {
             "cgg-logo/albedo.vol",
             "ad/density.vol",
             "ad/albedo.vol",
-            "envmap-cube/sky.exr"
+            "envmap-cube/sky.exr",
+            "smoke/smoke.vol"
         ]
     );
     let unit = volpt_scene::Bounds {
@@ -283,4 +285,62 @@ fn generated_files_hold_what_the_generator_made() {
             k % 3
         );
     }
+    let read = read_vol(&written[5]).expect("smoke.vol reads");
+    let made = SMOKE.grid();
+    assert_eq!((read.resolution, read.channels), (made.resolution, 1));
+    assert_eq!(read.bbox, SMOKE.bounds);
+    assert!(read.data == made.data, "smoke.vol: samples differ");
+}
+
+/// The smoke stand-in has Mitsuba's `smoke.vol` shape and box and resembles its density: values in
+/// 0..1 with the maximum reached, mostly empty, a thin plume (the fractions its documentation
+/// states, within a third), nothing below a fifth of the box's height, and denser above the middle
+/// than at the bottom of the plume, as smoke rises and spreads.
+#[test]
+fn smoke_plume_has_smoke_vol_box_and_statistics() {
+    let grid = SMOKE.grid();
+    let [w, h, d] = grid.resolution;
+    assert_eq!(grid.resolution, [128, 128, 50]);
+    assert_eq!(
+        grid.bbox,
+        volpt_scene::Bounds {
+            min: [-0.5, -0.5, -0.1953125],
+            max: [0.5, 0.5, 0.1953125]
+        }
+    );
+    let n = grid.data.len();
+    assert_eq!(n, (w * h * d) as usize);
+    assert!(grid.data.iter().all(|&v| (0.0..=1.0).contains(&v)));
+    assert_eq!(grid.data.iter().fold(0.0f32, |m, &v| m.max(v)), 1.0);
+    let fraction =
+        |f: &dyn Fn(f32) -> bool| grid.data.iter().filter(|&&v| f(v)).count() as f64 / n as f64;
+    let mean = grid.data.iter().map(|&v| v as f64).sum::<f64>() / n as f64;
+    let near = |found: f64, stated: f64| (found - stated).abs() <= stated / 3.0;
+    assert!(
+        near(fraction(&|v| v > 0.0), 0.13),
+        "non-zero {}",
+        fraction(&|v| v > 0.0)
+    );
+    assert!(
+        near(fraction(&|v| v > 0.1), 0.04),
+        "above 0.1 {}",
+        fraction(&|v| v > 0.1)
+    );
+    assert!(near(mean, 0.014), "mean {mean}");
+    let layer = |y: u32| -> f64 {
+        (0..d)
+            .flat_map(|z| (0..w).map(move |x| ((z * h + y) * w + x) as usize))
+            .map(|i| grid.data[i] as f64)
+            .sum()
+    };
+    let floor = (0..h).find(|&y| layer(y) > 0.0).expect("a plume");
+    assert!(
+        floor as f64 >= 0.2 * (h - 1) as f64,
+        "smoke from row {floor}"
+    );
+    let lower: f64 = (floor..h / 2).map(layer).sum();
+    let upper: f64 = (h / 2..h).map(layer).sum();
+    assert!(upper > lower, "upper half {upper}, lower {lower}");
+    // The same grid every time (no state, no clock, no platform maths).
+    assert!(SMOKE.grid().data == grid.data);
 }

@@ -2,6 +2,7 @@
 // Each test file uses its own part of these helpers.
 #![allow(dead_code)]
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -39,4 +40,31 @@ pub fn assert_clean_error(out: &Output, needles: &[&str]) {
 
 pub fn assert_success(out: &Output) {
     assert!(out.status.success(), "stderr: {}", stderr(out));
+}
+
+/// Whether a failed `--backend cuda` run failed because this `volpt` carries no GPU kernels
+/// (`cargo xtask ptx` did not run before the build), which stops it before the driver. The error
+/// must then say how to build them; the caller skips what needs the kernels, and this says so.
+/// With `VOLPT_REQUIRE_PTX=1` (as `.ci/run` sets) a build without kernels fails instead.
+pub fn skipped_without_kernels(test: &str, err: &str) -> bool {
+    if !err.contains("was built without the GPU's") {
+        return false;
+    }
+    assert!(
+        err.contains("cargo xtask ptx"),
+        "the missing kernels' error does not say how to build them: {err}"
+    );
+    assert!(
+        std::env::var_os("VOLPT_REQUIRE_PTX").is_none(),
+        "{test}: VOLPT_REQUIRE_PTX is set but this volpt has no GPU kernels: run `cargo xtask ptx` \
+         before building: {err}"
+    );
+    // Straight to stderr, past the test harness's capture of `eprintln!`, so that a passing run
+    // shows the skip too.
+    let _ = writeln!(
+        std::io::stderr(),
+        "skipped: {test} past the kernels' check: this volpt was built without GPU kernels; run \
+         `cargo xtask ptx`, then the test again"
+    );
+    true
 }
