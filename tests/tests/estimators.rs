@@ -54,17 +54,16 @@ fn lat_long_sky() -> SceneDescription {
     scene(LOW_ALBEDO, broad_sun_sky())
 }
 
-/// Each candidate against `reference` on `desc`, `spp` samples per pixel for every render, the
-/// reference rendered once; all renders with different seeds, so independent.
+/// Each candidate (a scene and its settings) against the reference, `spp` samples per pixel for
+/// every render, the reference rendered once; all renders with different seeds, so independent.
 fn compare(
-    desc: &SceneDescription,
     spp: u32,
-    reference: PathSettings,
-    candidates: &[(&str, PathSettings)],
+    (desc, settings): (&SceneDescription, PathSettings),
+    candidates: &[(&str, &SceneDescription, PathSettings)],
 ) {
     let start = std::time::Instant::now();
-    let a = ImageMean::render(desc, spp, 1, reference);
-    for (seed, (name, settings)) in (2..).zip(candidates) {
+    let a = ImageMean::render(desc, spp, 1, settings);
+    for (seed, (name, desc, settings)) in (2..).zip(candidates) {
         let b = ImageMean::render(desc, spp, seed, *settings);
         assert_agree(name, &a, &b);
     }
@@ -192,12 +191,9 @@ fn global_majorant_matches_the_majorant_grid_on_a_generated_medium() {
         majorant_resolution: 1,
         ..nee()
     };
-    compare(
-        &lat_long_sky(),
-        SPP_GLOBAL,
-        nee(),
-        &[("global majorant, nee, lat-long sky", global)],
-    );
+    let desc = lat_long_sky();
+    let candidates = [("global majorant, nee, lat-long sky", &desc, global)];
+    compare(SPP_GLOBAL, (&desc, nee()), &candidates);
 }
 
 /// Each roulette rule from the first interaction on against no roulette, in a medium of albedo
@@ -238,23 +234,15 @@ fn every_grid_lookup_matches_dense_trilinear_on_a_generated_medium() {
         d.medium.storage = storage;
         d
     };
-    let a = ImageMean::render(&desc, SPP_LOOKUP, 1, plain());
-    for (seed, (name, lookup, storage)) in (2..).zip([
-        (
-            "any-layout reads (bricked)",
-            GridLookup::Trilinear,
-            GridStorage::Bricked,
-        ),
-        ("texture filter", GridLookup::Texture, GridStorage::Dense),
-        (
-            "half-precision texture",
-            GridLookup::TextureHalf,
-            GridStorage::Dense,
-        ),
-    ]) {
-        let b = ImageMean::render(&with(lookup, storage), SPP_LOOKUP, seed, plain());
-        assert_agree(name, &a, &b);
-    }
+    let bricked = with(GridLookup::Trilinear, GridStorage::Bricked);
+    let texture = with(GridLookup::Texture, GridStorage::Dense);
+    let half = with(GridLookup::TextureHalf, GridStorage::Dense);
+    let candidates = [
+        ("any-layout reads (bricked)", &bricked, plain()),
+        ("texture filter", &texture, plain()),
+        ("half-precision texture", &half, plain()),
+    ];
+    compare(SPP_LOOKUP, (&desc, plain()), &candidates);
 }
 
 // Samples per pixel, sized from pilot renders of 256 spp: the factor by which those fell short

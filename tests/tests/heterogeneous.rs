@@ -427,6 +427,8 @@ fn grid_and_nee_match_global_pt_on_generated_scenes() {
     );
 }
 
+/// CI has no `../shared/data` and skips this: the twins of its comparisons on generated media, which
+/// CI runs, are in `estimators.rs` (`ci_guards.rs` checks that they exist).
 #[test]
 fn grid_and_nee_match_global_pt_on_smoke_and_bucky() {
     let Some(data) = shared_data() else {
