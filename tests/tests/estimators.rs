@@ -79,18 +79,12 @@ fn compare(
 /// lat-long sky whose sun the environment sampling favours.
 #[test]
 fn next_event_estimation_matches_path_tracing_on_a_generated_medium() {
-    compare(
-        &constant_sky(),
-        SPP_CONSTANT_NEE,
-        plain(),
-        &[("nee, constant sky", nee())],
-    );
-    compare(
-        &lat_long_sky(),
-        SPP_LAT_LONG_NEE,
-        plain(),
-        &[("nee, lat-long sky", nee())],
-    );
+    let constant = constant_sky();
+    let candidates = [("nee, constant sky", &constant, nee())];
+    compare(SPP_CONSTANT_NEE, (&constant, plain()), &candidates);
+    let lat_long = lat_long_sky();
+    let candidates = [("nee, lat-long sky", &lat_long, nee())];
+    compare(SPP_LAT_LONG_NEE, (&lat_long, plain()), &candidates);
 }
 
 /// Ratio tracking's error against the transmittance by quadrature, over `rays` shadow rays from
@@ -207,18 +201,16 @@ fn each_roulette_rule_matches_no_roulette_on_a_generated_medium() {
         roulette,
         ..plain()
     };
-    compare(
-        &scene((0.5, 0.98), EnvironmentDesc::Constant([1.0, 0.9, 0.8])),
-        SPP_ROULETTE,
-        plain(),
-        &[
-            ("Mitsuba's roulette", rule(Roulette::Mitsuba)),
-            (
-                "the thesis's throughput roulette",
-                rule(Roulette::Throughput),
-            ),
-        ],
-    );
+    let desc = scene((0.5, 0.98), EnvironmentDesc::Constant([1.0, 0.9, 0.8]));
+    let candidates = [
+        ("Mitsuba's roulette", &desc, rule(Roulette::Mitsuba)),
+        (
+            "the thesis's throughput roulette",
+            &desc,
+            rule(Roulette::Throughput),
+        ),
+    ];
+    compare(SPP_ROULETTE, (&desc, plain()), &candidates);
 }
 
 /// Every grid lookup against dense trilinear reads of the same grids: the any-layout reads
