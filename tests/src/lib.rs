@@ -2,7 +2,9 @@
 //! rendering them through the same factory and CPU backend the CLI uses; [`reference`] holds the
 //! independent `f64` references they are compared with, [`compare`] the comparisons.
 
+pub mod agreement;
 pub mod compare;
+pub mod generated;
 pub mod reference;
 
 use volpt_core::path::PathState;
@@ -129,29 +131,48 @@ struct PixelStatistics {
 impl SceneVisitor for PixelStatistics {
     type Output = Vec<[(f64, f64); 3]>;
 
+    /// Rows are shared out over the available cores (pixels are independent: each has its own
+    /// random streams, so the result does not depend on the number of threads).
     fn visit<S: volpt_render::RenderScene>(self, scene: &S) -> Self::Output {
         let camera = scene.camera();
         let n = self.spp as f64;
-        let mut out = Vec::new();
-        for y in 0..camera.height {
-            for x in 0..camera.width {
-                let (mut sum, mut sum2) = ([0.0f64; 3], [0.0f64; 3]);
-                for s in 0..self.spp {
-                    let mut path = PathState::from_camera(scene, x, y, s, self.seed);
-                    volpt_core::path::trace(scene, &mut path);
-                    for (c, v) in path.radiance.to_array().into_iter().enumerate() {
-                        sum[c] += v as f64;
-                        sum2[c] += v as f64 * v as f64;
-                    }
+        let pixel = |x: u32, y: u32| {
+            let (mut sum, mut sum2) = ([0.0f64; 3], [0.0f64; 3]);
+            for s in 0..self.spp {
+                let mut path = PathState::from_camera(scene, x, y, s, self.seed);
+                volpt_core::path::trace(scene, &mut path);
+                for (c, v) in path.radiance.to_array().into_iter().enumerate() {
+                    sum[c] += v as f64;
+                    sum2[c] += v as f64 * v as f64;
                 }
-                out.push(std::array::from_fn(|c| {
-                    let mean = sum[c] / n;
-                    let var = (sum2[c] / n - mean * mean).max(0.0) * n / (n - 1.0);
-                    (mean, var / n)
-                }));
             }
-        }
-        out
+            std::array::from_fn(|c| {
+                let mean = sum[c] / n;
+                let var = (sum2[c] / n - mean * mean).max(0.0) * n / (n - 1.0);
+                (mean, var / n)
+            })
+        };
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()) as u32;
+        let rows: Vec<Vec<[(f64, f64); 3]>> = std::thread::scope(|s| {
+            let workers: Vec<_> = (0..threads)
+                .map(|t| {
+                    s.spawn(move || {
+                        (t..camera.height)
+                            .step_by(threads as usize)
+                            .map(|y| (0..camera.width).map(|x| pixel(x, y)).collect())
+                            .collect::<Vec<Vec<_>>>()
+                    })
+                })
+                .collect();
+            let done: Vec<Vec<Vec<_>>> = workers
+                .into_iter()
+                .map(|w| w.join().expect("worker"))
+                .collect();
+            (0..camera.height)
+                .map(|y| done[(y % threads) as usize][(y / threads) as usize].clone())
+                .collect()
+        });
+        rows.into_iter().flatten().collect()
     }
 }
 

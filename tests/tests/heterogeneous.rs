@@ -426,7 +426,8 @@ fn grid_and_nee_match_global_pt_on_generated_scenes() {
 }
 
 /// Smoke on the generated stand-in, and on Mitsuba's grid where it is beside the checkout; bucky on
-/// the repository's Bucky.raw.
+/// the repository's Bucky.raw. Its comparisons have twins on generated media in `estimators.rs`
+/// (`ci_guards.rs` checks that they exist).
 #[test]
 fn grid_and_nee_match_global_pt_on_smoke_and_bucky() {
     let dir = tempfile::tempdir().expect("temp dir");
