@@ -9,7 +9,8 @@
 # target/release/volpt). Installs the wheel into a fresh venv (with the system's site-packages:
 # numpy from there if it has it; else from PyPI, or offline from a folder of wheels with
 # VOLPT_PIP_ARGS="--no-index --find-links DIR", e.g. one `pip download numpy -d DIR` filled), renders scenes/example/cube.xml at 64x64,
-# 16 spp, seed 3 with `--backend cuda --strategy regeneration-sk` (exact math) from both, and
+# 16 spp, seed 3 with `--backend cuda --strategy naive-sk` (exact math: the CPU's paths, summed in
+# the CPU's order; regeneration-sk's f64 sums take the order its atomics happen in) from both, and
 # compares the EXR files byte for byte, the images and the film sums (the CLI's checkpoint)
 # bit for bit, and the CUDA render against the CPU's. Exit 0 if all are equal.
 set -euo pipefail
@@ -34,7 +35,7 @@ scene=scenes/example/cube.xml
 # VOLPT_CHECK_BACKEND=cpu runs the same comparison on the CPU (the script's own test, no GPU).
 backend="${VOLPT_CHECK_BACKEND:-cuda}"
 gpu=()
-[[ "$backend" == cuda ]] && gpu=(--strategy regeneration-sk)
+[[ "$backend" == cuda ]] && gpu=(--strategy naive-sk)
 args=(--resolution 64x64 --spp 16 --seed 3 --backend "$backend" "${gpu[@]}")
 time "$volpt_bin" render "$scene" "${args[@]}" -o "$work/cli.exr" --checkpoint "$work/cli.ck"
 
@@ -45,7 +46,7 @@ import numpy as np
 import volpt
 
 scene_file, work, backend = sys.argv[1], Path(sys.argv[2]), sys.argv[3]
-gpu = {"strategy": "regeneration-sk"} if backend == "cuda" else {}
+gpu = {"strategy": "naive-sk"} if backend == "cuda" else {}
 scene = volpt.load(scene_file, {"resolution": (64, 64)})
 start = time.monotonic()
 film = scene.render(spp=16, seed=3, backend=backend, **gpu)
