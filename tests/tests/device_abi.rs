@@ -152,7 +152,7 @@ impl Uploader for HostUploader {
                 texture: 0,
             };
         }
-        let bricked = volpt_zerocopy::layout::bricked(values, res, channels).expect("memory");
+        let bricked = volpt_gpu_mem::layout::bricked(values, res, channels).expect("memory");
         let placed = PlacedGrid {
             address: bricked.as_ptr() as u64,
             len: bricked.len() as u64,

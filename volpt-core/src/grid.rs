@@ -529,7 +529,7 @@ mod tests {
     use super::*;
 
     /// The bricked form of dense samples, written with the layout's own index: what a host
-    /// uploader does (volpt-zerocopy), here only to test the lookup.
+    /// uploader does (volpt-gpu-mem), here only to test the lookup.
     fn brick<const C: usize>(dense: &[f32], res: [u32; 3]) -> Vec<f32> {
         let len = GridLayout::Bricked.values(res, C as u32).unwrap() as usize;
         let mut out = vec![0.0; len];

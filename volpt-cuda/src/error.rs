@@ -34,7 +34,7 @@ pub enum CudaError {
     #[error(transparent)]
     Empty(#[from] volpt_film::NothingToRender),
     #[error(transparent)]
-    Volume(#[from] volpt_zerocopy::ZeroCopyError),
+    Volume(#[from] volpt_gpu_mem::GpuMemError),
     #[error("CUDA driver call failed while {doing}: {source}")]
     Driver {
         doing: &'static str,

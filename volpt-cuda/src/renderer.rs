@@ -23,7 +23,7 @@ use volpt_device::launch::{
 };
 use volpt_device::{LaunchParams, Math, Strategy};
 use volpt_film::{Film, Image, RenderOptions, RenderStats};
-use volpt_zerocopy::{VolumePlacer, VolumePolicy};
+use volpt_gpu_mem::{VolumePlacer, VolumePolicy};
 
 use crate::entry::{entry_name, single_kernel_ptx};
 use crate::error::{CudaError, Doing};

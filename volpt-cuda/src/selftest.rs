@@ -12,7 +12,7 @@ use cudarc::driver::{CudaSlice, LaunchConfig, PushKernelArg};
 use volpt_core::abi::GridParams;
 use volpt_core::{Aabb, Grid, GridMapping, GridPlacement, TexelFormat, Vec3};
 use volpt_device::launch::BLOCK_SIZE;
-use volpt_zerocopy::{VolumePlacer, VolumePolicy};
+use volpt_gpu_mem::{VolumePlacer, VolumePolicy};
 
 use crate::error::{CudaError, Doing};
 use crate::CudaRenderer;

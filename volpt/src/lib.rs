@@ -59,7 +59,7 @@ pub use volpt_cuda::{Math, Strategy};
 pub use volpt_film::{Film, Image, RenderStats};
 pub use volpt_render::{Effects, Variant};
 pub use volpt_scene::{GridLookup, SceneDescription};
-pub use volpt_zerocopy::VolumeMemory;
+pub use volpt_gpu_mem::VolumeMemory;
 
 pub use volpt_core as core;
 pub use volpt_cuda as cuda;

@@ -14,7 +14,7 @@ use cudarc::driver::{CudaContext, DriverError};
 use half::f16;
 use volpt_core::TexelFormat;
 
-use crate::error::ZeroCopyError;
+use crate::error::GpuMemError;
 
 /// A texture object and the array it reads; dropping it destroys both.
 pub struct GridTexture {
@@ -54,14 +54,14 @@ impl GridTexture {
         res: [u32; 3],
         channels: u32,
         texel: TexelFormat,
-    ) -> Result<Self, ZeroCopyError> {
+    ) -> Result<Self, GpuMemError> {
         let bytes = texture_bytes(res, channels, texel);
         let driver = |doing: &'static str| {
             move |source: DriverError| {
-                if ZeroCopyError::is_out_of_memory(&source) {
-                    ZeroCopyError::TextureOutOfMemory { bytes, source }
+                if GpuMemError::is_out_of_memory(&source) {
+                    GpuMemError::TextureOutOfMemory { bytes, source }
                 } else {
-                    ZeroCopyError::Driver {
+                    GpuMemError::Driver {
                         doing,
                         bytes,
                         source,

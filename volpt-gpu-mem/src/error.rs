@@ -4,7 +4,7 @@ use thiserror::Error;
 /// What can go wrong placing a volume; every out-of-memory case says how much was asked for and
 /// what to try instead.
 #[derive(Debug, Error)]
-pub enum ZeroCopyError {
+pub enum GpuMemError {
     #[error(
         "the GPU has no room for a volume of {} (--volume-memory device): use \
          --volume-memory auto, zerocopy or managed to read it from host memory",
@@ -76,8 +76,6 @@ pub enum ZeroCopyError {
          memory: drop one of them"
     )]
     TextureInHostMemory { memory: crate::policy::VolumeMemory },
-    #[error(transparent)]
-    Load(#[from] volpt_scene::SceneError),
     #[error("CUDA driver call failed while {doing} ({} volume): {source}", crate::policy::human_bytes(*.bytes))]
     Driver {
         doing: &'static str,
@@ -87,7 +85,7 @@ pub enum ZeroCopyError {
     },
 }
 
-impl ZeroCopyError {
+impl GpuMemError {
     /// Whether the driver said it ran out of memory (device or host).
     pub(crate) fn is_out_of_memory(source: &DriverError) -> bool {
         source.0 == cudarc::driver::sys::CUresult::CUDA_ERROR_OUT_OF_MEMORY

@@ -9,7 +9,7 @@ use rayon::prelude::*;
 use volpt_core::abi::{PlacedGrid, Uploader};
 use volpt_core::{GridLayout, GridPlacement, TexelFormat};
 
-use crate::error::ZeroCopyError;
+use crate::error::GpuMemError;
 use crate::layout::{brick_into, bricked, values_in};
 use crate::memory::{HostRegistration, ManagedBuffer, PinnedBuffer};
 use crate::policy::{decide, human_bytes, Placement, VolumeMemory, VolumePolicy};
@@ -83,7 +83,7 @@ pub struct VolumePlacer {
     used: u64,
     held: Vec<Held>,
     placed: Vec<Placed>,
-    error: Option<ZeroCopyError>,
+    error: Option<GpuMemError>,
 }
 
 impl VolumePlacer {
@@ -95,9 +95,9 @@ impl VolumePlacer {
     pub unsafe fn new(
         stream: Arc<CudaStream>,
         policy: VolumePolicy,
-    ) -> Result<Self, ZeroCopyError> {
+    ) -> Result<Self, GpuMemError> {
         let ctx = stream.context().clone();
-        let (free, total) = ctx.mem_get_info().map_err(|source| ZeroCopyError::Driver {
+        let (free, total) = ctx.mem_get_info().map_err(|source| GpuMemError::Driver {
             doing: "asking how much device memory is free",
             bytes: 0,
             source,
@@ -123,7 +123,7 @@ impl VolumePlacer {
 
     /// The first error of any placement; the parameters built with this placer are only valid
     /// if this is `Ok`.
-    pub fn check(&mut self) -> Result<(), ZeroCopyError> {
+    pub fn check(&mut self) -> Result<(), GpuMemError> {
         self.error.take().map_or(Ok(()), Err)
     }
 
@@ -138,7 +138,7 @@ impl VolumePlacer {
         res: [u32; 3],
         channels: u32,
         any_layout: bool,
-    ) -> Result<PlacedGrid, ZeroCopyError> {
+    ) -> Result<PlacedGrid, GpuMemError> {
         let layout = match self.policy.layout {
             // The scene's kernels read this grid dense only (the factory selects the any-layout
             // medium when the description asks for bricks).
@@ -166,7 +166,7 @@ impl VolumePlacer {
         };
         let (address, memory) = match decide(&self.policy, bytes, self.used, self.free_device) {
             Placement::OverBudget { left, budget } => {
-                return Err(ZeroCopyError::OverBudget {
+                return Err(GpuMemError::OverBudget {
                     bytes,
                     left,
                     budget,
@@ -177,7 +177,7 @@ impl VolumePlacer {
                     self.used += bytes;
                     (address, PlacedIn::Device)
                 }
-                Err(ZeroCopyError::OutOfDeviceMemory { .. })
+                Err(GpuMemError::OutOfDeviceMemory { .. })
                     if self.policy.memory == VolumeMemory::Auto =>
                 {
                     tracing::warn!(
@@ -221,10 +221,10 @@ impl VolumePlacer {
         res: [u32; 3],
         channels: u32,
         texel: TexelFormat,
-    ) -> Result<PlacedGrid, ZeroCopyError> {
+    ) -> Result<PlacedGrid, GpuMemError> {
         let bytes = texture_bytes(res, channels, texel);
         if let memory @ (VolumeMemory::ZeroCopy | VolumeMemory::Managed) = self.policy.memory {
-            return Err(ZeroCopyError::TextureInHostMemory { memory });
+            return Err(GpuMemError::TextureInHostMemory { memory });
         }
         let device = VolumePolicy {
             memory: VolumeMemory::Device,
@@ -233,7 +233,7 @@ impl VolumePlacer {
         if let Placement::OverBudget { left, budget } =
             decide(&device, bytes, self.used, self.free_device)
         {
-            return Err(ZeroCopyError::TextureOverBudget {
+            return Err(GpuMemError::TextureOverBudget {
                 bytes,
                 left,
                 budget,
@@ -256,13 +256,13 @@ impl VolumePlacer {
         })
     }
 
-    fn copy_to_device(&mut self, grid: &Grid<'_>) -> Result<u64, ZeroCopyError> {
+    fn copy_to_device(&mut self, grid: &Grid<'_>) -> Result<u64, GpuMemError> {
         let bytes = grid.len as u64 * 4;
         let copied = match grid.layout {
             GridLayout::Dense => self.stream.clone_htod(grid.values),
             GridLayout::Bricked => {
                 let host = bricked(grid.values, grid.res, grid.channels)
-                    .ok_or(ZeroCopyError::OutOfHostMemory { bytes })?;
+                    .ok_or(GpuMemError::OutOfHostMemory { bytes })?;
                 self.stream.clone_htod(&host)
             }
         };
@@ -272,7 +272,7 @@ impl VolumePlacer {
         Ok(address)
     }
 
-    fn zero_copy(&mut self, grid: &Grid<'_>) -> Result<(u64, PlacedIn), ZeroCopyError> {
+    fn zero_copy(&mut self, grid: &Grid<'_>) -> Result<(u64, PlacedIn), GpuMemError> {
         if grid.layout == GridLayout::Dense {
             match HostRegistration::new(&self.ctx, grid.values) {
                 Ok(registration) => {
@@ -284,7 +284,7 @@ impl VolumePlacer {
                 }
                 // A small grid sharing a page with one registered before: copy it instead.
                 Err(e) if HostRegistration::already_registered(&e) => {}
-                Err(e @ ZeroCopyError::OutOfPinnedMemory { .. }) => return Err(e),
+                Err(e @ GpuMemError::OutOfPinnedMemory { .. }) => return Err(e),
                 // Registration is not supported everywhere (some virtualised or older systems):
                 // pinned memory of our own still maps the grid, at the cost of a copy.
                 Err(e) => tracing::warn!(%e, "cannot page-lock the volume in place: copying it"),
@@ -297,7 +297,7 @@ impl VolumePlacer {
         Ok((address, PlacedIn::ZeroCopy))
     }
 
-    fn managed(&mut self, grid: &Grid<'_>, device_bytes: u64) -> Result<u64, ZeroCopyError> {
+    fn managed(&mut self, grid: &Grid<'_>, device_bytes: u64) -> Result<u64, GpuMemError> {
         let mut buffer = ManagedBuffer::zeroed(&self.ctx, grid.len)?;
         grid.write_into(buffer.as_mut_slice());
         buffer.place(device_bytes, &self.stream)?;
@@ -331,11 +331,11 @@ impl Grid<'_> {
     }
 }
 
-fn device_error(bytes: u64, source: DriverError) -> ZeroCopyError {
-    if ZeroCopyError::is_out_of_memory(&source) {
-        ZeroCopyError::OutOfDeviceMemory { bytes, source }
+fn device_error(bytes: u64, source: DriverError) -> GpuMemError {
+    if GpuMemError::is_out_of_memory(&source) {
+        GpuMemError::OutOfDeviceMemory { bytes, source }
     } else {
-        ZeroCopyError::Driver {
+        GpuMemError::Driver {
             doing: "copying a volume to the GPU",
             bytes,
             source,

@@ -11,7 +11,7 @@ use std::sync::Arc;
 
 use cudarc::driver::{sys, CudaContext, CudaStream, DriverError};
 
-use crate::error::ZeroCopyError;
+use crate::error::GpuMemError;
 
 /// `CU_DEVICE_CPU` of `cuda.h` (not in cudarc's bindings): the host, as a `cuMemAdvise` target.
 const CU_DEVICE_CPU: sys::CUdevice = -1;
@@ -38,10 +38,10 @@ unsafe impl Sync for PinnedBuffer {}
 
 impl PinnedBuffer {
     /// `len` zeroed `f32`s of page-locked, device-mapped host memory in `ctx`.
-    pub fn zeroed(ctx: &Arc<CudaContext>, len: usize) -> Result<Self, ZeroCopyError> {
+    pub fn zeroed(ctx: &Arc<CudaContext>, len: usize) -> Result<Self, GpuMemError> {
         let bytes = bytes_of(len);
         let driver = |doing| {
-            move |source| ZeroCopyError::Driver {
+            move |source| GpuMemError::Driver {
                 doing,
                 bytes,
                 source,
@@ -56,9 +56,9 @@ impl PinnedBuffer {
         // SAFETY: `host` is a valid out-pointer; the driver writes it only on success.
         unsafe { sys::cuMemHostAlloc(&mut host, size, flags) }
             .result()
-            .map_err(|source| ZeroCopyError::OutOfPinnedMemory { bytes, source })?;
+            .map_err(|source| GpuMemError::OutOfPinnedMemory { bytes, source })?;
         let Some(host) = NonNull::new(host.cast::<f32>()) else {
-            return Err(ZeroCopyError::Driver {
+            return Err(GpuMemError::Driver {
                 doing: "allocating pinned host memory (the driver returned null)",
                 bytes,
                 source: DriverError(sys::CUresult::CUDA_ERROR_UNKNOWN),
@@ -79,20 +79,6 @@ impl PinnedBuffer {
         buffer.device = device;
         // SAFETY: `size` bytes at `host` are ours; zero is a valid `f32`.
         unsafe { std::ptr::write_bytes(host.as_ptr().cast::<u8>(), 0, size) };
-        Ok(buffer)
-    }
-
-    /// A raw grid file streamed straight into new pinned memory (`volpt_scene::read_raw_into`):
-    /// the file's values are never held anywhere else. Kernels read them at
-    /// [`PinnedBuffer::device_address`]; the CPU through [`PinnedBuffer::as_slice`].
-    pub fn read_raw(
-        ctx: &Arc<CudaContext>,
-        path: &std::path::Path,
-        layout: &volpt_scene::RawLayout,
-    ) -> Result<Self, ZeroCopyError> {
-        let (count, _) = layout.checked_size(path)?;
-        let mut buffer = Self::zeroed(ctx, count)?;
-        volpt_scene::read_raw_into(path, layout, buffer.as_mut_slice())?;
         Ok(buffer)
     }
 
@@ -175,17 +161,17 @@ impl<'a> HostRegistration<'a> {
     /// Page-locks and maps `values` (the pages that hold them, [`register_range`]). Fails
     /// with `CUDA_ERROR_HOST_MEMORY_ALREADY_REGISTERED` when a page is registered already (small
     /// allocations can share one), which [`HostRegistration::already_registered`] recognises.
-    pub fn new(ctx: &Arc<CudaContext>, values: &'a [f32]) -> Result<Self, ZeroCopyError> {
+    pub fn new(ctx: &Arc<CudaContext>, values: &'a [f32]) -> Result<Self, GpuMemError> {
         let bytes = bytes_of(values.len());
         let driver = |doing| {
-            move |source| ZeroCopyError::Driver {
+            move |source| GpuMemError::Driver {
                 doing,
                 bytes,
                 source,
             }
         };
         if values.is_empty() {
-            return Err(ZeroCopyError::Driver {
+            return Err(GpuMemError::Driver {
                 doing: "page-locking an empty volume",
                 bytes,
                 source: DriverError(sys::CUresult::CUDA_ERROR_INVALID_VALUE),
@@ -207,7 +193,7 @@ impl<'a> HostRegistration<'a> {
             .result()
             .map_err(|source| match source.0 {
                 sys::CUresult::CUDA_ERROR_OUT_OF_MEMORY => {
-                    ZeroCopyError::OutOfPinnedMemory { bytes, source }
+                    GpuMemError::OutOfPinnedMemory { bytes, source }
                 }
                 _ => driver("page-locking a volume in host memory")(source),
             })?;
@@ -228,10 +214,10 @@ impl<'a> HostRegistration<'a> {
     }
 
     /// Whether `error` (from [`HostRegistration::new`]) says the memory was registered already.
-    pub fn already_registered(error: &ZeroCopyError) -> bool {
+    pub fn already_registered(error: &GpuMemError) -> bool {
         matches!(
             error,
-            ZeroCopyError::Driver { source, .. }
+            GpuMemError::Driver { source, .. }
                 if source.0 == sys::CUresult::CUDA_ERROR_HOST_MEMORY_ALREADY_REGISTERED
         )
     }
@@ -286,10 +272,10 @@ unsafe impl Sync for ManagedBuffer {}
 
 impl ManagedBuffer {
     /// `len` zeroed `f32`s of managed memory, attached globally (any stream may read it).
-    pub fn zeroed(ctx: &Arc<CudaContext>, len: usize) -> Result<Self, ZeroCopyError> {
+    pub fn zeroed(ctx: &Arc<CudaContext>, len: usize) -> Result<Self, GpuMemError> {
         let bytes = bytes_of(len);
         ctx.bind_to_thread()
-            .map_err(|source| ZeroCopyError::Driver {
+            .map_err(|source| GpuMemError::Driver {
                 doing: "making the GPU's context current",
                 bytes,
                 source,
@@ -305,7 +291,7 @@ impl ManagedBuffer {
             )
         }
         .result()
-        .map_err(|source| ZeroCopyError::OutOfManagedMemory { bytes, source })?;
+        .map_err(|source| GpuMemError::OutOfManagedMemory { bytes, source })?;
         let buffer = Self {
             address,
             len,
@@ -331,12 +317,12 @@ impl ManagedBuffer {
     /// [`crate::policy::MANAGED_GRANULE`], at most the buffer) preferred on the buffer's device and
     /// prefetched there on `stream`, the rest preferred in host memory and mapped for the device,
     /// so that the device reads it remotely instead of migrating (and evicting) pages.
-    pub fn place(&self, device_bytes: u64, stream: &CudaStream) -> Result<(), ZeroCopyError> {
+    pub fn place(&self, device_bytes: u64, stream: &CudaStream) -> Result<(), GpuMemError> {
         let device = self.ctx.cu_device();
         let total = bytes_of(self.len);
         let device_bytes = device_bytes.min(total);
         let driver = |doing| {
-            move |source| ZeroCopyError::Driver {
+            move |source| GpuMemError::Driver {
                 doing,
                 bytes: total,
                 source,
