@@ -274,12 +274,11 @@ impl ManagedBuffer {
     /// `len` zeroed `f32`s of managed memory, attached globally (any stream may read it).
     pub fn zeroed(ctx: &Arc<CudaContext>, len: usize) -> Result<Self, GpuMemError> {
         let bytes = bytes_of(len);
-        ctx.bind_to_thread()
-            .map_err(|source| GpuMemError::Driver {
-                doing: "making the GPU's context current",
-                bytes,
-                source,
-            })?;
+        ctx.bind_to_thread().map_err(|source| GpuMemError::Driver {
+            doing: "making the GPU's context current",
+            bytes,
+            source,
+        })?;
         let size = len.max(1) * std::mem::size_of::<f32>();
         let mut address: sys::CUdeviceptr = 0;
         // SAFETY: `address` is a valid out-pointer.

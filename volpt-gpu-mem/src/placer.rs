@@ -92,10 +92,7 @@ impl VolumePlacer {
     /// # Safety
     /// Every slice given to [`Uploader::grid`] must stay live and unmoved until the placer is
     /// dropped: zero-copy grids are the caller's own memory, page-locked in place.
-    pub unsafe fn new(
-        stream: Arc<CudaStream>,
-        policy: VolumePolicy,
-    ) -> Result<Self, GpuMemError> {
+    pub unsafe fn new(stream: Arc<CudaStream>, policy: VolumePolicy) -> Result<Self, GpuMemError> {
         let ctx = stream.context().clone();
         let (free, total) = ctx.mem_get_info().map_err(|source| GpuMemError::Driver {
             doing: "asking how much device memory is free",

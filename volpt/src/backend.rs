@@ -11,9 +11,9 @@ use std::time::{Duration, Instant};
 use volpt_core::GridLayout;
 use volpt_cuda::{CudaRenderer, Math, Schedule, Strategy};
 use volpt_film::{Film, RenderOptions, RenderStats};
+use volpt_gpu_mem::{VolumeMemory, VolumePolicy};
 use volpt_render::{render_samples, with_scene_as, RenderScene, SceneVisitor};
 use volpt_scene::GridStorage;
-use volpt_gpu_mem::{VolumeMemory, VolumePolicy};
 
 use crate::auto::{self, AutoCache};
 use crate::{multi, Error, Observer, Scene};

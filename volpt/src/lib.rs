@@ -48,8 +48,8 @@ pub use backend::{
 };
 pub use checkpoint::{merge, render_checkpointed, Checkpointing, Part};
 pub use error::Error;
-pub use info::Info;
 pub use films::{merge_films, read_film, FilmFile, MergeError, Merged};
+pub use info::Info;
 pub use observer::{Observer, Quiet};
 pub use scene::{ParamValue, Scene, PARAMS};
 pub use settings::{RenderSettings, Tracking};
@@ -57,9 +57,9 @@ pub use settings::{RenderSettings, Tracking};
 pub use volpt_core::{Estimator, PathSettings, Roulette};
 pub use volpt_cuda::{Math, Strategy};
 pub use volpt_film::{Film, Image, RenderStats};
+pub use volpt_gpu_mem::VolumeMemory;
 pub use volpt_render::{Effects, Variant};
 pub use volpt_scene::{GridLookup, SceneDescription};
-pub use volpt_gpu_mem::VolumeMemory;
 
 pub use volpt_core as core;
 pub use volpt_cuda as cuda;
