@@ -141,6 +141,11 @@ fn ptx_build(package: &str, flavour: Flavour, only: Only) -> Result<PathBuf> {
         Only::All => (target_dir, ""),
         Only::Selftests => (target_dir.join("selftests"), " --cfg volpt_selftests_only"),
     };
+    // Created here, not by cargo: the two flavours' builds run at once, and the fast one's
+    // directory lies inside the exact one's, which cargo would create at the same moment (in a
+    // fresh clone the fast build then failed to find its parent).
+    std::fs::create_dir_all(&target_dir)
+        .with_context(|| format!("creating {}", target_dir.display()))?;
     run(Command::new(env!("CARGO"))
         .current_dir(&root)
         .env("RUSTC_BOOTSTRAP", "1")
