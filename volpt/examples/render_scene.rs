@@ -1,13 +1,13 @@
 //! Renders a scene through the library, as `volpt render SCENE -o OUT.exr` does on the CPU.
 //!
-//!     cargo run --release -p volpt --example render -- scenes/example/cube.xml cube.exr
+//!     cargo run --release -p volpt --example render_scene -- scenes/example/cube.xml cube.exr
 
 use volpt::{Backend, BackendOptions, RenderSettings, Scene};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let (Some(scene_file), Some(output)) = (args.next(), args.next()) else {
-        return Err("usage: render SCENE OUTPUT.exr".into());
+        return Err("usage: render_scene SCENE OUTPUT.exr".into());
     };
     let settings = RenderSettings {
         spp: Some(16),
