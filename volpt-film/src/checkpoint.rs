@@ -74,6 +74,32 @@ impl Fnv {
     }
 }
 
+/// Appends `sums` (little-endian `f64`) and an FNV-1a checksum of everything before it to
+/// `header`, and writes the whole to `path` atomically: to a temporary file beside it, then
+/// renamed, so that an interruption while writing leaves the previous file intact. The tail of
+/// checkpoints and film files alike.
+pub(crate) fn write_sums_atomically(
+    mut bytes: Vec<u8>,
+    sums: &[[f64; 3]],
+    path: &Path,
+) -> std::io::Result<()> {
+    for sum in sums {
+        for c in sum {
+            bytes.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    let mut fnv = Fnv::default();
+    fnv.write(&bytes);
+    bytes.extend_from_slice(&fnv.finish().to_le_bytes());
+    let mut name = path.file_name().unwrap_or_default().to_owned();
+    name.push(".partial");
+    let partial = path.with_file_name(name);
+    let mut file = std::fs::File::create(&partial)?;
+    file.write_all(&bytes)?;
+    file.sync_all()?;
+    std::fs::rename(&partial, path)
+}
+
 impl Checkpoint {
     /// Writes the checkpoint to `path` atomically: to a temporary file beside it, then renamed, so
     /// that an interruption while writing leaves the previous checkpoint intact.
@@ -100,21 +126,7 @@ impl Checkpoint {
         for v in [film.width, film.height, seed, samples] {
             bytes.extend_from_slice(&v.to_le_bytes());
         }
-        for sum in &film.sums {
-            for c in sum {
-                bytes.extend_from_slice(&c.to_le_bytes());
-            }
-        }
-        let mut fnv = Fnv::default();
-        fnv.write(&bytes);
-        bytes.extend_from_slice(&fnv.finish().to_le_bytes());
-        let mut name = path.file_name().unwrap_or_default().to_owned();
-        name.push(".partial");
-        let partial = path.with_file_name(name);
-        let mut file = std::fs::File::create(&partial).map_err(io)?;
-        file.write_all(&bytes).map_err(io)?;
-        file.sync_all().map_err(io)?;
-        std::fs::rename(&partial, path).map_err(io)
+        write_sums_atomically(bytes, &film.sums, path).map_err(io)
     }
 
     /// Reads the checkpoint at `path` and checks that it belongs to a render of `fingerprint` and

@@ -21,13 +21,13 @@
 //! memory limit); then the checksum; then the ranges. Checkpoints (`VOLPTCK1`, samples `0..n`) read
 //! as films of the one range `0..n`.
 
-use std::io::{Read, Write};
+use std::io::Read;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
-use crate::checkpoint::Fnv;
+use crate::checkpoint::{write_sums_atomically, Fnv};
 use crate::{Accumulation, Film};
 
 /// The film file's magic; the last byte is the format's version.
@@ -196,21 +196,7 @@ impl FilmFile {
             bytes.extend_from_slice(&r.start.to_le_bytes());
             bytes.extend_from_slice(&r.end.to_le_bytes());
         }
-        for sum in &self.film.sums {
-            for c in sum {
-                bytes.extend_from_slice(&c.to_le_bytes());
-            }
-        }
-        let mut fnv = Fnv::default();
-        fnv.write(&bytes);
-        bytes.extend_from_slice(&fnv.finish().to_le_bytes());
-        let mut name = path.file_name().unwrap_or_default().to_owned();
-        name.push(".partial");
-        let partial = path.with_file_name(name);
-        let mut file = std::fs::File::create(&partial).map_err(io)?;
-        file.write_all(&bytes).map_err(io)?;
-        file.sync_all().map_err(io)?;
-        std::fs::rename(&partial, path).map_err(io)
+        write_sums_atomically(bytes, &self.film.sums, path).map_err(io)
     }
 
     /// Reads the film file (or checkpoint) at `path`, refusing one whose sums would take more than
