@@ -6,14 +6,17 @@
 // Lists of sample ranges, some of one range.
 #![allow(clippy::single_range_in_vec_init)]
 
+mod common;
+
+use common::CancelAfter;
+
 use std::ops::Range;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::Duration;
 
 use volpt::{
-    merge_films, read_film, Backend, Checkpointing, Error, Film, FilmFile, MergeError, Observer,
-    Quiet, RenderSettings, Scene,
+    merge_films, read_film, Backend, Checkpointing, Error, Film, FilmFile, MergeError, Quiet,
+    RenderSettings, Scene,
 };
 
 fn example() -> PathBuf {
@@ -263,31 +266,13 @@ fn several_devices_equal_one_and_repeat_bit_for_bit() {
     assert_close(&film, &whole);
 }
 
-/// Cancels at the `after`-th look, asking for a look after every sample.
-struct CancelAfter {
-    looks: AtomicU32,
-    after: u32,
-}
-
-impl Observer for CancelAfter {
-    fn cancelled(&self) -> bool {
-        self.looks.fetch_add(1, Ordering::SeqCst) + 1 >= self.after
-    }
-    fn check_every(&self) -> Option<Duration> {
-        Some(Duration::ZERO)
-    }
-}
-
 #[test]
 fn several_devices_cancelled_hold_a_prefix_of_samples_and_resume_to_the_whole_render() {
     let scene = scene(12);
     let whole = render(&Backend::cpu(), &scene, 0..12);
     let backend = Backend::cpu_as_devices(2);
     let mut film = scene.film();
-    let stop = CancelAfter {
-        looks: AtomicU32::new(0),
-        after: 3,
-    };
+    let stop = CancelAfter::new(3);
     let first = backend.render(&scene, &mut film, 0..12, &stop).unwrap();
     assert!(first.cancelled(&(0..12)), "{:?}", first.samples);
     assert_eq!(first.samples.start, 0);
@@ -312,10 +297,7 @@ fn several_devices_write_checkpoints_that_resume_on_one_device() {
         resume: None,
         interval: Duration::from_millis(1),
     };
-    let stop = CancelAfter {
-        looks: AtomicU32::new(0),
-        after: 2,
-    };
+    let stop = CancelAfter::new(2);
     let (_, rendered) =
         volpt::render_checkpointed(&Backend::cpu_as_devices(2), &scene, &checkpointing, &stop)
             .unwrap();

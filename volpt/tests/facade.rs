@@ -2,13 +2,13 @@
 //! and merged equal one whole render; parameters equal a reload of the changed scene file; the
 //! fingerprint sees every part of a render and nothing else.
 
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU32, Ordering};
-use std::time::Duration;
+mod common;
 
-use volpt::{
-    merge, Backend, Error, Film, Observer, ParamValue, Part, Quiet, RenderSettings, Scene,
-};
+use common::CancelAfter;
+
+use std::path::{Path, PathBuf};
+
+use volpt::{merge, Backend, Error, Film, ParamValue, Part, Quiet, RenderSettings, Scene};
 
 fn example() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/example/cube.xml")
@@ -31,30 +31,12 @@ fn render(scene: &Scene, samples: std::ops::Range<u32>) -> Film {
     film
 }
 
-/// Cancels after `after` looks, checking after every sample.
-struct CancelAfter {
-    looks: AtomicU32,
-    after: u32,
-}
-
-impl Observer for CancelAfter {
-    fn cancelled(&self) -> bool {
-        self.looks.fetch_add(1, Ordering::SeqCst) + 1 >= self.after
-    }
-    fn check_every(&self) -> Option<Duration> {
-        Some(Duration::ZERO)
-    }
-}
-
 #[test]
 fn a_cancelled_render_resumed_is_the_whole_render_bit_for_bit() {
     let scene = Scene::load(example(), &small()).unwrap();
     let whole = render(&scene, 0..6);
     let mut film = scene.film();
-    let stop = CancelAfter {
-        looks: AtomicU32::new(0),
-        after: 2,
-    };
+    let stop = CancelAfter::new(2);
     let backend = Backend::cpu();
     let first = backend.render(&scene, &mut film, 0..6, &stop).unwrap();
     assert!(first.cancelled(&(0..6)), "{:?}", first.samples);
