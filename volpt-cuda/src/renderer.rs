@@ -23,7 +23,7 @@ use volpt_device::launch::{
 };
 use volpt_device::{LaunchParams, Math, Strategy};
 use volpt_film::{Film, Image, RenderOptions, RenderStats};
-use volpt_gpu_mem::{VolumePlacer, VolumePolicy};
+use volpt_gpu_mem::{ResidentGrids, VolumePlacer, VolumePolicy};
 
 use crate::entry::{entry_name, single_kernel_ptx};
 use crate::error::{CudaError, Doing};
@@ -106,6 +106,8 @@ pub struct CudaRenderer {
     device_name: String,
     multiprocessors: u32,
     volumes: VolumePolicy,
+    /// The grids of the scene rendered last by [`CudaRenderer::render_samples_keeping`].
+    resident: Arc<ResidentGrids>,
 }
 
 impl CudaRenderer {
@@ -155,6 +157,7 @@ impl CudaRenderer {
             device_name,
             multiprocessors,
             volumes: VolumePolicy::default(),
+            resident: Arc::default(),
         })
     }
 
@@ -194,6 +197,8 @@ impl CudaRenderer {
     /// Where renders place their grids from now on (`--volume-memory`, docs/out-of-core.md).
     pub fn set_volume_policy(&mut self, policy: VolumePolicy) {
         self.volumes = policy;
+        // Grids kept under another policy may be where this one would not put them.
+        self.resident = Arc::default();
     }
 
     pub fn device_name(&self) -> &str {
@@ -227,6 +232,50 @@ impl CudaRenderer {
         options: &RenderOptions,
         progress: &dyn Fn(u64, u64),
     ) -> Result<RenderStats, CudaError> {
+        self.render_samples_placing(scene, schedule, film, samples, options, progress, None)
+    }
+
+    /// [`CudaRenderer::render_samples`] for one of many renders of the scene numbered `grids` (a
+    /// viewer's frames, the batches of several GPUs): its grids stay on the GPU from one render
+    /// to the next instead of being copied each time, until a render of another scene.
+    ///
+    /// # Safety
+    /// `grids` names one scene's grids for this renderer's lifetime: every render passing it has
+    /// grids holding the same values wherever they are found at the same address and length
+    /// ([`VolumePlacer::keeping`]).
+    #[allow(clippy::too_many_arguments)]
+    pub unsafe fn render_samples_keeping<S: SceneAbi>(
+        &self,
+        scene: &S,
+        schedule: impl Into<Schedule>,
+        film: &mut Film,
+        samples: Range<u32>,
+        options: &RenderOptions,
+        progress: &dyn Fn(u64, u64),
+        grids: u64,
+    ) -> Result<RenderStats, CudaError> {
+        self.render_samples_placing(
+            scene,
+            schedule,
+            film,
+            samples,
+            options,
+            progress,
+            Some(grids),
+        )
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn render_samples_placing<S: SceneAbi>(
+        &self,
+        scene: &S,
+        schedule: impl Into<Schedule>,
+        film: &mut Film,
+        samples: Range<u32>,
+        options: &RenderOptions,
+        progress: &dyn Fn(u64, u64),
+        keep: Option<u64>,
+    ) -> Result<RenderStats, CudaError> {
         let (width, height) = (scene.camera().width, scene.camera().height);
         film.check_pass((width, height), &samples)?;
         let schedule = schedule.into();
@@ -239,6 +288,10 @@ impl CudaRenderer {
         // SAFETY: the grids are `scene`'s, borrowed for this whole call; `volumes` is dropped
         // before it returns.
         let mut volumes = unsafe { VolumePlacer::new(stream.clone(), self.volumes) }?;
+        if let Some(grids) = keep {
+            // SAFETY: `render_samples_keeping`'s contract.
+            volumes = unsafe { volumes.keeping(self.resident.clone(), grids) };
+        }
         let scene_params = scene.to_params(&mut volumes);
         volumes.check()?;
 
