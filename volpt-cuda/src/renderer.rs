@@ -190,6 +190,14 @@ impl CudaRenderer {
             .map_err(|_| CudaError::MissingKernel(entry.to_owned()))
     }
 
+    /// Compiles the kernel that a render of `S` under `schedule` launches, which the first such
+    /// render would do (several GPUs do it at once, before their render starts).
+    pub fn load_kernel<S: SceneAbi>(&self, schedule: impl Into<Schedule>) -> Result<(), CudaError> {
+        let schedule = schedule.into();
+        self.kernel(&entry_name::<S>(schedule.strategy), schedule.max_registers)
+            .map(drop)
+    }
+
     pub(crate) fn stream(&self) -> &Arc<CudaStream> {
         &self.stream
     }

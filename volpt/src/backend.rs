@@ -631,6 +631,23 @@ impl SceneVisitor for Render<'_> {
             _ => Vec::new(),
         };
         if !devices.is_empty() {
+            // Every GPU compiles its kernel at once, before the render's clock starts (as one
+            // GPU's render does before its own).
+            if let Inner::Cuda { renderers, .. } = &backend.0 {
+                std::thread::scope(|threads| {
+                    let loads: Vec<_> = renderers
+                        .iter()
+                        .zip(&schedules)
+                        .filter_map(|(renderer, schedule)| {
+                            let schedule = (*schedule)?;
+                            Some(threads.spawn(move || renderer.load_kernel::<S>(schedule)))
+                        })
+                        .collect();
+                    loads.into_iter().try_for_each(|load| {
+                        load.join().unwrap_or_else(|p| std::panic::resume_unwind(p))
+                    })
+                })?;
+            }
             let (stats, done) =
                 multi::render_shared(&devices, film, samples.clone(), observer, after_chunk)?;
             return Ok(Rendered {
