@@ -44,8 +44,10 @@ class PartDone:
     index: int
     #: The part's samples of every pixel.
     samples: range
-    #: The Ray node that rendered it (its IP address) and the worker process there.
+    #: The Ray node that rendered it: its IP address, its Ray node ID (hex), and the worker
+    #: process there.
     node: str
+    node_id: str
     pid: int
     #: Seconds its render took on the worker (without loading the scene).
     seconds: float
@@ -112,10 +114,11 @@ def _render_part(
     try:
         import ray
 
-        node = ray.util.get_node_ip_address()
+        node, node_id = ray.util.get_node_ip_address(), ray.get_runtime_context().get_node_id()
     except Exception:  # outside Ray (a direct call): the host's name
-        node = socket.gethostname()
-    return _film_bytes(film), {"node": node, "pid": os.getpid(), "seconds": film.elapsed}
+        node, node_id = socket.gethostname(), ""
+    where = {"node": node, "node_id": node_id, "pid": os.getpid(), "seconds": film.elapsed}
+    return _film_bytes(film), where
 
 
 def _write_atomically(path: str, data: bytes) -> None:
@@ -276,6 +279,7 @@ def render(
                         index=i,
                         samples=ranges[i],
                         node=where["node"],
+                        node_id=where["node_id"],
                         pid=where["pid"],
                         seconds=where["seconds"],
                         done=done,
