@@ -10,6 +10,7 @@ VOLPT_REQUIRE_RAY is set (python/ci.sh sets it).
 import faulthandler
 import os
 import signal
+import subprocess
 import sys
 import threading
 import time
@@ -20,7 +21,7 @@ import pytest
 
 import volpt
 import volpt.distributed as vd
-from conftest import bits, run_cli
+from conftest import REPO, bits, run_cli
 
 if os.environ.get("VOLPT_REQUIRE_RAY"):
     import ray
@@ -80,6 +81,25 @@ def test_without_ray_says_what_to_install(monkeypatch, grid_scene):
     monkeypatch.setitem(sys.modules, "ray", None)  # `import ray` raises ImportError
     with pytest.raises(ImportError, match=r"pip install 'volpt\[ray\]'"):
         vd.render(grid_scene, 4, parts=2, backend="cpu")
+
+
+def test_example_on_a_local_cluster(tmp_path, grid_scene):
+    # python/examples/ray_render.py as its docstring runs it: its own local cluster of two CPUs
+    # (two worker processes). Before the module's cluster starts, so that one cluster runs at once.
+    spp, parts = 16, 4
+    env = {k: v for k, v in os.environ.items() if k != "RAY_ADDRESS"}
+    out = subprocess.run(
+        [
+            sys.executable, str(REPO / "python" / "examples" / "ray_render.py"), str(grid_scene),
+            "--spp", str(spp), "--parts", str(parts), "--resolution", f"{SIZE[0]}x{SIZE[1]}",
+            "--backend", "cpu", "--local-cpus", "2", "-o", str(tmp_path / "ray.exr"),
+        ],
+        capture_output=True, text=True, timeout=300, env=env,
+    )
+    assert out.returncode == 0, out.stderr
+    assert f"part {parts}/{parts} " in out.stderr and "'CPU': 2.0" in out.stderr, out.stderr
+    local = partition_render(volpt.load(grid_scene, SETTINGS), spp, parts)
+    assert np.array_equal(bits(volpt.read_exr(tmp_path / "ray.exr")), bits(local.image()))
 
 
 def test_merged_image_equals_single_process_render(cluster, tmp_path, volpt_bin, grid_scene):
