@@ -121,6 +121,18 @@ def _render_part(
     return _film_bytes(film), where
 
 
+def _reason(error: BaseException) -> str:
+    """A failed task's error in one line: a task's own exception (Ray's ``cause``) by its class and
+    message, Ray's own (a worker or node lost) by its message."""
+    cause = getattr(error, "cause", None)
+    if isinstance(cause, BaseException):
+        text = f"{type(cause).__name__}: {cause}"
+    else:
+        text = str(error)
+    lines = text.strip().splitlines()
+    return lines[0] if lines else type(error).__name__
+
+
 def _write_atomically(path: str, data: bytes) -> None:
     tmp = f"{path}.tmp{os.getpid()}"
     with open(tmp, "wb") as f:
@@ -292,13 +304,10 @@ def render(
 
     if failed:
         failed.sort(key=lambda f: f[0])
-        lines = [
-            f"  samples {ranges[i].start}..{ranges[i].stop} (part {i}): {str(e).strip().splitlines()[0]}"
-            for i, e in failed
-        ]
+        lines = [f"  samples {ranges[i].start}..{ranges[i].stop} (part {i}): {_reason(e)}" for i, e in failed]
         kept = f" The other parts' films are in {os.fspath(parts_dir)}." if parts_dir is not None else ""
         raise RenderError(
-            f"{len(failed)} of {len(ranges)} parts failed after {max_retries} retries:\n"
+            f"{len(failed)} of {len(ranges)} parts failed (max_retries={max_retries}):\n"
             + "\n".join(lines)
             + f"\nRender them with `volpt render SCENE --samples A..B --film FILE` and merge "
             f"them with the others (`volpt merge`).{kept}"
