@@ -103,7 +103,7 @@ def test_example_on_a_local_cluster(tmp_path, grid_scene):
 
 
 def test_merged_image_equals_single_process_render(cluster, tmp_path, volpt_bin, grid_scene):
-    spp, parts = 24, 3
+    spp, parts = 48, 3  # parts of a few tenths of a second: both nodes take one
     arrived = []
     film = vd.render(
         grid_scene, spp, parts=parts, seed=3, backend="cpu", settings=SETTINGS,
