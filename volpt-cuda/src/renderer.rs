@@ -108,6 +108,19 @@ pub struct CudaRenderer {
     volumes: VolumePolicy,
     /// The grids of the scene rendered last by [`CudaRenderer::render_samples_keeping`].
     resident: Arc<ResidentGrids>,
+    /// The launch size the last render of a kept scene ended with, and what it was measured on
+    /// (scene, kernel, image size): the next render of that scene starts there instead of with
+    /// [`FIRST_LAUNCH_PATHS`] (several GPUs render many batches, each a render of its own).
+    launch_budget: Mutex<Option<(BudgetKey, u64)>>,
+}
+
+/// What a launch budget was measured on.
+#[derive(Clone, Debug, PartialEq, Eq)]
+struct BudgetKey {
+    grids: u64,
+    kernel: String,
+    max_registers: Option<u32>,
+    size: (u32, u32),
 }
 
 impl CudaRenderer {
@@ -158,6 +171,7 @@ impl CudaRenderer {
             multiprocessors,
             volumes: VolumePolicy::default(),
             resident: Arc::default(),
+            launch_budget: Mutex::default(),
         })
     }
 
@@ -364,8 +378,22 @@ impl CudaRenderer {
         let total = pixels * samples.len() as u64;
         stream.synchronize().doing("copying the scene")?;
         let start = Instant::now();
-        // The first launch's budget, then what the measured rate traces in `LAUNCH_SECONDS`.
-        let budget = Cell::new(FIRST_LAUNCH_PATHS);
+        // The first launch's budget (what the last render of this kept scene measured), then
+        // what the measured rate traces in `LAUNCH_SECONDS`.
+        let budget_key = keep.map(|grids| BudgetKey {
+            grids,
+            kernel: name.clone(),
+            max_registers: schedule.max_registers,
+            size: (width, height),
+        });
+        let carried = {
+            let last = self.launch_budget.lock().unwrap_or_else(|e| e.into_inner());
+            match (&*last, &budget_key) {
+                (Some((key, budget)), Some(now)) if key == now => Some(*budget),
+                _ => None,
+            }
+        };
+        let budget = Cell::new(carried.unwrap_or(FIRST_LAUNCH_PATHS));
         let mut done = 0;
         // Tiles one after the other, each with all its samples (the thesis's image tiling).
         for tile in Tile::grid(width, height, columns, rows) {
@@ -449,6 +477,10 @@ impl CudaRenderer {
             params.first_sample = samples.start;
         }
         let elapsed = start.elapsed();
+        if let Some(key) = budget_key {
+            *self.launch_budget.lock().unwrap_or_else(|e| e.into_inner()) =
+                Some((key, budget.get()));
+        }
 
         let sums = stream.clone_dtoh(&device_film).doing("reading the film")?;
         let totals = stream.clone_dtoh(&counters).doing("reading the counters")?;
