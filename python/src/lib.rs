@@ -46,7 +46,7 @@ fn to_py(error: Error) -> PyErr {
         Error::Param { .. } => "ParamError",
         Error::Cpu(_) | Error::Cuda(_) => "RenderError",
         Error::Checkpoint(_) | Error::FilmFile(_) => "CheckpointError",
-        Error::Merge(_) | Error::Films(_) => "MergeError",
+        Error::Films(_) => "MergeError",
         Error::Image(_) => "ImageError",
     };
     raise(class, message(&error))

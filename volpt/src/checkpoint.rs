@@ -11,8 +11,9 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use volpt_film::checkpoint::Checkpoint;
-use volpt_film::Film;
+use volpt_film::{Film, FilmFile};
 
+use crate::films::{merge_films, MergeError, Merged};
 use crate::{Backend, Error, Observer, Rendered, Scene};
 
 /// Where to save and where to resume from, and how often to save.
@@ -120,62 +121,46 @@ pub struct Part {
     pub film: Film,
 }
 
-/// Adds `parts` of one render into the film of all their samples, in the order of their ranges
-/// (so the same partition gives the same bits whatever order the parts arrive in). Parts of
-/// another render (fingerprint, seed, film size), overlapping ranges and gaps between ranges are
-/// refused, each named.
-pub fn merge(mut parts: Vec<Part>) -> Result<Part, Error> {
-    parts.sort_by_key(|p| (p.samples.start, p.samples.end));
-    let mut parts = parts.into_iter();
-    let Some(mut merged) = parts.next() else {
-        return Err(Error::Merge("nothing to merge: no films".into()));
-    };
-    for part in parts {
-        let mismatch = |field: &str, expected: String, found: String| {
-            Error::Merge(format!(
-                "the film of samples {:?} is of another render: its {field} is {found}, the \
-                 first film's is {expected}",
-                part.samples
-            ))
-        };
-        if part.fingerprint != merged.fingerprint {
-            return Err(mismatch(
-                "scene fingerprint",
-                format!("{:016x}", merged.fingerprint),
-                format!("{:016x}", part.fingerprint),
-            ));
+/// Adds `parts` of one render into the film of all their samples, as [`merge_films`] adds film
+/// files (in the order of their ranges, so the same partition gives the same bits whatever order
+/// the parts arrive in; parts of another render, overlapping ranges refused). The merged samples
+/// must be one range: a gap between two parts is refused, naming it.
+pub fn merge(parts: Vec<Part>) -> Result<Part, Error> {
+    let films = parts
+        .into_iter()
+        .map(|p| {
+            let name = format!("the film of samples {:?}", p.samples);
+            let file = FilmFile {
+                fingerprint: p.fingerprint,
+                seed: p.seed,
+                ranges: vec![p.samples],
+                film: p.film,
+            };
+            (name, file)
+        })
+        .collect();
+    let Merged { film, missing } = merge_films(films, None)?;
+    // `merge_films` counts from sample 0; parts may start later.
+    let first = film.ranges.first().map_or(0, |r| r.start);
+    let missing: Vec<_> = missing.into_iter().filter(|r| r.start >= first).collect();
+    if !missing.is_empty() {
+        return Err(MergeError::Gaps {
+            missing,
+            held: film.ranges,
         }
-        if part.seed != merged.seed {
-            return Err(mismatch(
-                "seed",
-                merged.seed.to_string(),
-                part.seed.to_string(),
-            ));
-        }
-        let size = |f: &Film| format!("{}x{}", f.width, f.height);
-        if (part.film.width, part.film.height) != (merged.film.width, merged.film.height) {
-            return Err(mismatch("film", size(&merged.film), size(&part.film)));
-        }
-        if part.samples.start < merged.samples.end {
-            return Err(Error::Merge(format!(
-                "the films of samples {:?} and {:?} overlap",
-                merged.samples, part.samples
-            )));
-        }
-        if part.samples.start > merged.samples.end {
-            return Err(Error::Merge(format!(
-                "samples {:?} are in no film (between {:?} and {:?})",
-                merged.samples.end..part.samples.start,
-                merged.samples,
-                part.samples
-            )));
-        }
-        for (sum, add) in merged.film.sums.iter_mut().zip(&part.film.sums) {
-            for c in 0..3 {
-                sum[c] += add[c];
-            }
-        }
-        merged.samples.end = part.samples.end;
+        .into());
     }
-    Ok(merged)
+    let FilmFile {
+        fingerprint,
+        seed,
+        ranges,
+        film,
+    } = film;
+    let samples = ranges.first().map_or(0..0, |r| r.clone());
+    Ok(Part {
+        fingerprint,
+        seed,
+        samples,
+        film,
+    })
 }

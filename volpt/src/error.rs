@@ -27,13 +27,10 @@ pub enum Error {
     /// A checkpoint or film file that cannot be read, written, or is of another render.
     #[error(transparent)]
     Checkpoint(#[from] volpt_film::CheckpointError),
-    /// Films that do not add up to one render.
-    #[error("{0}")]
-    Merge(String),
     /// A film file that cannot be read or written ([`crate::films`]).
     #[error(transparent)]
     FilmFile(#[from] volpt_film::FilmFileError),
-    /// Film files that do not add up to one render, naming the files ([`crate::films`]).
+    /// Films that do not add up to one render, naming each film ([`crate::films`]).
     #[error(transparent)]
     Films(#[from] crate::films::MergeError),
     /// An image that cannot be written or read.

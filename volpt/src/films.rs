@@ -60,9 +60,9 @@ pub enum MergeError {
     },
     /// Samples of `0..spp` that no film holds.
     #[error(
-        "samples {} are in no film (the films hold {}): render them with `volpt render SCENE \
-         --samples A..B --film FILE` and merge again, or accept a noisier image of the samples \
-         held with --allow-gaps",
+        "samples {} are in no film (the films hold {}): render them (`volpt render SCENE \
+         --samples A..B --film FILE`) and merge again, or merge the samples held into a noisier \
+         image (`volpt merge --allow-gaps`)",
         format_ranges(missing),
         format_ranges(held)
     )]

@@ -79,10 +79,10 @@ fn ranges_merged_equal_the_whole_render_and_the_same_partition_gives_the_same_bi
     assert_eq!(merge(reversed).unwrap().film.sums, merged.film.sums);
 
     let refused = |parts: Vec<Part>, needle: &str| match merge(parts) {
-        Err(e @ Error::Merge(_)) => assert!(e.to_string().contains(needle), "{e}"),
+        Err(e @ Error::Films(_)) => assert!(e.to_string().contains(needle), "{e}"),
         other => panic!("expected a refusal naming {needle:?}, got {other:?}"),
     };
-    refused(vec![part(0..3), part(2..6)], "overlap");
+    refused(vec![part(0..3), part(2..6)], "both hold samples 2..3");
     refused(vec![part(0..2), part(4..6)], "samples 2..4 are in no film");
     let mut other_seed = part(2..6);
     other_seed.seed += 1;
