@@ -212,6 +212,9 @@ enum LookupArg {
     /// texture, of samples held in half precision (rounded toward zero; at most 65504).
     #[value(name = "texture-f16")]
     TextureF16,
+    /// One of the eight samples, chosen with probability its trilinear weight: an unbiased
+    /// estimate of trilinear for one read (on the GPU one unfiltered texel).
+    Stochastic,
 }
 
 impl From<LookupArg> for GridLookup {
@@ -221,6 +224,7 @@ impl From<LookupArg> for GridLookup {
             LookupArg::Nearest => GridLookup::Nearest,
             LookupArg::Texture => GridLookup::Texture,
             LookupArg::TextureF16 => GridLookup::TextureHalf,
+            LookupArg::Stochastic => GridLookup::Stochastic,
         }
     }
 }
