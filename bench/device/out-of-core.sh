@@ -83,7 +83,7 @@ SCENES=(
     "bucky:scenes/bucky/scene.toml:1K:-Ddata=$DATA"
 )
 COMMON=(--spp 4 --seed 7 --resolution 200x200)
-GPU=(--backend cuda --strategy naive-sk)
+GPU=(--backend cuda --math exact --strategy naive-sk)
 for entry in "${SCENES[@]}"; do
     IFS=: read -r scene file partial params <<<"$entry"
     [ -f "$file" ] || { log "SKIP $scene: $file not in this bundle"; continue; }

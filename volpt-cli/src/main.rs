@@ -10,6 +10,7 @@ mod plot;
 mod volume;
 
 use std::path::{Path, PathBuf};
+use std::fmt::Write as _;
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
@@ -624,7 +625,10 @@ fn render_command(args: RenderArgs) -> Result<()> {
             (film.image(spp), rendered.stats, spp)
         }
     };
-    println!("{}", summary(&image, spp, &stats, variant));
+    println!(
+        "{}",
+        summary(&image, spp, &stats, variant, &configuration(&backend, &scene))
+    );
     match output {
         Some(output) => write_image(&image, &output, preview.as_deref()),
         None => Ok(()),
@@ -714,15 +718,52 @@ fn preview_for(output: &Path) -> Result<Option<PathBuf>> {
     Ok(Some(preview_path(output)))
 }
 
-fn summary(image: &Image, spp: u32, stats: &RenderStats, variant: Variant) -> String {
+/// Which configuration renders: the device, the GPU's strategy and math, and the grid lookup of a
+/// medium with grids (`--math`, `--lookup`; their defaults are the fastest correct ones).
+fn configuration(backend: &volpt::Backend, scene: &volpt::Scene) -> String {
+    let mut s = backend.device_name();
+    if let Some(strategy) = backend.strategy() {
+        let _ = write!(s, ", {strategy}");
+    }
+    if let Some(math) = backend.math() {
+        let _ = write!(s, ", {math} math");
+    }
+    let medium = &scene.description().medium;
+    let grids = matches!(medium.density, volpt_scene::description::DensityDesc::Grid(_))
+        || matches!(medium.albedo, volpt_scene::description::AlbedoDesc::Grid(_));
+    if grids {
+        let _ = write!(s, ", {} lookup", lookup_name(medium.lookup));
+    }
+    s
+}
+
+/// A lookup by its `--lookup` name.
+fn lookup_name(lookup: GridLookup) -> &'static str {
+    match lookup {
+        GridLookup::Trilinear => "trilinear",
+        GridLookup::Nearest => "nearest",
+        GridLookup::Texture => "texture",
+        GridLookup::TextureHalf => "texture-f16",
+        GridLookup::Stochastic => "stochastic",
+    }
+}
+
+fn summary(
+    image: &Image,
+    spp: u32,
+    stats: &RenderStats,
+    variant: Variant,
+    configuration: &str,
+) -> String {
     let c = &stats.counters;
     let mut s = format!(
-        "{}x{} at {} spp ({}) in {:.3} s: {:.3} M paths/s, {:.3} M segments/s, \
+        "{}x{} at {} spp ({}; {}) in {:.3} s: {:.3} M paths/s, {:.3} M segments/s, \
          {:.3} M tracking steps/s ({:.2} segments/path)",
         image.width,
         image.height,
         spp,
         variant,
+        configuration,
         stats.elapsed.as_secs_f64(),
         stats.paths_per_second() * 1e-6,
         stats.segments_per_second() * 1e-6,
