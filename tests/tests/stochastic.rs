@@ -101,7 +101,10 @@ fn stochastic_lookups_match_trilinear_on_a_generated_medium() {
         if seed == 3 {
             // The any-layout reads of bricked grids choose the same samples as the texture path's.
             let any_layout = pixel_statistics_with(&bricked, SPP, seed, settings);
-            assert!(any_layout == b, "bricked stochastic reads differ from dense ones");
+            assert!(
+                any_layout == b,
+                "bricked stochastic reads differ from dense ones"
+            );
         }
     }
     eprintln!(

@@ -9,8 +9,8 @@ mod info;
 mod plot;
 mod volume;
 
-use std::path::{Path, PathBuf};
 use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
@@ -627,7 +627,13 @@ fn render_command(args: RenderArgs) -> Result<()> {
     };
     println!(
         "{}",
-        summary(&image, spp, &stats, variant, &configuration(&backend, &scene))
+        summary(
+            &image,
+            spp,
+            &stats,
+            variant,
+            &configuration(&backend, &scene)
+        )
     );
     match output {
         Some(output) => write_image(&image, &output, preview.as_deref()),
@@ -729,8 +735,10 @@ fn configuration(backend: &volpt::Backend, scene: &volpt::Scene) -> String {
         let _ = write!(s, ", {math} math");
     }
     let medium = &scene.description().medium;
-    let grids = matches!(medium.density, volpt_scene::description::DensityDesc::Grid(_))
-        || matches!(medium.albedo, volpt_scene::description::AlbedoDesc::Grid(_));
+    let grids = matches!(
+        medium.density,
+        volpt_scene::description::DensityDesc::Grid(_)
+    ) || matches!(medium.albedo, volpt_scene::description::AlbedoDesc::Grid(_));
     if grids {
         let _ = write!(s, ", {} lookup", lookup_name(medium.lookup));
     }

@@ -168,7 +168,8 @@ struct DeltaAcceptance<'a, M> {
 impl<M: Medium> TentativeCollision for DeltaAcceptance<'_, M> {
     #[inline(always)]
     fn stop_at(&mut self, rng: &mut Rng, t: f32, majorant: f32, bits: u64) -> bool {
-        M::HOMOGENEOUS || rng.next_f32() * majorant < self.medium.sigma_t_random(self.ray.at(t), bits)
+        M::HOMOGENEOUS
+            || rng.next_f32() * majorant < self.medium.sigma_t_random(self.ray.at(t), bits)
     }
 }
 

@@ -137,7 +137,8 @@ pub fn describe(
         AlbedoDesc::Grid(g) => grid(g),
     };
     field("albedo", albedo);
-    let grids = matches!(m.density, DensityDesc::Grid(_)) || matches!(m.albedo, AlbedoDesc::Grid(_));
+    let grids =
+        matches!(m.density, DensityDesc::Grid(_)) || matches!(m.albedo, AlbedoDesc::Grid(_));
     if grids {
         let lookup = match m.lookup {
             GridLookup::Trilinear => "trilinear",
