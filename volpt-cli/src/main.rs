@@ -140,7 +140,8 @@ struct SceneArgs {
     /// index-matched boundary, pt elsewhere; nee needs an index-matched boundary).
     #[arg(long, value_enum)]
     estimator: Option<EstimatorArg>,
-    /// How the medium's grids are reconstructed between samples (default: the scene's, trilinear).
+    /// How the medium's grids are reconstructed between samples (default: stochastic on a GPU
+    /// with fast math where textures fit in its memory, else trilinear).
     #[arg(long, value_enum)]
     lookup: Option<LookupArg>,
     /// Russian roulette's survival probability (default: mitsuba); where it starts is --rr-depth.

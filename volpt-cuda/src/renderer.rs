@@ -204,6 +204,11 @@ impl CudaRenderer {
         &self.device_name
     }
 
+    /// The device memory free now (`cuMemGetInfo`), if the driver says.
+    pub fn free_memory(&self) -> Option<u64> {
+        self.ctx.mem_get_info().ok().map(|(free, _)| free as u64)
+    }
+
     /// Renders `scene` as `schedule` says with the kernel of `S`, calling `progress(done, total)` in
     /// paths after each launch.
     pub fn render<S: SceneAbi>(
