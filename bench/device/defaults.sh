@@ -15,9 +15,12 @@
 #    math, TIME seconds per setting against a REFSPP reference;
 # 5. start-up: a 16x16, 1-spp render's process time, warm (kernel in the driver's JIT cache),
 #    and its parts from `RUST_LOG=volpt_cuda=debug` (context, kernel cut, JIT/module load).
+# 6. the defaults as shipped: the summary line of a render without flags, `--math exact` alone
+#    against the CPU (bit for bit, naive-sk), and `volpt bench` without flags, with `--strategy
+#    auto` and with fixed strategies (all with the default math and lookup).
 #   bash bundle/defaults.sh   -> $OUT/defaults.txt, $OUT/converge-*.md
 # Knobs: TRIALS (5), TIME (1.0), REFSPP (4096), PSPP (parity spp, 2048), PRES (parity
-# resolution, 200), ONLY (scene regex), PARTS (default "1 2 3 4 5").
+# resolution, 200), ONLY (scene regex), PARTS (default "1 2 3 4 5 6").
 set -uo pipefail
 cd "$(dirname "$0")"
 OUT=${OUT:-$PWD/out}
@@ -30,7 +33,7 @@ REFSPP=${REFSPP:-4096}
 PSPP=${PSPP:-2048}
 PRES=${PRES:-200}
 ONLY=${ONLY:-.}
-PARTS=${PARTS:-1 2 3 4 5}
+PARTS=${PARTS:-1 2 3 4 5 6}
 part() { [[ " $PARTS " == *" $1 "* ]]; }
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/defaults.XXXXXX")
 export RUST_BACKTRACE=0 RUST_LIB_BACKTRACE=0 VOLPT_CACHE_DIR=$WORK/cache
@@ -179,5 +182,35 @@ PY
     echo "volpt --version: $(python3 -c "print(f'{$e - $s:.3f}')") s"
     s=$(date +%s.%N); "$VOLPT" render "${tiny[@]:0:5}" -o "$WORK/tiny-cpu.exr" >/dev/null 2>&1; e=$(date +%s.%N)
     echo "the same render on the CPU: $(python3 -c "print(f'{$e - $s:.3f}')") s"
+    }
+    part 6 && {
+    echo "## 6. the defaults as shipped: what a render without flags runs, --math exact alone, auto against fixed strategies"
+    for entry in "${selected[@]}"; do
+        IFS=: read -r name file params grids <<<"$entry"
+        # shellcheck disable=SC2086
+        "$VOLPT" render "$file" $params --backend cuda -o "$WORK/d-$name.exr" 2>/dev/null | grep -m 1 " spp (" | sed "s/^/$name: /"
+        # --math exact alone: the CPU's image bit for bit (naive-sk).
+        common=(--resolution 64x64 --spp 4 --seed 7)
+        # shellcheck disable=SC2086
+        "$VOLPT" render "$file" $params "${common[@]}" -o "$WORK/e-$name-cpu.exr" >/dev/null 2>&1
+        # shellcheck disable=SC2086
+        "$VOLPT" render "$file" $params "${common[@]}" --backend cuda --math exact --strategy naive-sk \
+            -o "$WORK/e-$name-gpu.exr" >/dev/null 2>&1
+        if "$VOLPT" compare "$WORK/e-$name-cpu.exr" "$WORK/e-$name-gpu.exr" --identical >"$WORK/c.txt" 2>&1; then
+            echo "PASS $name: --math exact (naive-sk) is the CPU's image bit for bit"
+        else
+            echo "FAIL $name: --math exact (naive-sk) differs from the CPU: $(tail -n 1 "$WORK/c.txt")"
+        fi
+        for s in no-flags auto naive-sk regeneration-sk regeneration-warp-sk regeneration-block-sk streaming-sk sorting-sk; do
+            flags=(--strategy "$s")
+            [ "$s" = no-flags ] && flags=()
+            # shellcheck disable=SC2086
+            timeout 120 "$VOLPT" bench "$file" $params --backend cuda "${flags[@]}" --trials "$TRIALS" --json \
+                >"$WORK/b.json" 2>"$WORK/b.log" \
+                || { echo "FAIL $name $s: $(first_error "$WORK/b.log")"; continue; }
+            python3 -c "import json,sys; r=json.load(open(sys.argv[1])); print(f\"{sys.argv[2]:<22} {sys.argv[3]:<22} {r['time_median_s']*1e3:9.2f} ms  {r['segments_per_s']/1e9:7.3f} G seg/s  {r.get('variant')}\")" \
+                "$WORK/b.json" "$name" "$s"
+        done
+    done
     }
 } 2>&1 | tee -a "$OUT/defaults.txt"
