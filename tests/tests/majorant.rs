@@ -199,7 +199,9 @@ impl SceneVisitor for LookupBound<'_> {
         let mut largest = 0.0f32;
         for (i, &p) in self.points.iter().enumerate() {
             // Random bits for a stochastic lookup (every other lookup ignores them).
-            let bits = (i as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(29);
+            let bits = (i as u64 + 1)
+                .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+                .rotate_left(29);
             let s = scene.medium().sigma_t_random(p, bits);
             if !(s.is_finite() && s >= 0.0) {
                 return Err(p);

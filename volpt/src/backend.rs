@@ -12,8 +12,8 @@ use volpt_core::GridLayout;
 use volpt_cuda::{CudaRenderer, Math, Schedule, Strategy};
 use volpt_film::{Film, RenderOptions, RenderStats};
 use volpt_gpu_mem::{VolumeMemory, VolumePolicy};
-use volpt_scene::GridLookup;
 use volpt_render::{render_samples, with_scene_as, RenderScene, SceneVisitor};
+use volpt_scene::GridLookup;
 use volpt_scene::GridStorage;
 
 use crate::auto::{self, AutoCache};
@@ -298,7 +298,10 @@ impl Backend {
             return GridLookup::Trilinear;
         };
         let fits = || {
-            if matches!(volumes.memory, VolumeMemory::ZeroCopy | VolumeMemory::Managed) {
+            if matches!(
+                volumes.memory,
+                VolumeMemory::ZeroCopy | VolumeMemory::Managed
+            ) {
                 return false;
             }
             let bytes = scene.texture_bytes();

@@ -15,7 +15,7 @@ use volpt_scene::{
 
 /// A scene described field by field, in `volpt info`'s order: `scene`, `variant`, `film`,
 /// `camera`, `integrator`, `bounds`, `boundary`, `density`, `majorant`, `tracking`, `estimator`,
-/// `albedo`, `phase`, `light`. A value of several lines (the variant's specialisations, the
+/// `albedo`, `lookup` (a medium with grids), `math`, `phase`, `light`. A value of several lines (the variant's specialisations, the
 /// tracking's default rule) has them separated by `\n`. [`fmt::Display`] writes `volpt info`'s
 /// text: each key in a column of 11 characters, later lines of a value indented to it.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -141,7 +141,10 @@ pub fn describe(
         matches!(m.density, DensityDesc::Grid(_)) || matches!(m.albedo, AlbedoDesc::Grid(_));
     if grids {
         let lookup = match m.lookup {
-            GridLookup::Trilinear => "trilinear",
+            GridLookup::Trilinear => {
+                "trilinear (without --lookup, a GPU with fast math reads stochastic lookups \
+                 instead where the grids fit in its memory)"
+            }
             GridLookup::Nearest => "nearest (biased: a blockier field)",
             GridLookup::Texture => "texture (the texture unit's filter, 8-bit weights: biased)",
             GridLookup::TextureHalf => "texture-f16 (half-precision texels, 8-bit weights: biased)",
