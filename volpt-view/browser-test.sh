@@ -2,10 +2,11 @@
 # The viewer in a real browser (CI): installs Debian's chromium and Playwright for Python (in a
 # venv; Playwright's own browser download is never used), starts `volpt view` on 127.0.0.1 with
 # the CPU backend and a small scene, and runs volpt-view/browser_test.py against it. The screenshot
-# goes to docs/viewer.png (argument 1 overrides).
+# goes to target/viewer.png; `bash volpt-view/browser-test.sh docs/viewer.png` renews the one in the
+# docs (CI leaves tracked files alone).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-screenshot=${1:-docs/viewer.png}
+screenshot=${1:-target/viewer.png}
 started=$SECONDS
 
 if [[ ! -x /usr/bin/chromium ]]; then

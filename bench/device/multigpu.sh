@@ -6,12 +6,14 @@
 #
 # 1. Equality: naive-sk (one GPU adds every sample in order, as the CPU does) on one GPU and on two;
 #    the two films' sums compared (film_diff.py: the largest relative difference, f64 rounding only).
-# 2. Speed-up: each included scene at a production sample count, 400x400, regeneration-sk (fixed,
+# 2. Speed-up: each included scene at a production sample count, $RESOLUTION (default 800x800),
+#    regeneration-sk (fixed,
 #    so that no `auto` calibration enters the timing), one GPU against `--gpus all`; after a short
 #    warm-up render on both GPUs (the driver's JIT cache). The time is the render's own ("in X s":
 #    one GPU, its kernels; several, the wall time of the shared queue from the first batch to the
 #    last film added, grid copies and film transfers of every batch included) and the process's
-#    wall time (scene loading, GPU contexts and the JIT cache too).
+#    wall time (scene loading, GPU contexts and the JIT cache too). The several-GPU render logs
+#    its batches (device, samples, start, duration: `RUST_LOG=volpt=debug`) in NAME-all.log.
 # 3. Processes: two `volpt render --samples` processes, one per GPU, and `volpt merge`, against
 #    the one-GPU image.
 # 4. `auto` on two GPUs: one calibration (the second GPU, of the same model, finds it cached).
@@ -21,6 +23,7 @@ OUT=${OUT:-$PWD/out}
 mkdir -p "$OUT"
 VOLPT=$PWD/bin/volpt
 DATA=$PWD/data
+RESOLUTION=${RESOLUTION:-800x800}
 failures=0
 log() { echo "== $*" | tee -a "$OUT/summary.txt"; }
 now() { date +%s.%N; }
@@ -59,13 +62,13 @@ SCENES=(
 echo "scene,spp,one_gpu_render_s,two_gpu_render_s,render_speedup,one_gpu_process_s,two_gpu_process_s,process_speedup,max_relative" >"$OUT/speedup.csv"
 for entry in "${SCENES[@]}"; do
     IFS=: read -r name file params spp <<<"$entry"
-    common=(--resolution 400x400 --seed 1 --backend cuda --strategy regeneration-sk)
+    common=(--resolution "$RESOLUTION" --seed 1 --backend cuda --strategy regeneration-sk)
     # shellcheck disable=SC2086
     "$VOLPT" render "$file" $params "${common[@]}" --spp 4 --gpus all -o /dev/null >/dev/null 2>&1
     for gpus in 0 all; do
         start=$(now)
         # shellcheck disable=SC2086
-        "$VOLPT" render "$file" $params "${common[@]}" --spp "$spp" --gpus "$gpus" \
+        RUST_LOG=info,volpt=debug "$VOLPT" render "$file" $params "${common[@]}" --spp "$spp" --gpus "$gpus" \
             -o "$OUT/$name-$gpus.exr" >"$OUT/$name-$gpus.log" 2>&1 \
             || { log "FAIL $name --gpus $gpus: $(tail -n 2 "$OUT/$name-$gpus.log" | tr '\n' ' ')"; failures=$((failures + 1)); }
         calc "$(now) - $start" >"$OUT/$name-$gpus.wall"

@@ -9,7 +9,8 @@
 # Each run starts `volpt view SCENE --backend B --resolution R --bind 127.0.0.1:0`, runs
 # bin/viewer-bench against it (see volpt-view/examples/viewer_bench.rs: the time from a still
 # camera move to its first frame, frames/s of the still refinement, frames/s and move-to-frame time
-# while orbiting at 60 moves/s), and stops the server with Ctrl-C (SIGINT), which must end it.
+# while orbiting at 60 moves/s; a view shown again must give its first image byte for byte), and
+# stops the server with Ctrl-C (SIGINT), which must end it.
 #
 # Environment:
 #   OUT                 outputs (default ./out)
@@ -99,6 +100,10 @@ for scene in $SCENES; do
           failures=$((failures + 1)); continue
       fi
       echo "{\"scene\":\"$scene\",\"resolution\":\"$res\",\"result\":$json}" >>"$JSONL"
+      if [ "$(num "$json" repeat_identical)" != True ]; then
+          say "| $scene | $backend | $res | FAIL: a view shown again is not its first image ($(num "$json" repeat_identical)) |"
+          failures=$((failures + 1))
+      fi
       say "| $scene | $backend | $res | $(num "$json" still_move_to_frame_ms_median) | $(num "$json" still_frames_per_s) | $(num "$json" still_spp_after) | $(num "$json" orbit_frames_per_s) | $(num "$json" orbit_move_to_frame_ms_median) | $(num "$json" orbit_resolution) | $(num "$json" orbit_render_ms_mean) / $(num "$json" orbit_tonemap_ms_mean) / $(num "$json" orbit_encode_ms_mean) |"
     done
   done

@@ -1024,6 +1024,54 @@ impl Film {
         })
     }
 
+    /// Writes the film in the film file format (`VOLPTFL1`, what `volpt render --film` writes
+    /// and `volpt merge` reads), atomically.
+    fn save_film(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let part = &self.part;
+        let file = volpt::FilmFile {
+            fingerprint: part.fingerprint,
+            seed: part.seed,
+            ranges: vec![part.samples.clone()],
+            film: part.film.clone(),
+        };
+        py.allow_threads(|| file.write(&path))
+            .map_err(|e| to_py(e.into()))
+    }
+
+    /// Reads a film file (`volpt render --film`, `volpt merge --film`, `Film.save_film`) or a
+    /// checkpoint; a film of several ranges (a merge with gaps) is refused.
+    #[staticmethod]
+    fn load_film(py: Python<'_>, path: PathBuf) -> PyResult<Film> {
+        let file = py
+            .allow_threads(|| volpt::read_film(&path))
+            .map_err(to_py)?;
+        let samples = match file.ranges.as_slice() {
+            [range] => range.clone(),
+            ranges => {
+                return Err(raise(
+                    "CheckpointError",
+                    format!(
+                        "{}: the film holds samples {}, not one range (merge it with the films \
+                         of the samples between them first)",
+                        path.display(),
+                        volpt::film::film_file::format_ranges(ranges)
+                    ),
+                ))
+            }
+        };
+        Ok(Film {
+            part: Part {
+                fingerprint: file.fingerprint,
+                seed: file.seed,
+                samples,
+                film: file.film,
+            },
+            elapsed: 0.0,
+            paths: 0,
+            notes: Vec::new(),
+        })
+    }
+
     fn __repr__(&self) -> String {
         let p = &self.part;
         format!(

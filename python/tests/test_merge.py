@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import volpt
-from conftest import CUBE, SETTINGS, bits
+from conftest import CUBE, SETTINGS, SIZE, bits, run_cli
 
 
 @pytest.fixture(scope="module")
@@ -84,3 +84,36 @@ def test_save_and_load_refusals(tmp_path, scene):
     (tmp_path / "bad.ck").write_bytes(bytes(data))
     with pytest.raises(volpt.CheckpointError, match=r"checksum"):
         volpt.Film.load(tmp_path / "bad.ck")
+
+
+def test_film_files_are_the_command_lines(tmp_path, scene, volpt_bin, grid_scene):
+    # Film.save_film writes what `volpt render --samples --film` writes; load_film reads both.
+    late = scene.render(samples=range(2, 5), seed=4)
+    late.save_film(tmp_path / "py.vfilm")
+    loaded = volpt.Film.load_film(tmp_path / "py.vfilm")
+    assert loaded.samples == range(2, 5) and loaded.seed == 4 and loaded.fingerprint == scene.fingerprint
+    assert np.array_equal(bits(loaded.sums), bits(late.sums))
+    run_cli(
+        volpt_bin, "render", grid_scene, "--resolution", f"{SIZE[0]}x{SIZE[1]}", "--seed", 4,
+        "--samples", "2..5", "--film", tmp_path / "cli.vfilm",
+    )
+    assert (tmp_path / "cli.vfilm").read_bytes() == (tmp_path / "py.vfilm").read_bytes()
+    # A checkpoint reads as a film of samples 0..n; `volpt merge` takes the Python films.
+    scene.render(spp=2, seed=4).save(tmp_path / "head.ck")
+    head = volpt.Film.load_film(tmp_path / "head.ck")
+    assert head.samples == range(0, 2)
+    run_cli(volpt_bin, "merge", tmp_path / "py.vfilm", tmp_path / "head.ck", "--spp", 5, "-o", tmp_path / "m.exr")
+    assert np.array_equal(bits(volpt.read_exr(tmp_path / "m.exr")), bits(volpt.merge([head, loaded]).image()))
+    # Refused: a film of several ranges (a merge with gaps), a damaged file, a missing one.
+    scene.render(samples=range(7, 8), seed=4).save_film(tmp_path / "far.vfilm")
+    run_cli(volpt_bin, "merge", tmp_path / "head.ck", tmp_path / "far.vfilm", "--allow-gaps",
+            "-o", tmp_path / "gaps.exr", "--film", tmp_path / "gaps.vfilm")
+    with pytest.raises(volpt.CheckpointError, match=r"gaps\.vfilm: the film holds samples 0\.\.2, 7\.\.8, not one range"):
+        volpt.Film.load_film(tmp_path / "gaps.vfilm")
+    data = bytearray((tmp_path / "py.vfilm").read_bytes())
+    data[60] ^= 1
+    (tmp_path / "bad.vfilm").write_bytes(bytes(data))
+    with pytest.raises(volpt.CheckpointError, match=r"bad\.vfilm: not a volpt film file, or a damaged one: its checksum"):
+        volpt.Film.load_film(tmp_path / "bad.vfilm")
+    with pytest.raises(volpt.CheckpointError, match=r"missing\.vfilm"):
+        volpt.Film.load_film(tmp_path / "missing.vfilm")

@@ -165,6 +165,16 @@ class Film:
         """Saves the film in volpt's checkpoint format (``volpt render --checkpoint``'s; ``volpt
         render --resume`` continues it). The format holds samples ``0..n``: a film of a range that
         starts later raises ``CheckpointError`` (merge it with the films before it first)."""
+    def save_film(self, path: Union[str, os.PathLike[str]]) -> None:
+        """Writes the film in volpt's film file format (``VOLPTFL1``, atomically): what ``volpt
+        render --samples A..B --film FILE`` writes and ``volpt merge`` reads, for a film of any
+        sample range. Raises ``CheckpointError``."""
+    @staticmethod
+    def load_film(path: Union[str, os.PathLike[str]]) -> Film:
+        """Reads a film file (``Film.save_film``, ``volpt render --film``, ``volpt merge --film``)
+        or a checkpoint, checked as ``volpt merge`` checks it (magic, length, checksum, ranges).
+        A film of several ranges (a merge with ``--allow-gaps``) raises ``CheckpointError``, as
+        does a damaged file."""
     @staticmethod
     def load(path: Union[str, os.PathLike[str]], scene: Optional[Scene] = None) -> Film:
         """Reads a film saved by ``Film.save`` or ``volpt render --checkpoint``. With ``scene``,

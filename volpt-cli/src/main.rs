@@ -352,6 +352,10 @@ struct ViewArgs {
     /// loopback ports).
     #[arg(long)]
     token: bool,
+    /// Stream the linear image to the tev HDR viewer listening at HOST:PORT (tev's default is
+    /// 127.0.0.1:14158) as well, reconnecting when tev restarts.
+    #[arg(long, value_name = "HOST:PORT")]
+    tev: Option<String>,
 }
 
 #[derive(Args)]
@@ -508,6 +512,7 @@ fn main() -> Result<()> {
             let options = volpt_view::ViewOptions {
                 bind: args.bind,
                 token: args.token,
+                tev: args.tev,
                 backend: BackendOptions {
                     kind: args.sampling.backend.into(),
                     gpu: args.sampling.gpu.options(&args.sampling.volumes),

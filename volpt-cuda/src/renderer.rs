@@ -23,7 +23,7 @@ use volpt_device::launch::{
 };
 use volpt_device::{LaunchParams, Math, Strategy};
 use volpt_film::{Film, Image, RenderOptions, RenderStats};
-use volpt_gpu_mem::{VolumePlacer, VolumePolicy};
+use volpt_gpu_mem::{ResidentGrids, VolumePlacer, VolumePolicy};
 
 use crate::entry::{entry_name, single_kernel_ptx};
 use crate::error::{CudaError, Doing};
@@ -106,6 +106,21 @@ pub struct CudaRenderer {
     device_name: String,
     multiprocessors: u32,
     volumes: VolumePolicy,
+    /// The grids of the scene rendered last by [`CudaRenderer::render_samples_keeping`].
+    resident: Arc<ResidentGrids>,
+    /// The launch size the last render of a kept scene ended with, and what it was measured on
+    /// (scene, kernel, image size): the next render of that scene starts there instead of with
+    /// [`FIRST_LAUNCH_PATHS`] (several GPUs render many batches, each a render of its own).
+    launch_budget: Mutex<Option<(BudgetKey, u64)>>,
+}
+
+/// What a launch budget was measured on.
+#[derive(Clone, Debug, PartialEq, Eq)]
+struct BudgetKey {
+    grids: u64,
+    kernel: String,
+    max_registers: Option<u32>,
+    size: (u32, u32),
 }
 
 impl CudaRenderer {
@@ -159,6 +174,8 @@ impl CudaRenderer {
             device_name,
             multiprocessors,
             volumes: VolumePolicy::default(),
+            resident: Arc::default(),
+            launch_budget: Mutex::default(),
         })
     }
 
@@ -191,6 +208,14 @@ impl CudaRenderer {
             .map_err(|_| CudaError::MissingKernel(entry.to_owned()))
     }
 
+    /// Compiles the kernel that a render of `S` under `schedule` launches, which the first such
+    /// render would do (several GPUs do it at once, before their render starts).
+    pub fn load_kernel<S: SceneAbi>(&self, schedule: impl Into<Schedule>) -> Result<(), CudaError> {
+        let schedule = schedule.into();
+        self.kernel(&entry_name::<S>(schedule.strategy), schedule.max_registers)
+            .map(drop)
+    }
+
     pub(crate) fn stream(&self) -> &Arc<CudaStream> {
         &self.stream
     }
@@ -198,6 +223,8 @@ impl CudaRenderer {
     /// Where renders place their grids from now on (`--volume-memory`, docs/out-of-core.md).
     pub fn set_volume_policy(&mut self, policy: VolumePolicy) {
         self.volumes = policy;
+        // Grids kept under another policy may be where this one would not put them.
+        self.resident = Arc::default();
     }
 
     pub fn device_name(&self) -> &str {
@@ -236,6 +263,50 @@ impl CudaRenderer {
         options: &RenderOptions,
         progress: &dyn Fn(u64, u64),
     ) -> Result<RenderStats, CudaError> {
+        self.render_samples_placing(scene, schedule, film, samples, options, progress, None)
+    }
+
+    /// [`CudaRenderer::render_samples`] for one of many renders of the scene numbered `grids` (a
+    /// viewer's frames, the batches of several GPUs): its grids stay on the GPU from one render
+    /// to the next instead of being copied each time, until a render of another scene.
+    ///
+    /// # Safety
+    /// `grids` names one scene's grids for this renderer's lifetime: every render passing it has
+    /// grids holding the same values wherever they are found at the same address and length
+    /// ([`VolumePlacer::keeping`]).
+    #[allow(clippy::too_many_arguments)]
+    pub unsafe fn render_samples_keeping<S: SceneAbi>(
+        &self,
+        scene: &S,
+        schedule: impl Into<Schedule>,
+        film: &mut Film,
+        samples: Range<u32>,
+        options: &RenderOptions,
+        progress: &dyn Fn(u64, u64),
+        grids: u64,
+    ) -> Result<RenderStats, CudaError> {
+        self.render_samples_placing(
+            scene,
+            schedule,
+            film,
+            samples,
+            options,
+            progress,
+            Some(grids),
+        )
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn render_samples_placing<S: SceneAbi>(
+        &self,
+        scene: &S,
+        schedule: impl Into<Schedule>,
+        film: &mut Film,
+        samples: Range<u32>,
+        options: &RenderOptions,
+        progress: &dyn Fn(u64, u64),
+        keep: Option<u64>,
+    ) -> Result<RenderStats, CudaError> {
         let (width, height) = (scene.camera().width, scene.camera().height);
         film.check_pass((width, height), &samples)?;
         let schedule = schedule.into();
@@ -248,6 +319,10 @@ impl CudaRenderer {
         // SAFETY: the grids are `scene`'s, borrowed for this whole call; `volumes` is dropped
         // before it returns.
         let mut volumes = unsafe { VolumePlacer::new(stream.clone(), self.volumes) }?;
+        if let Some(grids) = keep {
+            // SAFETY: `render_samples_keeping`'s contract.
+            volumes = unsafe { volumes.keeping(self.resident.clone(), grids) };
+        }
         let scene_params = scene.to_params(&mut volumes);
         volumes.check()?;
 
@@ -312,8 +387,22 @@ impl CudaRenderer {
         let total = pixels * samples.len() as u64;
         stream.synchronize().doing("copying the scene")?;
         let start = Instant::now();
-        // The first launch's budget, then what the measured rate traces in `LAUNCH_SECONDS`.
-        let budget = Cell::new(FIRST_LAUNCH_PATHS);
+        // The first launch's budget (what the last render of this kept scene measured), then
+        // what the measured rate traces in `LAUNCH_SECONDS`.
+        let budget_key = keep.map(|grids| BudgetKey {
+            grids,
+            kernel: name.clone(),
+            max_registers: schedule.max_registers,
+            size: (width, height),
+        });
+        let carried = {
+            let last = self.launch_budget.lock().unwrap_or_else(|e| e.into_inner());
+            match (&*last, &budget_key) {
+                (Some((key, budget)), Some(now)) if key == now => Some(*budget),
+                _ => None,
+            }
+        };
+        let budget = Cell::new(carried.unwrap_or(FIRST_LAUNCH_PATHS));
         let mut done = 0;
         // Tiles one after the other, each with all its samples (the thesis's image tiling).
         for tile in Tile::grid(width, height, columns, rows) {
@@ -397,6 +486,10 @@ impl CudaRenderer {
             params.first_sample = samples.start;
         }
         let elapsed = start.elapsed();
+        if let Some(key) = budget_key {
+            *self.launch_budget.lock().unwrap_or_else(|e| e.into_inner()) =
+                Some((key, budget.get()));
+        }
 
         let sums = stream.clone_dtoh(&device_film).doing("reading the film")?;
         let totals = stream.clone_dtoh(&counters).doing("reading the counters")?;

@@ -25,6 +25,6 @@ pub mod texture;
 
 pub use error::GpuMemError;
 pub use memory::{HostRegistration, ManagedBuffer, PinnedBuffer};
-pub use placer::{Placed, VolumePlacer};
+pub use placer::{Placed, ResidentGrids, VolumePlacer};
 pub use policy::{Placement, VolumeMemory, VolumePolicy};
 pub use texture::GridTexture;

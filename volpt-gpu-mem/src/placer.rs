@@ -2,7 +2,7 @@
 //! decides, and owns that memory for the render.
 
 use std::fmt;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use cudarc::driver::{CudaContext, CudaStream, DevicePtr, DriverError};
 use rayon::prelude::*;
@@ -72,8 +72,54 @@ impl fmt::Display for Placed {
     }
 }
 
+/// Grids kept placed between renders of one scene: a viewer renders the same grids at every frame,
+/// several GPUs at every batch, and copying them again each time cost more than rendering a frame.
+/// Kept for one scene at a time: a render of another frees them ([`VolumePlacer::keeping`]).
+#[derive(Default)]
+pub struct ResidentGrids {
+    kept: Mutex<Kept>,
+}
+
+#[derive(Default)]
+struct Kept {
+    /// The scene whose grids these are.
+    scene: Option<u64>,
+    grids: Vec<Resident>,
+}
+
+/// A grid kept on the device: what it was placed from, where it went, and its memory.
+struct Resident {
+    key: GridKey,
+    placed: PlacedGrid,
+    record: Placed,
+    _memory: Held,
+}
+
+/// What a grid's placement depends on (the policy is the renderer's, the same for every render).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct GridKey {
+    /// The host values' address and length.
+    values: (usize, usize),
+    res: [u32; 3],
+    channels: u32,
+    placement: GridPlacement,
+    texel: TexelFormat,
+}
+
+impl ResidentGrids {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Bytes of grids kept now.
+    pub fn bytes(&self) -> u64 {
+        let kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
+        kept.grids.iter().map(|r| r.record.bytes).sum()
+    }
+}
+
 /// Places a scene's grids (and copies its other values, such as environment maps, to the device)
-/// for one render; dropping it frees everything.
+/// for one render; dropping it frees everything except the grids it keeps ([`Self::keeping`]).
 pub struct VolumePlacer {
     ctx: Arc<CudaContext>,
     stream: Arc<CudaStream>,
@@ -84,6 +130,8 @@ pub struct VolumePlacer {
     held: Vec<Held>,
     placed: Vec<Placed>,
     error: Option<GpuMemError>,
+    /// Where this render's grids are kept for the next render of the same scene, and the scene.
+    keep: Option<(Arc<ResidentGrids>, u64)>,
 }
 
 impl VolumePlacer {
@@ -115,7 +163,97 @@ impl VolumePlacer {
             held: Vec::new(),
             placed: Vec::new(),
             error: None,
+            keep: None,
         })
+    }
+
+    /// This placer, taking the grids of scene `scene` from `resident` where an earlier render of
+    /// it left them, and leaving the grids it places there for the next one. Grids that stay in
+    /// the caller's memory (page-locked in place) are not kept: they must not outlive the render.
+    /// A render of another scene frees the grids kept of the one before.
+    ///
+    /// # Safety
+    /// `scene` names one scene's grids for as long as `resident` lives: every grid given to
+    /// [`Uploader::grid`] under `scene`, by any placer keeping into `resident`, holds the same
+    /// values whenever it is found at the same address with the same length (a scene whose grids
+    /// are never written after loading, named by a number no other scene gets).
+    pub unsafe fn keeping(mut self, resident: Arc<ResidentGrids>, scene: u64) -> Self {
+        self.keep = Some((resident, scene));
+        self
+    }
+
+    /// The grid of `key` as an earlier render of this scene left it; frees the grids of any other
+    /// scene.
+    fn kept(&mut self, key: &GridKey) -> Option<PlacedGrid> {
+        let (resident, scene) = self.keep.as_ref()?;
+        let mut kept = resident.kept.lock().unwrap_or_else(|e| e.into_inner());
+        if kept.scene != Some(*scene) {
+            if !kept.grids.is_empty() {
+                // The renders that read them are over (each placer waits for its kernels before
+                // it is dropped); wait anyway rather than free memory a kernel could read.
+                if let Err(e) = self.stream.synchronize() {
+                    tracing::error!(%e, "synchronising before freeing the kept volumes");
+                }
+                tracing::debug!("freeing the grids kept of the scene rendered before");
+            }
+            // Free now, though the driver said otherwise when this placer asked.
+            self.free_device += kept.grids.iter().map(|r| on_device(&r.record)).sum::<u64>();
+            kept.grids.clear();
+            kept.scene = Some(*scene);
+        }
+        let Some(resident) = kept.grids.iter().find(|r| r.key == *key) else {
+            // The same values placed otherwise before (another lookup or layout): this render
+            // places them anew, and the scene's next render will find them so.
+            let replaced = |r: &Resident| r.key.values == key.values;
+            if kept.grids.iter().any(replaced) {
+                if let Err(e) = self.stream.synchronize() {
+                    tracing::error!(%e, "synchronising before freeing a kept volume");
+                }
+                let freed: u64 = kept
+                    .grids
+                    .iter()
+                    .filter(|r| replaced(r))
+                    .map(|r| on_device(&r.record))
+                    .sum();
+                self.free_device += freed;
+                kept.grids.retain(|r| !replaced(r));
+            }
+            return None;
+        };
+        let (placed, record) = (resident.placed, resident.record);
+        drop(kept);
+        tracing::debug!("volume kept from the render before: {record}");
+        // Counted against the budget as if placed now; the driver's free memory, asked for when
+        // this placer was made, already lacks it.
+        self.used += on_device(&record);
+        self.free_device += on_device(&record);
+        self.placed.push(record);
+        Some(placed)
+    }
+
+    /// Keeps the grid just placed for the next render of this scene, unless it stays in the
+    /// caller's memory: its memory is the last held and its placement the last recorded (every
+    /// placement holds one piece of memory and records itself once).
+    fn keep(&mut self, key: GridKey, placed: PlacedGrid) {
+        let Some((resident, _)) = &self.keep else {
+            return;
+        };
+        let Some(&record) = self.placed.last() else {
+            return;
+        };
+        if record.memory == PlacedIn::ZeroCopyInPlace {
+            return;
+        }
+        let Some(memory) = self.held.pop() else {
+            return;
+        };
+        let mut kept = resident.kept.lock().unwrap_or_else(|e| e.into_inner());
+        kept.grids.push(Resident {
+            key,
+            placed,
+            record,
+            _memory: memory,
+        });
     }
 
     /// The first error of any placement; the parameters built with this placer are only valid
@@ -304,6 +442,15 @@ impl VolumePlacer {
     }
 }
 
+/// Device memory a placement takes.
+fn on_device(placed: &Placed) -> u64 {
+    match placed.memory {
+        PlacedIn::Device | PlacedIn::Texture(_) => placed.bytes,
+        PlacedIn::Managed { device_bytes } => device_bytes,
+        PlacedIn::ZeroCopy | PlacedIn::ZeroCopyInPlace => 0,
+    }
+}
+
 /// A grid being placed: its dense host values and the layout and length it takes on the device.
 struct Grid<'v> {
     values: &'v [f32],
@@ -376,13 +523,26 @@ impl Uploader for VolumePlacer {
         if self.error.is_some() {
             return failed;
         }
+        let key = GridKey {
+            values: (values.as_ptr() as usize, values.len()),
+            res,
+            channels,
+            placement,
+            texel,
+        };
+        if let Some(placed) = self.kept(&key) {
+            return placed;
+        }
         let placed = match placement {
             GridPlacement::Texture => self.texture(values, res, channels, texel),
             GridPlacement::AnyLayout => self.place(values, res, channels, true),
             GridPlacement::Dense => self.place(values, res, channels, false),
         };
         match placed {
-            Ok(placed) => placed,
+            Ok(placed) => {
+                self.keep(key, placed);
+                placed
+            }
             Err(e) => {
                 self.error = Some(e);
                 failed

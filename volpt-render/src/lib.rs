@@ -9,7 +9,8 @@
 pub mod factory;
 
 pub use factory::{
-    path_settings, with_scene, with_scene_as, Effects, RenderScene, SceneVisitor, Variant,
+    path_settings, with_scene, with_scene_as, with_scene_cached, Effects, FactoryCache,
+    RenderScene, SceneVisitor, Variant,
 };
 pub use volpt_cpu::{render, render_samples, RenderError};
 pub use volpt_film::{

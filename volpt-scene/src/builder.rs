@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 
 use crate::description::{Bounds, SceneDescription};
 use crate::error::SceneError;
+use crate::validate::CheckedData;
 use crate::{mitsuba, toml_scene};
 
 /// One source of scenes.
@@ -157,6 +158,17 @@ impl SceneAssembler {
     /// The builder's scene with the config's overrides applied, refused if `f32` positions cannot
     /// resolve its free flights ([`crate::numerics`]).
     pub fn assemble(&self, builder: &dyn SceneBuilder) -> Result<SceneDescription, SceneError> {
+        self.assemble_checked(builder).map(|(desc, _)| desc)
+    }
+
+    /// [`SceneAssembler::assemble`], with what checking the scene's data found (to check the
+    /// scene again after its settings change without reading the data: [`validate_settings`]).
+    ///
+    /// [`validate_settings`]: crate::validate::validate_settings
+    pub fn assemble_checked(
+        &self,
+        builder: &dyn SceneBuilder,
+    ) -> Result<(SceneDescription, CheckedData), SceneError> {
         let c = &self.config;
         let mut desc = builder.build(&c.params)?;
         tracing::debug!(source = %builder.source(), "built scene");
@@ -175,7 +187,7 @@ impl SceneAssembler {
         }
         // Too dense for f32 positions first: its message says how to rescale the scene.
         crate::numerics::check_position_resolution(&desc, Path::new(&builder.source()))?;
-        crate::validate::validate(&desc, &builder.source())?;
-        Ok(desc)
+        let checked = crate::validate::validate(&desc, &builder.source())?;
+        Ok((desc, checked))
     }
 }

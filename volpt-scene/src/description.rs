@@ -173,6 +173,9 @@ pub struct GridDesc {
     pub channels: u32,
     pub bounds: Bounds,
     pub convention: GridConvention,
+    /// Not serialised: the values of gigabyte grids are hashed on their own, once per scene, by
+    /// what fingerprints a scene (the facade's `fingerprint::content`).
+    #[serde(skip)]
     pub data: Vec<f32>,
 }
 
@@ -197,7 +200,9 @@ pub enum EnvironmentDesc {
 pub struct LatLongDesc {
     pub width: u32,
     pub height: u32,
-    /// Linear RGB radiance, `3 * width * height` values, row-major from the top-left pixel.
+    /// Linear RGB radiance, `3 * width * height` values, row-major from the top-left pixel. Not
+    /// serialised, as a grid's values ([`GridDesc::data`]).
+    #[serde(skip)]
     pub rgb: Vec<f32>,
     /// Map-to-world transform; its linear part is a rotation (possibly a mirroring), and its
     /// translation does not matter for light from infinitely far away.

@@ -19,8 +19,40 @@ pub const FILM_BYTES_PER_PIXEL: u64 = 40;
 /// any alpha above a few is already as rough as a surface gets.
 pub const MAX_ALPHA: f32 = 1e4;
 
-/// Checks `desc`; `source` names the scene file (or builder) in errors.
-pub fn validate(desc: &SceneDescription, source: &str) -> Result<(), SceneError> {
+/// What checking every value of a scene's data (its grids and environment map) found. The data
+/// does not change once a scene is assembled, so a scene whose camera, film or parameters change
+/// is checked again by [`validate_settings`] with this, without reading the data again (a viewer
+/// moves the camera at every frame; the grids may be gigabytes).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CheckedData {
+    /// The density grid's largest value (0 without a grid).
+    pub largest_density: f32,
+    /// The albedo grid's largest value (0 without a grid).
+    pub largest_albedo: f32,
+}
+
+/// Checks `desc`, every value of its data included; `source` names the scene file (or builder) in
+/// errors.
+pub fn validate(desc: &SceneDescription, source: &str) -> Result<CheckedData, SceneError> {
+    check(desc, source, None)
+}
+
+/// [`validate`] for a scene whose data `data` says was checked: the same checks, the data's values
+/// taken from `data` instead of read. `data` must be what [`validate`] returned for this scene's
+/// data (its settings may have changed since).
+pub fn validate_settings(
+    desc: &SceneDescription,
+    source: &str,
+    data: CheckedData,
+) -> Result<(), SceneError> {
+    check(desc, source, Some(data)).map(drop)
+}
+
+fn check(
+    desc: &SceneDescription,
+    source: &str,
+    checked: Option<CheckedData>,
+) -> Result<CheckedData, SceneError> {
     let invalid = |field: &str, expected: &str, found: String| SceneError::InvalidScene {
         source_name: source.to_owned(),
         field: field.to_owned(),
@@ -111,8 +143,16 @@ pub fn validate(desc: &SceneDescription, source: &str) -> Result<(), SceneError>
             }
             *d
         }
-        DensityDesc::Grid(grid) => check_grid(grid, "density grid", f32::MAX, &invalid)?,
+        DensityDesc::Grid(grid) => match checked {
+            Some(data) => data.largest_density,
+            None => check_grid(grid, "density grid", f32::MAX, &invalid)?,
+        },
     };
+    let largest_density = match &medium.density {
+        DensityDesc::Constant(_) => 0.0,
+        DensityDesc::Grid(_) => max_density,
+    };
+    let mut largest_albedo = 0.0;
     match &medium.albedo {
         AlbedoDesc::Constant(rgb) => {
             if !rgb.iter().all(|a| (0.0..=1.0).contains(a)) {
@@ -124,7 +164,10 @@ pub fn validate(desc: &SceneDescription, source: &str) -> Result<(), SceneError>
             }
         }
         AlbedoDesc::Grid(grid) => {
-            check_grid(grid, "albedo grid", 1.0, &invalid)?;
+            largest_albedo = match checked {
+                Some(data) => data.largest_albedo,
+                None => check_grid(grid, "albedo grid", 1.0, &invalid)?,
+            };
         }
     }
     if let PhaseDesc::HenyeyGreenstein { g } = medium.phase {
@@ -172,7 +215,8 @@ pub fn validate(desc: &SceneDescription, source: &str) -> Result<(), SceneError>
                     format!("{} for {} x {}", map.rgb.len(), map.width, map.height),
                 ));
             }
-            if let Some(v) = map.rgb.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
+            let unchecked = if checked.is_none() { &map.rgb[..] } else { &[] };
+            if let Some(v) = unchecked.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
                 return Err(invalid(
                     "environment map",
                     "finite radiances >= 0",
@@ -188,7 +232,10 @@ pub fn validate(desc: &SceneDescription, source: &str) -> Result<(), SceneError>
             }
         }
     }
-    Ok(())
+    Ok(CheckedData {
+        largest_density,
+        largest_albedo,
+    })
 }
 
 /// What a box must be.

@@ -10,6 +10,10 @@
 //! 3. orbit: camera moves at 60 Hz (interactive, as a drag sends them) for SECONDS: frames/s of
 //!    frames showing a move, the time from a move to the frame showing it, and the resolution.
 //!
+//! Between 1 and 2, the view of the first move is shown again: its first frame must equal the
+//! first one byte for byte (`repeat_identical`), as a render of a scene whose camera went
+//! elsewhere and came back, its grids kept on the GPU in between, must.
+//!
 //! Prints one JSON object.
 
 use std::time::{Duration, Instant};
@@ -48,8 +52,9 @@ async fn send(ws: &mut Ws, message: Value) {
         .expect("sending");
 }
 
-/// The next frame (acknowledged), or `None` at `deadline`.
-async fn next_frame(ws: &mut Ws, deadline: Instant) -> Option<(Value, usize)> {
+/// The next frame (acknowledged), or `None` at `deadline`: its header, its image's size and a hash
+/// of the image.
+async fn next_frame(ws: &mut Ws, deadline: Instant) -> Option<(Value, usize, u64)> {
     loop {
         let message = tokio::time::timeout_at(deadline.into(), ws.next())
             .await
@@ -58,7 +63,9 @@ async fn next_frame(ws: &mut Ws, deadline: Instant) -> Option<(Value, usize)> {
             Message::Binary(b) => {
                 let (header, image) = split_frame(&b)?;
                 send(ws, json!({"type": "ack", "frame": header["frame"]})).await;
-                return Some((header, image.len()));
+                let mut hash = std::hash::DefaultHasher::new();
+                std::hash::Hash::hash(image, &mut hash);
+                return Some((header, image.len(), std::hash::Hasher::finish(&hash)));
             }
             Message::Text(t) => eprintln!("viewer_bench: server says {t}"),
             Message::Close(_) => return None,
@@ -101,7 +108,7 @@ async fn main() {
     )
     .await;
     let far = Instant::now() + Duration::from_secs(120);
-    let (first, _) = next_frame(&mut ws, far).await.expect("a first frame");
+    let (first, _, _) = next_frame(&mut ws, far).await.expect("a first frame");
     let mut epoch = first["epoch"].as_u64().unwrap_or(0);
 
     // 1. Latency of a still move: send, wait for the new epoch's first frame.
@@ -115,13 +122,29 @@ async fn main() {
             json!({"type": "camera", "origin": o, "target": target}),
         )
         .await;
-        while let Some((h, bytes)) = next_frame(&mut ws, sent + Duration::from_secs(60)).await {
+        while let Some((h, _, image)) = next_frame(&mut ws, sent + Duration::from_secs(60)).await {
             if h["epoch"].as_u64() > Some(epoch) {
                 epoch = h["epoch"].as_u64().unwrap_or(epoch);
                 latency.push(sent.elapsed().as_secs_f64() * 1e3);
-                first_frames.push((h, bytes));
+                first_frames.push((h, image));
                 break;
             }
+        }
+    }
+    // The first move's view again: the same image.
+    let sent = Instant::now();
+    let o = orbit(origin, target, up, 0.05);
+    send(
+        &mut ws,
+        json!({"type": "camera", "origin": o, "target": target}),
+    )
+    .await;
+    let mut repeat_identical = None;
+    while let Some((h, _, image)) = next_frame(&mut ws, sent + Duration::from_secs(60)).await {
+        if h["epoch"].as_u64() > Some(epoch) {
+            epoch = h["epoch"].as_u64().unwrap_or(epoch);
+            repeat_identical = first_frames.first().map(|(_, first)| *first == image);
+            break;
         }
     }
 
@@ -129,7 +152,9 @@ async fn main() {
     let started = Instant::now();
     let mut still_frames = 0u32;
     let mut last_still = Value::Null;
-    while let Some((h, _)) = next_frame(&mut ws, started + Duration::from_secs_f64(seconds)).await {
+    while let Some((h, _, _)) =
+        next_frame(&mut ws, started + Duration::from_secs_f64(seconds)).await
+    {
         if h["epoch"].as_u64() == Some(epoch) {
             still_frames += 1;
             last_still = h;
@@ -156,7 +181,7 @@ async fn main() {
                                      "interactive": true})).await;
             }
             frame = next_frame(&mut ws, end) => {
-                let Some((h, size)) = frame else { break };
+                let Some((h, size, _)) = frame else { break };
                 if h["interactive"] != true { continue; }
                 frames += 1;
                 let shown = vec3(&h["view"]["origin"]);
@@ -198,6 +223,7 @@ async fn main() {
     let report = json!({
         "backend": hello["backend"], "device": hello["device"], "strategy": hello["strategy"],
         "math": hello["math"], "width": hello["width"], "height": hello["height"],
+        "repeat_identical": repeat_identical,
         "still_move_to_frame_ms_median": median(latency.clone()),
         "still_move_to_frame_ms_all": latency,
         "still_first_frame_render_ms_median": median(first_render),

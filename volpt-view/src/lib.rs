@@ -15,6 +15,7 @@
 pub mod encode;
 pub mod protocol;
 pub mod render;
+pub mod tev;
 
 use std::collections::VecDeque;
 use std::net::SocketAddr;
@@ -68,6 +69,8 @@ pub struct ViewOptions {
     /// Require the token on a loopback bind too: on a shared machine every user reaches its
     /// loopback ports. (Any other bind always requires it.)
     pub token: bool,
+    /// A tev viewer (`HOST:PORT`) to stream the linear image to as well ([`tev`]).
+    pub tev: Option<String>,
 }
 
 /// What every connection's task shares.
@@ -120,6 +123,7 @@ impl Viewer {
             })?;
         let addr = listener.local_addr()?;
         let (shutdown, shutdown_rx) = watch::channel(false);
+        let scene_name = hello.scene.clone();
         let state = Arc::new(AppState {
             shared: shared.clone(),
             commands: commands.clone(),
@@ -138,6 +142,16 @@ impl Viewer {
                 authorize,
             ))
             .with_state(state);
+        if let Some(addr) = options.tev {
+            let name = format!("volpt view: {scene_name}");
+            tokio::spawn(tev::stream(
+                addr,
+                name,
+                shared.clone(),
+                commands.clone(),
+                shutdown_rx.clone(),
+            ));
+        }
         let mut stop = shutdown_rx;
         let server = tokio::spawn(async move {
             axum::serve(listener, app)

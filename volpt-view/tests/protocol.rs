@@ -43,6 +43,7 @@ async fn start(spp: u32, token: bool) -> Viewer {
             bind: "127.0.0.1:0".parse().unwrap(),
             backend: BackendOptions::default(),
             token,
+            tev: None,
         },
     )
     .await

@@ -12,7 +12,7 @@ use volpt_core::GridLayout;
 use volpt_cuda::{CudaRenderer, Math, Schedule, Strategy};
 use volpt_film::{Film, RenderOptions, RenderStats};
 use volpt_gpu_mem::{VolumeMemory, VolumePolicy};
-use volpt_render::{render_samples, with_scene_as, RenderScene, SceneVisitor};
+use volpt_render::{render_samples, with_scene_cached, RenderScene, SceneVisitor};
 use volpt_scene::GridLookup;
 use volpt_scene::GridStorage;
 
@@ -428,16 +428,24 @@ impl Backend {
                 film.width, film.height
             )));
         }
+        let (factory, grids) = scene.grids();
         let visitor = Render {
             backend: self,
-            auto_keys: self.auto_keys(scene),
+            loaded: scene,
+            grids,
             options: scene.options(),
             film,
             samples,
             observer,
             after_chunk,
         };
-        with_scene_as(desc, scene.path_settings(), scene.effects(), visitor)
+        with_scene_cached(
+            desc,
+            scene.path_settings(),
+            scene.effects(),
+            factory,
+            visitor,
+        )
     }
 
     /// The key of a scene's `auto` choice: the GPU, the math and the scene as rendered.
@@ -570,8 +578,10 @@ fn schedule(gpu: &GpuOptions) -> Result<Option<Schedule>, Error> {
 /// One render, handed the monomorphised scene by the factory.
 struct Render<'a> {
     backend: &'a Backend,
-    /// One per GPU ([`Backend::auto_keys`]).
-    auto_keys: Vec<String>,
+    /// The scene as loaded, of which the visitor gets the monomorphised build.
+    loaded: &'a Scene,
+    /// The number naming its grids, for GPUs that keep them between renders.
+    grids: u64,
     options: RenderOptions,
     film: &'a mut Film,
     samples: Range<u32>,
@@ -585,7 +595,8 @@ impl SceneVisitor for Render<'_> {
     fn visit<S: RenderScene>(self, scene: &S) -> Self::Output {
         let Render {
             backend,
-            auto_keys,
+            loaded,
+            grids,
             options,
             film,
             samples,
@@ -611,6 +622,9 @@ impl SceneVisitor for Render<'_> {
                 auto,
                 ..
             } => {
+                // One key per GPU ([`Backend::auto_keys`]), computed only here: it fingerprints
+                // the scene.
+                let auto_keys = backend.auto_keys(loaded);
                 let mut chosen: Vec<(&str, Schedule)> = Vec::new();
                 let mut schedules = Vec::with_capacity(renderers.len());
                 for (renderer, key) in renderers.iter().zip(&auto_keys) {
@@ -657,8 +671,13 @@ impl SceneVisitor for Render<'_> {
                         move |film: &mut Film,
                               range: Range<u32>,
                               report: &(dyn Fn(u64, u64) + Sync)| {
-                            Ok(renderer
-                                .render_samples(scene, schedule, film, range, options, report)?)
+                            // SAFETY: `grids` names this scene's grids, which no one writes
+                            // ([`Scene::grids`]).
+                            Ok(unsafe {
+                                renderer.render_samples_keeping(
+                                    scene, schedule, film, range, options, report, grids,
+                                )
+                            }?)
                         },
                     )
                 })
@@ -666,6 +685,23 @@ impl SceneVisitor for Render<'_> {
             _ => Vec::new(),
         };
         if !devices.is_empty() {
+            // Every GPU compiles its kernel at once, before the render's clock starts (as one
+            // GPU's render does before its own).
+            if let Inner::Cuda { renderers, .. } = &backend.0 {
+                std::thread::scope(|threads| {
+                    let loads: Vec<_> = renderers
+                        .iter()
+                        .zip(&schedules)
+                        .filter_map(|(renderer, schedule)| {
+                            let schedule = (*schedule)?;
+                            Some(threads.spawn(move || renderer.load_kernel::<S>(schedule)))
+                        })
+                        .collect();
+                    loads.into_iter().try_for_each(|load| {
+                        load.join().unwrap_or_else(|p| std::panic::resume_unwind(p))
+                    })
+                })?;
+            }
             let (stats, done) =
                 multi::render_shared(&devices, film, samples.clone(), observer, after_chunk)?;
             return Ok(Rendered {
@@ -697,12 +733,21 @@ impl SceneVisitor for Render<'_> {
                 observer.progress(before + part, total);
             };
             let started = Instant::now();
-            let chunk_stats =
-                match (&backend.0, schedule) {
-                    (Inner::Cuda { renderers, .. }, Some(schedule)) => renderers[0]
-                        .render_samples(scene, schedule, film, range.clone(), &options, &report)?,
-                    _ => render_samples(scene, film, range.clone(), &options, &report)?,
-                };
+            let chunk_stats = match (&backend.0, schedule) {
+                // SAFETY: as above.
+                (Inner::Cuda { renderers, .. }, Some(schedule)) => unsafe {
+                    renderers[0].render_samples_keeping(
+                        scene,
+                        schedule,
+                        film,
+                        range.clone(),
+                        &options,
+                        &report,
+                        grids,
+                    )
+                }?,
+                _ => render_samples(scene, film, range.clone(), &options, &report)?,
+            };
             stats.elapsed += chunk_stats.elapsed;
             stats.counters = stats.counters.merge(chunk_stats.counters);
             done = range.end;

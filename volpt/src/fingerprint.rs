@@ -6,16 +6,24 @@
 //! Every part is hashed through its serde serialisation (postcard's stable wire format, fed to
 //! FNV-1a), so a field added to a description type is part of the fingerprint without anyone
 //! remembering to add it; the scene's own fields are listed by an exhaustive pattern, so a new one
-//! fails to compile until it is placed on one side or the other.
+//! fails to compile until it is placed on one side or the other. The values of the grids and of
+//! the environment map, which the description's serialisation leaves out, are hashed on their own
+//! ([`content`]), once per scene: a scene's data does not change, its camera does at every frame
+//! of a viewer.
 
 use serde::Serialize;
 use volpt_core::PathSettings;
 use volpt_film::checkpoint::Fnv;
 use volpt_render::Effects;
-use volpt_scene::SceneDescription;
+use volpt_scene::{AlbedoDesc, DensityDesc, EnvironmentDesc, SceneDescription};
 
-/// The fingerprint of rendering `desc` with `settings` and `effects`.
-pub fn fingerprint(desc: &SceneDescription, settings: &PathSettings, effects: Effects) -> u64 {
+/// The fingerprint of rendering `desc` with `settings` and `effects`; `content` is [`content`]`(desc)`.
+pub fn fingerprint(
+    desc: &SceneDescription,
+    settings: &PathSettings,
+    effects: Effects,
+    content: u64,
+) -> u64 {
     let SceneDescription {
         camera,
         film,
@@ -35,9 +43,38 @@ pub fn fingerprint(desc: &SceneDescription, settings: &PathSettings, effects: Ef
         environment,
         settings,
         effects,
+        content,
     );
     hasher.feed(&identity);
     hasher.0.finish()
+}
+
+/// The values of `desc`'s grids and environment map, each with its length, hashed (FNV-1a): what
+/// the description's serialisation leaves out.
+pub fn content(desc: &SceneDescription) -> u64 {
+    let data = [
+        match &desc.medium.density {
+            DensityDesc::Grid(g) => Some(&g.data[..]),
+            DensityDesc::Constant(_) => None,
+        },
+        match &desc.medium.albedo {
+            AlbedoDesc::Grid(g) => Some(&g.data[..]),
+            AlbedoDesc::Constant(_) => None,
+        },
+        match &desc.environment {
+            EnvironmentDesc::LatLong(map) => Some(&map.rgb[..]),
+            EnvironmentDesc::Constant(_) => None,
+        },
+    ];
+    let mut hash = Fnv::default();
+    for values in data {
+        let values = values.unwrap_or_default();
+        hash.write(&(values.len() as u64).to_le_bytes());
+        for v in values {
+            hash.write(&v.to_le_bytes());
+        }
+    }
+    hash.finish()
 }
 
 /// postcard's output, hashed as it is written instead of stored.

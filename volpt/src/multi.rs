@@ -186,6 +186,16 @@ pub(crate) fn render_shared(
                     let batch_started = Instant::now();
                     match device(&mut batch_film, batch.clone(), &progress) {
                         Ok(stats) => {
+                            // The schedule's timeline (`RUST_LOG=volpt=debug`): where the time
+                            // between batches goes.
+                            tracing::debug!(
+                                device = d,
+                                samples = ?batch,
+                                from_s = (batch_started - started).as_secs_f64(),
+                                took_s = batch_started.elapsed().as_secs_f64(),
+                                kernels_s = stats.elapsed.as_secs_f64(),
+                                "batch"
+                            );
                             finished.fetch_add(batch_paths, Ordering::Relaxed);
                             in_flight[d].store(0, Ordering::Relaxed);
                             // Batches grow towards one `check_every` of this device's work, at

@@ -2,13 +2,16 @@
 //! parameters that change between renders without reloading its grids.
 
 use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, OnceLock};
 
 use volpt_core::grid::HALF_MAX;
 use volpt_core::PathSettings;
 use volpt_film::{Film, RenderOptions};
-use volpt_render::factory::Parts;
+use volpt_render::factory::{FactoryCache, Parts};
 use volpt_render::{Effects, Variant};
 use volpt_scene::toml_scene::look_at;
+use volpt_scene::validate::CheckedData;
 use volpt_scene::{
     AlbedoDesc, DensityDesc, GridLookup, GridStorage, PhaseDesc, SceneAssembler, SceneBuilder,
     SceneDescription,
@@ -19,7 +22,7 @@ use crate::Error;
 
 /// A scene ready to render: its description, the path settings and variant choice it renders with,
 /// and its seed.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct Scene {
     /// Names the scene in errors: its file, or the builder's source.
     source: String,
@@ -35,6 +38,56 @@ pub struct Scene {
     /// Whether the grid lookup was chosen (a setting, [`Scene::set_lookup`]) rather than left to
     /// the backend's default ([`crate::Backend::prepare`]).
     lookup_chosen: bool,
+    /// What is known of the grids, which no method changes once the scene is built.
+    data: Arc<DataFacts>,
+}
+
+/// What a scene's data (its grids and environment map) was found to be, computed once: a scene
+/// rendered again and again with another camera or parameters (a viewer's frames, the batches of
+/// several GPUs) neither reads nor copies its grids again.
+#[derive(Debug)]
+struct DataFacts {
+    /// Names this scene's grids for a GPU that keeps them between renders: unique to the scene
+    /// (a clone gets its own, its grids being another copy).
+    id: u64,
+    /// What checking every value found ([`volpt_scene::validate`]).
+    checked: CheckedData,
+    /// The factory's scans of the grids and the last majorant grid.
+    factory: FactoryCache,
+    /// The grids' and the map's values hashed ([`crate::fingerprint`]), on first use.
+    content: OnceLock<u64>,
+}
+
+impl DataFacts {
+    fn new(checked: CheckedData) -> Self {
+        static NEXT_ID: AtomicU64 = AtomicU64::new(1);
+        Self {
+            id: NEXT_ID.fetch_add(1, Ordering::Relaxed),
+            checked,
+            factory: FactoryCache::new(),
+            content: OnceLock::new(),
+        }
+    }
+}
+
+impl Clone for Scene {
+    fn clone(&self) -> Self {
+        let data = DataFacts::new(self.data.checked);
+        if let Some(&content) = self.data.content.get() {
+            let _ = data.content.set(content);
+        }
+        Self {
+            source: self.source.clone(),
+            desc: self.desc.clone(),
+            path: self.path,
+            effects: self.effects,
+            seed: self.seed,
+            threads: self.threads,
+            up: self.up,
+            lookup_chosen: self.lookup_chosen,
+            data: Arc::new(data),
+        }
+    }
 }
 
 /// A parameter's value ([`Scene::get`], [`Scene::set`]).
@@ -100,11 +153,12 @@ impl Scene {
     /// The scene `builder` makes (any source, e.g. one written in code), with `settings` over it.
     pub fn build(builder: &dyn SceneBuilder, settings: &RenderSettings) -> Result<Self, Error> {
         settings.check_threads()?;
-        let mut desc = SceneAssembler::new(settings.config()).assemble(builder)?;
+        let (mut desc, checked) =
+            SceneAssembler::new(settings.config()).assemble_checked(builder)?;
         if let Some(lookup) = settings.lookup {
             desc.medium.lookup = lookup;
         }
-        check_lookup(&desc)?;
+        check_lookup(&desc, checked)?;
         let m = &desc.camera.to_world;
         Ok(Self {
             up: [m[0][1], m[1][1], m[2][1]],
@@ -115,6 +169,7 @@ impl Scene {
             threads: settings.threads,
             lookup_chosen: settings.lookup.is_some(),
             desc,
+            data: Arc::new(DataFacts::new(checked)),
         })
     }
 
@@ -137,7 +192,7 @@ impl Scene {
 
     /// The monomorphised variant the factory picks for this scene.
     pub fn variant(&self) -> Variant {
-        Parts::of(&self.desc, self.effects).variant()
+        Parts::of_cached(&self.desc, self.effects, &self.data.factory).variant()
     }
 
     pub fn spp(&self) -> u32 {
@@ -174,7 +229,11 @@ impl Scene {
 
     /// What makes two renders the same render ([`crate::fingerprint`]).
     pub fn fingerprint(&self) -> u64 {
-        crate::fingerprint::fingerprint(&self.desc, &self.path, self.effects)
+        let content = *self
+            .data
+            .content
+            .get_or_init(|| crate::fingerprint::content(&self.desc));
+        crate::fingerprint::fingerprint(&self.desc, &self.path, self.effects, content)
     }
 
     /// Replaces the path settings (tracking, estimator, roulette, depths) the scene renders with.
@@ -195,7 +254,7 @@ impl Scene {
     /// A lookup set here is kept by [`crate::Backend::prepare`].
     pub fn set_lookup(&mut self, lookup: GridLookup) -> Result<(), Error> {
         let before = std::mem::replace(&mut self.desc.medium.lookup, lookup);
-        check_lookup(&self.desc)
+        check_lookup(&self.desc, self.data.checked)
             .inspect_err(|_| self.desc.medium.lookup = before)
             .map(|()| self.lookup_chosen = true)
     }
@@ -244,7 +303,7 @@ impl Scene {
         let before = self.desc.film;
         self.desc.film.width = width;
         self.desc.film.height = height;
-        volpt_scene::validate::validate(&self.desc, &self.source)
+        self.validate()
             .map_err(Error::from)
             .inspect_err(|_| self.desc.film = before)
     }
@@ -290,8 +349,8 @@ impl Scene {
         let before = self.clone_light();
         let result = self.apply(key, value).and_then(|()| {
             volpt_scene::numerics::check_position_resolution(&self.desc, Path::new(&self.source))?;
-            volpt_scene::validate::validate(&self.desc, &self.source)?;
-            check_lookup(&self.desc)
+            self.validate()?;
+            check_lookup(&self.desc, self.data.checked)
         });
         if result.is_err() {
             self.restore_light(before);
@@ -376,6 +435,17 @@ impl Scene {
         Ok(())
     }
 
+    /// The scene checked as a loaded one is, its data's values as found when it was loaded.
+    fn validate(&self) -> Result<(), volpt_scene::SceneError> {
+        volpt_scene::validate::validate_settings(&self.desc, &self.source, self.data.checked)
+    }
+
+    /// What a renderer keeps of this scene between renders: the factory's scans of its grids,
+    /// and the number naming its grids (unique to this scene; its grids are never written).
+    pub(crate) fn grids(&self) -> (&FactoryCache, u64) {
+        (&self.data.factory, self.data.id)
+    }
+
     /// The small parts [`Scene::set`] changes (never the grids), to restore on a refusal.
     fn clone_light(&self) -> Light {
         let d = &self.desc;
@@ -457,7 +527,7 @@ fn not_here(key: &str, expected: &str, found: &str) -> Error {
 }
 
 /// Refuses a lookup the medium's grids cannot take: half-precision texels end at 65504.
-fn check_lookup(desc: &SceneDescription) -> Result<(), Error> {
+fn check_lookup(desc: &SceneDescription, checked: CheckedData) -> Result<(), Error> {
     if desc.medium.lookup != GridLookup::TextureHalf {
         return Ok(());
     }
@@ -466,14 +536,14 @@ fn check_lookup(desc: &SceneDescription) -> Result<(), Error> {
             "density",
             match &desc.medium.density {
                 DensityDesc::Constant(v) => *v,
-                DensityDesc::Grid(grid) => grid.max_value(),
+                DensityDesc::Grid(_) => checked.largest_density,
             },
         ),
         (
             "albedo",
             match &desc.medium.albedo {
                 AlbedoDesc::Constant(rgb) => rgb.iter().copied().fold(0.0, f32::max),
-                AlbedoDesc::Grid(grid) => grid.max_value(),
+                AlbedoDesc::Grid(_) => checked.largest_albedo,
             },
         ),
     ];

@@ -12,14 +12,18 @@
 //! - this file: the axis enums, the dispatch, [`Parts`] and what is derived from them;
 //! - [`parts`]: one function per axis from the description to a part, with the [`Simplification`]
 //!   rules;
+//! - [`cache`]: what the factory reads from a scene's grids, kept between builds of one scene
+//!   ([`FactoryCache`]);
 //! - [`camera`](camera()) and [`path_settings`]: the camera and integrator settings a file asks for;
 //! - [`majorant_choice`]: the cost model that picks a global majorant or a majorant grid.
 
+mod cache;
 mod camera;
 pub mod majorant_choice;
 pub mod parts;
 mod settings;
 
+pub use cache::{FactoryCache, Majorants};
 pub use camera::camera;
 pub use majorant_choice::{
     default_majorants, tracking_cost, MajorantChoice, MajorantRule, TrackingCost,
@@ -31,12 +35,14 @@ use parts::{aabb, boundary, environment, general_medium, lat_long, medium, phase
 
 use std::fmt;
 
+use std::sync::Arc;
 use volpt_core::abi::SceneAbi;
 use volpt_core::grid::{
     AnyLayout, DenseTrilinear, Grid, GridLookup, GridMapping, GridReads, TexelFormat,
     TextureTrilinear,
 };
-use volpt_core::majorant::{build_majorants, MajorantGrid};
+
+use volpt_core::majorant::MajorantGrid;
 use volpt_core::math::tan;
 use volpt_core::microfacet::Ggx;
 use volpt_core::path::Estimator;
@@ -200,11 +206,16 @@ pub struct Parts<'a> {
 impl<'a> Parts<'a> {
     /// Reads each axis of the description once; the parts borrow their grids from `desc`.
     pub fn of(desc: &'a SceneDescription, effects: Effects) -> Self {
+        Self::of_cached(desc, effects, &FactoryCache::new())
+    }
+
+    /// [`Parts::of`], with what `cache` knows of `desc`'s grids.
+    pub fn of_cached(desc: &'a SceneDescription, effects: Effects, cache: &FactoryCache) -> Self {
         let mut simplifications = Vec::new();
         let mut fired = |rule| simplifications.push(rule);
         let (medium, boundary, phase, environment) = match effects {
             Effects::Specialised => (
-                medium(desc, &mut fired),
+                medium(desc, cache, &mut fired),
                 boundary(desc, &mut fired),
                 phase(&desc.medium.phase, &mut fired),
                 environment(&desc.environment),
@@ -272,13 +283,25 @@ pub fn with_scene_as<V: SceneVisitor>(
     effects: Effects,
     visitor: V,
 ) -> V::Output {
+    with_scene_cached(desc, settings, effects, &FactoryCache::new(), visitor)
+}
+
+/// [`with_scene_as`] for a scene built again and again (its camera or parameters changed between
+/// renders): what `cache` knows of its grids is not computed again.
+pub fn with_scene_cached<V: SceneVisitor>(
+    desc: &SceneDescription,
+    settings: PathSettings,
+    effects: Effects,
+    cache: &FactoryCache,
+    visitor: V,
+) -> V::Output {
     let shared = Shared {
         camera: camera(&desc.camera, &desc.film),
         bounds: aabb(&desc.boundary.bounds),
         settings,
     };
-    let parts = Parts::of(desc, effects);
-    let derived = Derived::of(&parts, shared.bounds, &settings);
+    let parts = Parts::of_cached(desc, effects, cache);
+    let derived = Derived::of_cached(&parts, shared.bounds, &settings, cache);
     dispatch(shared, parts.with(&derived), visitor)
 }
 
@@ -286,7 +309,7 @@ pub fn with_scene_as<V: SceneVisitor>(
 /// medium and the sampling distribution of a lat-long map. Neither changes the variant.
 pub struct Derived {
     /// Per-cell majorants and the grid's resolution, if the medium tracks with a grid.
-    majorants: Option<(Vec<f32>, [u32; 3])>,
+    majorants: Option<Arc<Majorants>>,
     bounds: Aabb,
     /// The lat-long map's sampling distribution, for next-event estimation.
     distribution: Vec<f32>,
@@ -294,6 +317,16 @@ pub struct Derived {
 
 impl Derived {
     pub fn of(parts: &Parts<'_>, bounds: Aabb, settings: &PathSettings) -> Self {
+        Self::of_cached(parts, bounds, settings, &FactoryCache::new())
+    }
+
+    /// [`Derived::of`], the majorant grid from `cache` if it holds the one these parts need.
+    pub fn of_cached(
+        parts: &Parts<'_>,
+        bounds: Aabb,
+        settings: &PathSettings,
+        cache: &FactoryCache,
+    ) -> Self {
         let density = match &parts.medium {
             MediumPart::Homogeneous(_) => None,
             MediumPart::GridDensity(m) => Some((m.density, m.scale)),
@@ -305,15 +338,13 @@ impl Derived {
             .filter(|_| settings.majorant_resolution > 1)
             .map(|(density, scale)| {
                 let res = MajorantGrid::resolution_for(bounds, settings.majorant_resolution);
-                let mut data = vec![0.0; res.iter().map(|&r| r as usize).product()];
-                build_majorants(&density, scale, bounds, res, &mut data);
-                (data, res)
+                cache.majorants(&density, scale, bounds, res)
             })
             // A grid whose every cell has the global bound (a uniform density, as ad's) saves no
             // step and costs the walk: track with the global majorant.
-            .filter(|(data, _)| {
-                let global = data.iter().copied().fold(0.0, f32::max);
-                data.iter().any(|&m| m < global)
+            .filter(|m| {
+                let global = m.data.iter().copied().fold(0.0, f32::max);
+                m.data.iter().any(|&v| v < global)
             });
         let distribution = match &parts.environment {
             EnvironmentPart::LatLong(map) if settings.estimator == Estimator::NextEvent => {
@@ -333,7 +364,7 @@ impl Derived {
 
     /// The majorant grid's resolution, if the medium tracks with one.
     pub fn majorant_resolution(&self) -> Option<[u32; 3]> {
-        self.majorants.as_ref().map(|(_, res)| *res)
+        self.majorants.as_ref().map(|m| m.res)
     }
 }
 
@@ -343,7 +374,7 @@ impl<'a> Parts<'a> {
         let grid = derived
             .majorants
             .as_ref()
-            .map(|(data, res)| MajorantGrid::new(data, *res, derived.bounds));
+            .map(|m| MajorantGrid::new(&m.data, m.res, derived.bounds));
         match &mut self.medium {
             MediumPart::Homogeneous(_) => {}
             MediumPart::GridDensity(m) => m.majorants = grid,

@@ -38,23 +38,23 @@ impl fmt::Display for Simplification {
 
 /// The one value of `grid` per channel, if it has a single value everywhere and covers `bounds`
 /// (outside its own box a grid is zero, so a smaller grid is not constant over the medium).
-fn uniform<'g>(grid: &'g GridDesc, bounds: &Bounds) -> Option<&'g [f32]> {
+fn uniform<'g>(grid: &'g GridDesc, bounds: &Bounds, cache: &FactoryCache) -> Option<&'g [f32]> {
     let covers =
         (0..3).all(|i| grid.bounds.min[i] <= bounds.min[i] && grid.bounds.max[i] >= bounds.max[i]);
     let channels = grid.channels as usize;
     let first = grid.data.get(..channels)?;
-    let same = grid.data.chunks_exact(channels).all(|v| v == first);
-    (covers && same).then_some(first)
+    (covers && cache.is_uniform(&grid.data, channels)).then_some(first)
 }
 
 pub(super) fn medium<'a>(
     desc: &'a SceneDescription,
+    cache: &FactoryCache,
     fired: &mut dyn FnMut(Simplification),
 ) -> MediumPart<'a> {
     let medium = &desc.medium;
     let bounds = &desc.boundary.bounds;
     let density = match &medium.density {
-        DensityDesc::Grid(grid) => match uniform(grid, bounds) {
+        DensityDesc::Grid(grid) => match uniform(grid, bounds, cache) {
             Some(value) => {
                 fired(Simplification::ConstantDensityGrid);
                 Density::Constant(&value[0])
@@ -64,7 +64,7 @@ pub(super) fn medium<'a>(
         DensityDesc::Constant(sigma) => Density::Constant(sigma),
     };
     let albedo = match &medium.albedo {
-        AlbedoDesc::Grid(grid) => match uniform(grid, bounds) {
+        AlbedoDesc::Grid(grid) => match uniform(grid, bounds, cache) {
             Some(value) => {
                 fired(Simplification::ConstantAlbedoGrid);
                 Albedo::Constant(value)
