@@ -32,7 +32,7 @@ log "run.sh QUICK: $(grep -c '^== PASS' "$OUT/run/summary.txt") passed, $(grep -
 grep '^== FAIL' "$OUT/run/summary.txt" | tee -a "$OUT/facade.txt"
 
 for s in naive-sk regeneration-sk; do
-    R="scenes/cgg-logo/scene.xml -Dresolution=96 --seed 4 --backend cuda --strategy $s"
+    R="scenes/cgg-logo/scene.xml -Dresolution=96 --seed 4 --backend cuda --math exact --strategy $s"
     # shellcheck disable=SC2086
     "$VOLPT" render $R --spp 24 -o "$OUT/whole-$s.exr" >"$OUT/whole-$s.log" 2>&1
     # shellcheck disable=SC2086

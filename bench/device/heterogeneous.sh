@@ -28,7 +28,7 @@ SPP=${SPP:-100}          # bucky renders 3x this
 failures=0
 log() { echo "== $*" | tee -a "$OUT/summary.txt"; }
 if [ "$BACKEND" = cuda ]; then
-    GPU=(--backend cuda)
+    GPU=(--backend cuda --math exact)
     BENCH=(--backend cuda --strategy regeneration-sk)
 else
     GPU=()

@@ -83,7 +83,7 @@ SCENES=(
     "bucky:scenes/bucky/scene.toml:1K:-Ddata=$DATA"
 )
 COMMON=(--spp 4 --seed 7 --resolution 200x200)
-GPU=(--backend cuda --strategy naive-sk)
+GPU=(--backend cuda --math exact --strategy naive-sk)
 for entry in "${SCENES[@]}"; do
     IFS=: read -r scene file partial params <<<"$entry"
     [ -f "$file" ] || { log "SKIP $scene: $file not in this bundle"; continue; }
@@ -206,7 +206,7 @@ else
     fi
     log "   $(tail -n 2 "$WORK/logs/generate-big.log" 2>/dev/null | head -n 1)"
     scene_toml "$WORK/big.toml" "$BIG" "$bx" "$by" "$bz" 60
-    BIGRUN=(--spp 4 --seed 7 --resolution 256x256 --backend cuda --strategy naive-sk --memory-limit 16G)
+    BIGRUN=(--spp 4 --seed 7 --resolution 256x256 --backend cuda --math exact --strategy naive-sk --memory-limit 16G)
     : >"$OUT/big.txt"
     for p in "device:--volume-memory device" \
              "auto-2G:--volume-memory auto --device-memory-budget 2G" \

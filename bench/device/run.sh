@@ -56,7 +56,7 @@ for entry in "${SCENES[@]}"; do
         || { log "FAIL $name cpu render"; failures=$((failures + 1)); continue; }
     for s in "${STRATEGIES[@]}"; do
         # shellcheck disable=SC2086
-        if "$VOLPT" render "$file" $params --spp 4 --seed 7 --backend cuda --strategy "$s" \
+        if "$VOLPT" render "$file" $params --spp 4 --seed 7 --backend cuda --math exact --strategy "$s" \
             -o "$OUT/$name-$s.exr" >"$OUT/$name-$s.log" 2>&1; then
             if [ "$s" = naive-sk ]; then
                 check "$name-cpu-vs-$s" "$VOLPT" compare "$OUT/$name-cpu.exr" "$OUT/$name-$s.exr" --identical
@@ -89,7 +89,7 @@ fi
 
 # Checkpoints on the GPU: naive-sk resumed from a checkpoint equals its uninterrupted render bit for
 # bit. And a film too large for the card is a clear error (60000^2 pixels of f64 RGB: 86 GB).
-CK="scenes/cgg-logo/scene.xml -Dresolution=64 --seed 3 --backend cuda --strategy naive-sk"
+CK="scenes/cgg-logo/scene.xml -Dresolution=64 --seed 3 --backend cuda --math exact --strategy naive-sk"
 # shellcheck disable=SC2086
 if "$VOLPT" render $CK --spp 6 -o "$OUT/ck-whole.exr" >"$OUT/ck-whole.log" 2>&1 \
     && "$VOLPT" render $CK --spp 2 --checkpoint "$OUT/ck.ckpt" -o "$OUT/ck-part.exr" >"$OUT/ck-part.log" 2>&1 \

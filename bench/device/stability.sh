@@ -53,7 +53,7 @@ for entry in "${CASES[@]}"; do
     fi
     for s in naive-sk regeneration-sk; do
         # shellcheck disable=SC2086
-        if ! "$VOLPT" render "$SCENE" $params --spp 16 --seed 3 --backend cuda --strategy "$s" \
+        if ! "$VOLPT" render "$SCENE" $params --spp 16 --seed 3 --backend cuda --math exact --strategy "$s" \
             -o "$base-$s.exr" >"$base-$s.log" 2>&1; then
             log "FAIL $name $s: render: $(tail -n 1 "$base-$s.log")"; failures=$((failures + 1)); continue
         fi

@@ -92,7 +92,7 @@ if [ -z "${SKIP_CHECKS:-}" ]; then
             || { log "FAIL $name cpu render"; failures=$((failures + 1)); continue; }
         for s in "${STRATEGIES[@]}"; do
             # shellcheck disable=SC2086
-            if timeout "$T" "$VOLPT" render "$file" $params --spp 4 --seed 7 --backend cuda --strategy "$s" \
+            if timeout "$T" "$VOLPT" render "$file" $params --spp 4 --seed 7 --backend cuda --math exact --strategy "$s" \
                 -o "$OUT/$name-$s.exr" >"$OUT/$name-$s.log" 2>&1; then
                 # naive-sk sums each pixel's samples in the CPU's order, and so does naive-mk (one
                 # sample of every pixel per batch); the others add in the order paths end.
@@ -105,7 +105,7 @@ if [ -z "${SKIP_CHECKS:-}" ]; then
         done
         # Fast math: 16 spp with other seeds against exact math, as independent estimates.
         # shellcheck disable=SC2086
-        if timeout "$T" "$VOLPT" render "$file" $params --spp 16 --seed 11 --backend cuda -o "$OUT/$name-exact16.exr" \
+        if timeout "$T" "$VOLPT" render "$file" $params --spp 16 --seed 11 --backend cuda --math exact -o "$OUT/$name-exact16.exr" \
                 >"$OUT/$name-exact16.log" 2>&1 \
             && timeout "$T" "$VOLPT" render "$file" $params --spp 16 --seed 12 --backend cuda --math fast \
                 -o "$OUT/$name-fast16.exr" >"$OUT/$name-fast16.log" 2>&1; then

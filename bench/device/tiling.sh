@@ -32,14 +32,14 @@ SCENE=scenes/cgg-logo/scene.xml
     done
     small=(--resolution 97x61 --spp 4 --seed 7)
     "$VOLPT" render "$SCENE" "${small[@]}" -o "$WORK/cpu.exr" >/dev/null 2>&1
-    "$VOLPT" render "$SCENE" "${small[@]}" --backend cuda --strategy naive-sk -o "$WORK/naive.exr" >/dev/null 2>&1
+    "$VOLPT" render "$SCENE" "${small[@]}" --backend cuda --math exact --strategy naive-sk -o "$WORK/naive.exr" >/dev/null 2>&1
     for t in 2,3 7,5; do
-        "$VOLPT" render "$SCENE" "${small[@]}" --backend cuda --strategy naive-sk --tiles "$t" -o "$WORK/naive-$t.exr" >/dev/null 2>&1 \
+        "$VOLPT" render "$SCENE" "${small[@]}" --backend cuda --math exact --strategy naive-sk --tiles "$t" -o "$WORK/naive-$t.exr" >/dev/null 2>&1 \
             && "$VOLPT" compare "$WORK/naive.exr" "$WORK/naive-$t.exr" --identical >/dev/null 2>&1 \
             && echo "PASS naive-sk tiles $t: bit-identical to the whole film (and to the CPU: $("$VOLPT" compare "$WORK/cpu.exr" "$WORK/naive-$t.exr" --identical >/dev/null 2>&1 && echo yes || echo no))" \
             || echo "FAIL naive-sk tiles $t"
         for s in regeneration-sk regeneration-block-sk streaming-sk; do
-            "$VOLPT" render "$SCENE" "${small[@]}" --backend cuda --strategy "$s" --tiles "$t" -o "$WORK/$s-$t.exr" >/dev/null 2>&1 \
+            "$VOLPT" render "$SCENE" "${small[@]}" --backend cuda --math exact --strategy "$s" --tiles "$t" -o "$WORK/$s-$t.exr" >/dev/null 2>&1 \
                 && "$VOLPT" compare "$WORK/cpu.exr" "$WORK/$s-$t.exr" --max-relative 1e-6 >/dev/null 2>&1 \
                 && echo "PASS $s tiles $t: the CPU's image within 1e-6" \
                 || echo "FAIL $s tiles $t"

@@ -226,6 +226,7 @@ fn render_settings(
                         ("nearest", GridLookup::Nearest),
                         ("texture", GridLookup::Texture),
                         ("texture-f16", GridLookup::TextureHalf),
+                        ("stochastic", GridLookup::Stochastic),
                     ],
                 )?)
             }

@@ -63,7 +63,7 @@ def load(path: "str | os.PathLike[str]", settings: Optional[Mapping[str, Any]] =
     names and values: ``spp``, ``seed``, ``resolution`` ((width, height)), ``max_depth`` and
     ``rr_depth`` (-1: unlimited / never), ``tracking`` ("global", "grid"),
     ``majorant_resolution``, ``estimator`` ("pt", "nee"), ``lookup`` ("trilinear", "nearest",
-    "texture", "texture-f16"), ``roulette`` ("mitsuba", "throughput"), ``effects``
+    "texture", "texture-f16", "stochastic"), ``roulette`` ("mitsuba", "throughput"), ``effects``
     ("specialised", "general") and ``threads`` (CPU worker threads):
     ``volpt.load("cube.xml", {"resolution": (64, 48), "tracking": "grid"})``.
 

@@ -87,8 +87,8 @@ class Scene:
 
         ``backend``: ``"cpu"`` (every core) or ``"cuda"`` (GPU 0; opened once per process and
         reused). ``strategy`` (``STRATEGIES``; default: ``auto``'s cached choice or
-        regeneration-sk, as ``volpt render``) and ``math`` (``"exact"``, the CPU's bits, or
-        ``"fast"``) are the GPU's; the CPU refuses them.
+        regeneration-sk, as ``volpt render``) and ``math`` (``"fast"``, the default, statistically
+        equal, or ``"exact"``, the CPU's bits) are the GPU's; the CPU refuses them.
 
         ``progress``: ``True`` draws a bar on stderr; a callable is called ``progress(done,
         total)`` (paths) between chunks of samples, on the calling thread; an exception it raises

@@ -37,8 +37,9 @@ fn descriptions() -> Vec<SceneDescription> {
     };
     // The fourth medium's nearest-sample lookups select the any-layout grid medium (a constant
     // albedo becomes a one-voxel grid); a grid decoded with the other lookup renders a different
-    // image, so both lookups cross the ABI. The last reads textures of half-precision texels:
-    // decoded as f32 texels, its samples would differ.
+    // image, so both lookups cross the ABI. The fifth reads textures of half-precision texels:
+    // decoded as f32 texels, its samples would differ. The last reads one texel per lookup
+    // (stochastic): decoded as trilinear, it would read eight.
     let media = [
         (
             DensityDesc::Constant(2.0),
@@ -64,6 +65,11 @@ fn descriptions() -> Vec<SceneDescription> {
             DensityDesc::Grid(grid(1, grid_bounds, GridConvention::Cell)),
             AlbedoDesc::Grid(grid(3, grid_bounds, GridConvention::Vertex)),
             GridLookup::TextureHalf,
+        ),
+        (
+            DensityDesc::Grid(grid(1, grid_bounds, GridConvention::Vertex)),
+            AlbedoDesc::Grid(grid(3, grid_bounds, GridConvention::Cell)),
+            GridLookup::Stochastic,
         ),
     ];
     let boundaries = [

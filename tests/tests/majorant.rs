@@ -185,7 +185,8 @@ fn random_grid(cases: &mut Cases, channels: u32) -> GridDesc {
     }
 }
 
-/// The largest `sigma_t(p)` over `points` and the majorant, or the first point where a lookup is not a
+/// The largest `sigma_t(p)` over `points` (as the trackers read it, a stochastic lookup with
+/// random bits) and the majorant, or the first point where a lookup is not a
 /// finite non-negative number.
 struct LookupBound<'a> {
     points: &'a [Vec3],
@@ -196,8 +197,12 @@ impl SceneVisitor for LookupBound<'_> {
     fn visit<S: volpt_render::RenderScene>(self, scene: &S) -> Self::Output {
         let majorant = scene.medium().majorant();
         let mut largest = 0.0f32;
-        for &p in self.points {
-            let s = scene.medium().sigma_t(p);
+        for (i, &p) in self.points.iter().enumerate() {
+            // Random bits for a stochastic lookup (every other lookup ignores them).
+            let bits = (i as u64 + 1)
+                .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+                .rotate_left(29);
+            let s = scene.medium().sigma_t_random(p, bits);
             if !(s.is_finite() && s >= 0.0) {
                 return Err(p);
             }
@@ -270,6 +275,7 @@ fn majorant_bounds_every_lookup_the_renderer_can_make() {
             GridLookup::Nearest,
             GridLookup::Texture,
             GridLookup::TextureHalf,
+            GridLookup::Stochastic,
         ] {
             let medium = MediumDesc {
                 density: if constant_density {

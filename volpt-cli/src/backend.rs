@@ -70,8 +70,8 @@ pub struct GpuArgs {
     /// enough to repay it, else regeneration-sk).
     #[arg(long, value_enum)]
     pub strategy: Option<StrategyArg>,
-    /// GPU arithmetic: `exact` is bit-identical to the CPU (default), `fast` uses the GPU's
-    /// approximate instructions.
+    /// GPU arithmetic: `fast` (default) uses the GPU's approximate instructions, statistically
+    /// equal to `exact`, which is bit-identical to the CPU (with naive-sk).
     #[arg(long, value_enum)]
     pub math: Option<Math>,
     /// Cap the GPU kernel's registers per thread (the JIT spills the rest): more threads resident

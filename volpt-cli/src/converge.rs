@@ -377,7 +377,10 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         .with_context(|| format!("creating {}", args.out.display()))?;
     let reference = reference(args, &mut scene, &backend)?;
     drop(backend);
-    let scene_lookup = scene.description().medium.lookup;
+    // `--lookup`'s, if given; else each configuration's backend's default (`Backend::prepare`).
+    let scene_lookup = scene
+        .lookup_chosen()
+        .then(|| scene.description().medium.lookup);
     let (w, h) = scene.resolution();
 
     let mut results = Vec::new();
@@ -396,7 +399,8 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         let backend = config.sampling.open()?;
         scene.set_storage(GridStorage::Dense);
         backend.prepare(&mut scene);
-        scene.set_lookup(config.lookup.map_or(scene_lookup, Into::into))?;
+        let lookup = config.lookup.map(Into::into).or(scene_lookup);
+        scene.set_lookup(lookup.unwrap_or_else(|| backend.default_lookup(&scene)))?;
         scene.set_path_settings(config.settings);
         let film = Film::new(w, h).with_accumulation(config.accumulation.into());
         let mut halves = Halves {
@@ -714,7 +718,7 @@ mod tests {
         );
         assert_eq!(
             parse_setting("lookup=cubic").unwrap_err(),
-            "lookup: expected one of trilinear, nearest, texture, texture-f16, found \"cubic\""
+            "lookup: expected one of trilinear, nearest, texture, texture-f16, stochastic, found \"cubic\""
         );
 
         let scene = PathSettings::default();

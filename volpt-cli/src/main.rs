@@ -9,6 +9,7 @@ mod info;
 mod plot;
 mod volume;
 
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
@@ -139,7 +140,8 @@ struct SceneArgs {
     /// index-matched boundary, pt elsewhere; nee needs an index-matched boundary).
     #[arg(long, value_enum)]
     estimator: Option<EstimatorArg>,
-    /// How the medium's grids are reconstructed between samples (default: the scene's, trilinear).
+    /// How the medium's grids are reconstructed between samples (default: stochastic on a GPU
+    /// with fast math where textures fit in its memory, else trilinear).
     #[arg(long, value_enum)]
     lookup: Option<LookupArg>,
     /// Russian roulette's survival probability (default: mitsuba); where it starts is --rr-depth.
@@ -212,6 +214,9 @@ enum LookupArg {
     /// texture, of samples held in half precision (rounded toward zero; at most 65504).
     #[value(name = "texture-f16")]
     TextureF16,
+    /// One of the eight samples, chosen with probability its trilinear weight: an unbiased
+    /// estimate of trilinear for one read (on the GPU one unfiltered texel).
+    Stochastic,
 }
 
 impl From<LookupArg> for GridLookup {
@@ -221,6 +226,7 @@ impl From<LookupArg> for GridLookup {
             LookupArg::Nearest => GridLookup::Nearest,
             LookupArg::Texture => GridLookup::Texture,
             LookupArg::TextureF16 => GridLookup::TextureHalf,
+            LookupArg::Stochastic => GridLookup::Stochastic,
         }
     }
 }
@@ -625,7 +631,16 @@ fn render_command(args: RenderArgs) -> Result<()> {
             (film.image(spp), rendered.stats, spp)
         }
     };
-    println!("{}", summary(&image, spp, &stats, variant));
+    println!(
+        "{}",
+        summary(
+            &image,
+            spp,
+            &stats,
+            variant,
+            &configuration(&backend, &scene)
+        )
+    );
     match output {
         Some(output) => write_image(&image, &output, preview.as_deref()),
         None => Ok(()),
@@ -715,15 +730,54 @@ fn preview_for(output: &Path) -> Result<Option<PathBuf>> {
     Ok(Some(preview_path(output)))
 }
 
-fn summary(image: &Image, spp: u32, stats: &RenderStats, variant: Variant) -> String {
+/// Which configuration renders: the device, the GPU's strategy and math, and the grid lookup of a
+/// medium with grids (`--math`, `--lookup`; their defaults are the fastest correct ones).
+fn configuration(backend: &volpt::Backend, scene: &volpt::Scene) -> String {
+    let mut s = backend.device_name();
+    if let Some(strategy) = backend.strategy() {
+        let _ = write!(s, ", {strategy}");
+    }
+    if let Some(math) = backend.math() {
+        let _ = write!(s, ", {math} math");
+    }
+    let medium = &scene.description().medium;
+    let grids = matches!(
+        medium.density,
+        volpt_scene::description::DensityDesc::Grid(_)
+    ) || matches!(medium.albedo, volpt_scene::description::AlbedoDesc::Grid(_));
+    if grids {
+        let _ = write!(s, ", {} lookup", lookup_name(medium.lookup));
+    }
+    s
+}
+
+/// A lookup by its `--lookup` name.
+fn lookup_name(lookup: GridLookup) -> &'static str {
+    match lookup {
+        GridLookup::Trilinear => "trilinear",
+        GridLookup::Nearest => "nearest",
+        GridLookup::Texture => "texture",
+        GridLookup::TextureHalf => "texture-f16",
+        GridLookup::Stochastic => "stochastic",
+    }
+}
+
+fn summary(
+    image: &Image,
+    spp: u32,
+    stats: &RenderStats,
+    variant: Variant,
+    configuration: &str,
+) -> String {
     let c = &stats.counters;
     let mut s = format!(
-        "{}x{} at {} spp ({}) in {:.3} s: {:.3} M paths/s, {:.3} M segments/s, \
+        "{}x{} at {} spp ({}; {}) in {:.3} s: {:.3} M paths/s, {:.3} M segments/s, \
          {:.3} M tracking steps/s ({:.2} segments/path)",
         image.width,
         image.height,
         spp,
         variant,
+        configuration,
         stats.elapsed.as_secs_f64(),
         stats.paths_per_second() * 1e-6,
         stats.segments_per_second() * 1e-6,

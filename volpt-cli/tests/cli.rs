@@ -194,7 +194,17 @@ fn cuda_backend_without_a_gpu_is_a_clear_error() {
         args.extend(backend);
         (volpt(&args), file)
     };
-    let (out, gpu_file) = render("gpu.exr", &["--backend", "cuda", "--strategy", "naive-sk"]);
+    let (out, gpu_file) = render(
+        "gpu.exr",
+        &[
+            "--backend",
+            "cuda",
+            "--math",
+            "exact",
+            "--strategy",
+            "naive-sk",
+        ],
+    );
     if out.status.success() {
         let (cpu, cpu_file) = render("cpu.exr", &[]);
         assert!(cpu.status.success(), "{}", stderr(&cpu));

@@ -210,7 +210,7 @@ pub struct GridParams {
     pub offset: [f32; 3],
     /// [`GridLayout`], as [`GridLayout::to_u32`] writes it.
     pub layout: u32,
-    /// [`GridLookup`]: 0 trilinear, 1 nearest.
+    /// [`GridLookup`]: 0 trilinear, 1 nearest, 2 stochastic.
     pub lookup: u32,
     /// The texture object of a grid in a texture ([`GridPlacement::Texture`]), else 0.
     pub texture: u64,
@@ -225,6 +225,7 @@ impl GridLookup {
         match self {
             GridLookup::Trilinear => 0,
             GridLookup::Nearest => 1,
+            GridLookup::Stochastic => 2,
         }
     }
 
@@ -233,6 +234,8 @@ impl GridLookup {
     pub const fn from_code(code: u32) -> Self {
         if code == GridLookup::Nearest.code() {
             GridLookup::Nearest
+        } else if code == GridLookup::Stochastic.code() {
+            GridLookup::Stochastic
         } else {
             GridLookup::Trilinear
         }

@@ -142,6 +142,11 @@ pub enum GridLookup {
     Trilinear,
     /// The value of the nearest sample: one read instead of eight, a blockier field.
     Nearest,
+    /// One of the eight samples around a point, chosen with probability equal to its trilinear
+    /// weight ([`stochastic_corner`]): an unbiased estimate of `Trilinear`'s value for one read,
+    /// where the reader supplies random bits ([`Grid::lookup_random`]); without them
+    /// ([`Grid::lookup`]) it is `Trilinear`, the value it estimates.
+    Stochastic,
 }
 
 /// A grid of `C`-channel samples, ordered as its [`GridLayout`] says (dense: x fastest,
@@ -212,8 +217,19 @@ impl<'a, const C: usize> Grid<'a, C> {
         // One branch per lookup, not per corner: each layout gets its own copy of the
         // interpolation, and the dense copy is exactly the code of a grid without layouts.
         match self.layout {
-            GridLayout::Dense => self.interpolate(p, dense_index, self.lookup),
-            GridLayout::Bricked => self.interpolate(p, bricked_index, self.lookup),
+            GridLayout::Dense => self.interpolate(p, dense_index, self.lookup, None),
+            GridLayout::Bricked => self.interpolate(p, bricked_index, self.lookup, None),
+        }
+    }
+
+    /// [`Grid::lookup`], where a [`GridLookup::Stochastic`] grid reads the one sample that the
+    /// low 39 bits of `bits` choose (random bits independent of everything else the caller
+    /// draws); every other lookup ignores `bits` and is [`Grid::lookup`] bit for bit.
+    #[inline(always)]
+    pub fn lookup_random(&self, p: Vec3, bits: u64) -> [f32; C] {
+        match self.layout {
+            GridLayout::Dense => self.interpolate(p, dense_index, self.lookup, Some(bits)),
+            GridLayout::Bricked => self.interpolate(p, bricked_index, self.lookup, Some(bits)),
         }
     }
 
@@ -222,7 +238,7 @@ impl<'a, const C: usize> Grid<'a, C> {
     #[inline(always)]
     pub fn lookup_dense_trilinear(&self, p: Vec3) -> [f32; C] {
         debug_assert!(self.layout == GridLayout::Dense && self.lookup == GridLookup::Trilinear);
-        self.interpolate(p, dense_index, GridLookup::Trilinear)
+        self.interpolate(p, dense_index, GridLookup::Trilinear, None)
     }
 
     /// The index-space coordinates of the last sample along each axis.
@@ -236,7 +252,7 @@ impl<'a, const C: usize> Grid<'a, C> {
     }
 
     #[inline(always)]
-    fn interpolate<I>(&self, p: Vec3, index: I, lookup: GridLookup) -> [f32; C]
+    fn interpolate<I>(&self, p: Vec3, index: I, lookup: GridLookup, bits: Option<u64>) -> [f32; C]
     where
         I: Fn([u32; 3], u32, u32, u32) -> u32,
     {
@@ -255,15 +271,56 @@ impl<'a, const C: usize> Grid<'a, C> {
             .to_index_space(p)
             .max(Vec3::ZERO)
             .min(max_index);
-        match lookup {
-            GridLookup::Trilinear => trilinear(q, max_index, self.res, at),
-            GridLookup::Nearest => {
+        match (lookup, bits) {
+            (GridLookup::Nearest, _) => {
                 let n = q.round();
                 at(n.x as u32, n.y as u32, n.z as u32)
             }
+            (GridLookup::Stochastic, Some(bits)) => {
+                let [x, y, z] = stochastic_corner(q, max_index, self.res, bits);
+                at(x, y, z)
+            }
+            _ => trilinear(q, max_index, self.res, at),
         }
     }
 }
+
+/// The cell corner a stochastic trilinear lookup at index-space `q` (in `[0, max_index]`) reads:
+/// along each axis the upper sample with probability `f`, the fraction trilinear weighs it by,
+/// independently (13 bits of `bits` per axis), so that corner `c` is read with probability equal
+/// to its trilinear weight `prod f or (1 - f)`. Delta and ratio tracking use `sigma_t` only
+/// through `sigma_t / majorant`, linearly, and the albedo scales the throughput linearly, so the
+/// sample is an unbiased estimate of the trilinear value wherever it replaces it, and never above
+/// the largest sample (Pharr, Wronski, Salvi, Fajardo 2024, "Filtering After Shading With
+/// Stochastic Texture Filtering"). Each uniform is `(k + 0.5) / 2^13`: the probabilities are the
+/// weights rounded to the nearest multiple of 2^-13 (the f32 weights themselves carry 2^-15 of
+/// rounding at 256 samples per axis).
+#[inline(always)]
+pub fn stochastic_corner(q: Vec3, max_index: Vec3, res: [u32; 3], bits: u64) -> [u32; 3] {
+    const STEPS: f32 = (1u32 << STOCHASTIC_BITS) as f32;
+    const MASK: u64 = (1 << STOCHASTIC_BITS) - 1;
+    // The same cell and fractions as `trilinear`.
+    let base = q.floor().min((max_index - Vec3::ONE).max(Vec3::ZERO));
+    let f = q - base;
+    let axis = |base: f32, f: f32, shift: u32, res: u32| {
+        let u = ((bits >> shift) & MASK) as f32 * (1.0 / STEPS) + 0.5 / STEPS;
+        let lower = base as u32;
+        if u < f {
+            (lower + 1).min(res - 1)
+        } else {
+            lower
+        }
+    };
+    [
+        axis(base.x, f.x, 0, res[0]),
+        axis(base.y, f.y, STOCHASTIC_BITS, res[1]),
+        axis(base.z, f.z, 2 * STOCHASTIC_BITS, res[2]),
+    ]
+}
+
+/// Random bits per axis of [`stochastic_corner`]: 3 x 13 = 39, the low bits of a 64-bit random
+/// number whose top 24 bits make a uniform `f32` ([`crate::rng::Rng::next_f32`]).
+const STOCHASTIC_BITS: u32 = 13;
 
 /// How a grid medium reads its grids, fixed by the variant: a kernel then carries the code of
 /// one layout and one reconstruction instead of a branch between four copies of the
@@ -277,6 +334,13 @@ pub trait GridReads: Copy + Default + core::fmt::Debug {
     const PLACEMENT: GridPlacement;
 
     fn lookup<const C: usize>(grid: &Grid<'_, C>, p: Vec3) -> [f32; C];
+
+    /// [`GridReads::lookup`] with random `bits` for a [`GridLookup::Stochastic`] grid
+    /// ([`Grid::lookup_random`]); reads that fix the lookup to trilinear ignore them.
+    #[inline(always)]
+    fn lookup_random<const C: usize>(grid: &Grid<'_, C>, p: Vec3, _bits: u64) -> [f32; C] {
+        Self::lookup(grid, p)
+    }
 }
 
 /// Where a device keeps a grid, as the kernels that read it need.
@@ -373,6 +437,11 @@ impl GridReads for AnyLayout {
     fn lookup<const C: usize>(grid: &Grid<'_, C>, p: Vec3) -> [f32; C] {
         grid.lookup(p)
     }
+
+    #[inline(always)]
+    fn lookup_random<const C: usize>(grid: &Grid<'_, C>, p: Vec3, bits: u64) -> [f32; C] {
+        grid.lookup_random(p, bits)
+    }
 }
 
 /// Dense samples in a 3D texture, filtered trilinearly by the GPU's texture unit: one `tex`
@@ -382,6 +451,10 @@ impl GridReads for AnyLayout {
 /// axis: an accuracy/time knob (`docs/heterogeneous.md`), never the default. The CPU computes
 /// the documented filter from the samples ([`Grid::lookup_texture_filter`]); the GPU's differs
 /// from it by about a weight step at most (not bit for bit), measured by `volpt selftest`.
+///
+/// A [`GridLookup::Stochastic`] grid is read through the same texture, one texel at the centre of
+/// the chosen sample (where the filter's weights are exactly 1 and 0): the texture path's memory
+/// access with exact samples, so the CPU's software read of the same sample agrees bit for bit.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct TextureTrilinear;
 
@@ -404,7 +477,40 @@ impl GridReads for TextureTrilinear {
         }
         #[cfg(not(target_arch = "nvptx64"))]
         {
+            if grid.lookup == GridLookup::Stochastic {
+                // The value a stochastic lookup estimates (the GPU has no samples to compute it).
+                return grid.lookup(p);
+            }
             grid.lookup_texture_filter(p)
+        }
+    }
+
+    #[inline(always)]
+    fn lookup_random<const C: usize>(grid: &Grid<'_, C>, p: Vec3, bits: u64) -> [f32; C] {
+        if grid.lookup != GridLookup::Stochastic {
+            return Self::lookup(grid, p);
+        }
+        #[cfg(target_arch = "nvptx64")]
+        {
+            if !grid.mapping.bounds.contains(p) {
+                return [0.0; C];
+            }
+            let max_index = grid.max_index();
+            let q = grid
+                .mapping
+                .to_index_space(p)
+                .max(Vec3::ZERO)
+                .min(max_index);
+            let [x, y, z] = stochastic_corner(q, max_index, grid.res, bits);
+            let centre = Vec3::new(x as f32, y as f32, z as f32) + 0.5;
+            let t = texture_fetch(grid.texture, centre);
+            let mut v = [0.0; C];
+            v.copy_from_slice(&t[..C]);
+            v
+        }
+        #[cfg(not(target_arch = "nvptx64"))]
+        {
+            grid.lookup_random(p, bits)
         }
     }
 }

@@ -27,6 +27,21 @@ pub trait Medium {
     }
     fn sigma_t(&self, p: Vec3) -> f32;
     fn albedo(&self, p: Vec3) -> Spectrum;
+
+    /// An unbiased estimate of [`Medium::sigma_t`] at `p`, which may use the low 39 bits of
+    /// `bits` (random, independent of everything else the caller draws): a stochastic grid
+    /// lookup reads one sample instead of eight ([`crate::grid::GridLookup::Stochastic`]). The
+    /// trackers call this; every other medium returns `sigma_t(p)`.
+    #[inline(always)]
+    fn sigma_t_random(&self, p: Vec3, _bits: u64) -> f32 {
+        self.sigma_t(p)
+    }
+
+    /// [`Medium::albedo`] as an unbiased estimate, as [`Medium::sigma_t_random`].
+    #[inline(always)]
+    fn albedo_random(&self, p: Vec3, _bits: u64) -> Spectrum {
+        self.albedo(p)
+    }
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -63,6 +78,12 @@ pub trait AlbedoField {
     const CONSTANT: bool;
 
     fn albedo(&self, p: Vec3) -> Spectrum;
+
+    /// See [`Medium::albedo_random`].
+    #[inline(always)]
+    fn albedo_random(&self, p: Vec3, _bits: u64) -> Spectrum {
+        self.albedo(p)
+    }
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -89,6 +110,11 @@ impl<R: GridReads> AlbedoField for GridAlbedo<'_, R> {
     #[inline(always)]
     fn albedo(&self, p: Vec3) -> Spectrum {
         Spectrum::from_array(R::lookup(&self.0, p))
+    }
+
+    #[inline(always)]
+    fn albedo_random(&self, p: Vec3, bits: u64) -> Spectrum {
+        Spectrum::from_array(R::lookup_random(&self.0, p, bits))
     }
 }
 
@@ -128,6 +154,16 @@ impl<A: AlbedoField, R: GridReads> Medium for GridMedium<'_, A, R> {
     #[inline(always)]
     fn albedo(&self, p: Vec3) -> Spectrum {
         self.albedo.albedo(p)
+    }
+
+    #[inline(always)]
+    fn sigma_t_random(&self, p: Vec3, bits: u64) -> f32 {
+        self.scale * R::lookup_random(&self.density, p, bits)[0]
+    }
+
+    #[inline(always)]
+    fn albedo_random(&self, p: Vec3, bits: u64) -> Spectrum {
+        self.albedo.albedo_random(p, bits)
     }
 }
 

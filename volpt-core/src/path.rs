@@ -222,7 +222,8 @@ pub fn step<S: Scene>(scene: &S, path: &mut PathState) {
 /// [`step`] up to a real collision: one free flight and the event that ends it, unless that event
 /// is scattering in the medium, whose point it returns for [`scatter`]. The split lets a strategy
 /// fetch the albedo of many paths' collisions together (sorting-sk reads them in Morton order);
-/// the albedo draws no random number, so the path is the same either way.
+/// the albedo draws no random number (a stochastic lookup peeks at the next one,
+/// [`crate::rng::Rng::peek_u64`]), so the path is the same either way.
 #[inline(always)]
 pub fn fly<S: Scene>(scene: &S, path: &mut PathState) -> Option<Vec3> {
     advance::<S, true>(scene, path)
@@ -328,7 +329,9 @@ pub fn scatter<S: Scene>(scene: &S, path: &mut PathState, p: Vec3, albedo: Optio
     }
     path.throughput *= match albedo {
         Some(albedo) => albedo,
-        None => scene.medium().albedo(p),
+        // The low bits of the number the phase (or light) sample draws next: free random bits
+        // for a stochastic albedo lookup, independent of that sample's top 24 bits.
+        None => scene.medium().albedo_random(p, path.rng.peek_u64()),
     };
     if path.throughput == Spectrum::ZERO {
         // A black albedo absorbs the path: nothing it could gather would count.

@@ -18,6 +18,12 @@ fn mix64(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
+/// [`Rng::next_f32`] of a number already drawn: its top 24 bits as a uniform in [0, 1).
+#[inline(always)]
+pub fn unit_f32(r: u64) -> f32 {
+    (r >> 40) as f32 * (1.0 / (1u32 << 24) as f32)
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Rng {
     /// `key + dimension * golden`: the counter of SplitMix64, whose next number is `mix64` of
@@ -54,7 +60,15 @@ impl Rng {
     /// A uniform number in [0, 1): the top 24 bits, so every value is exactly representable.
     #[inline]
     pub fn next_f32(&mut self) -> f32 {
-        (self.next_u64() >> 40) as f32 * (1.0 / (1u32 << 24) as f32)
+        unit_f32(self.next_u64())
+    }
+
+    /// The number [`Rng::next_u64`] will return next, without drawing it: its low 40 bits are
+    /// independent of the top 24 that [`Rng::next_f32`] will use (a stochastic albedo lookup
+    /// reads them, so that a path draws the same numbers whatever the grid's lookup).
+    #[inline]
+    pub fn peek_u64(&self) -> u64 {
+        mix64(self.state.wrapping_add(GOLDEN_GAMMA))
     }
 
     #[inline]

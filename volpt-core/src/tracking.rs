@@ -4,7 +4,7 @@
 use crate::majorant::Dda;
 use crate::math::{exp, ln};
 use crate::medium::Medium;
-use crate::rng::Rng;
+use crate::rng::{unit_f32, Rng};
 use crate::Ray;
 
 /// How a free flight ends.
@@ -18,18 +18,20 @@ pub enum FreeFlight {
     OutOfSteps,
 }
 
-/// What a walk over the majorants does at each tentative collision: `stop_at(rng, t, majorant)`
-/// returns true to end the walk at distance `t`. Closures implement it (tests); the trackers use
+/// What a walk over the majorants does at each tentative collision: `stop_at(rng, t, majorant,
+/// bits)` returns true to end the walk at distance `t`; `bits` is the 64-bit number whose top 24
+/// bits drew `t`, so its low 40 are free random bits for a stochastic grid lookup at `t`
+/// ([`Medium::sigma_t_random`]). Closures implement it (tests); the trackers use
 /// named types whose method is always inlined, because the walk calls it from two loops and LLVM
 /// then keeps a closure's body as a function of its own, which on a GPU takes the medium, and the
 /// whole scene with it, by address into local memory (a ~500-byte stack frame per thread).
 pub trait TentativeCollision {
-    fn stop_at(&mut self, rng: &mut Rng, t: f32, majorant: f32) -> bool;
+    fn stop_at(&mut self, rng: &mut Rng, t: f32, majorant: f32, bits: u64) -> bool;
 }
 
 impl<F: FnMut(&mut Rng, f32, f32) -> bool> TentativeCollision for F {
     #[inline(always)]
-    fn stop_at(&mut self, rng: &mut Rng, t: f32, majorant: f32) -> bool {
+    fn stop_at(&mut self, rng: &mut Rng, t: f32, majorant: f32, _bits: u64) -> bool {
         self(rng, t, majorant)
     }
 }
@@ -69,7 +71,8 @@ pub fn walk_majorants<M: Medium>(
         let inv_majorant = 1.0 / majorant;
         let mut t = 0.0;
         loop {
-            t -= ln(1.0 - rng.next_f32()) * inv_majorant;
+            let bits = rng.next_u64();
+            t -= ln(1.0 - unit_f32(bits)) * inv_majorant;
             if t >= t_max {
                 return FreeFlight::Escaped;
             }
@@ -77,7 +80,7 @@ pub fn walk_majorants<M: Medium>(
                 return FreeFlight::OutOfSteps;
             }
             *steps += 1;
-            if at.stop_at(rng, t, majorant) {
+            if at.stop_at(rng, t, majorant, bits) {
                 return FreeFlight::Collision(t);
             }
         }
@@ -92,7 +95,8 @@ pub fn walk_majorants<M: Medium>(
             let inv_majorant = 1.0 / majorant;
             let mut t = start;
             loop {
-                t -= ln(1.0 - rng.next_f32()) * inv_majorant;
+                let bits = rng.next_u64();
+                t -= ln(1.0 - unit_f32(bits)) * inv_majorant;
                 if t >= end {
                     break;
                 }
@@ -100,7 +104,7 @@ pub fn walk_majorants<M: Medium>(
                     return FreeFlight::OutOfSteps;
                 }
                 *steps += 1;
-                if at.stop_at(rng, t, majorant) {
+                if at.stop_at(rng, t, majorant, bits) {
                     return FreeFlight::Collision(t);
                 }
             }
@@ -163,8 +167,9 @@ struct DeltaAcceptance<'a, M> {
 
 impl<M: Medium> TentativeCollision for DeltaAcceptance<'_, M> {
     #[inline(always)]
-    fn stop_at(&mut self, rng: &mut Rng, t: f32, majorant: f32) -> bool {
-        M::HOMOGENEOUS || rng.next_f32() * majorant < self.medium.sigma_t(self.ray.at(t))
+    fn stop_at(&mut self, rng: &mut Rng, t: f32, majorant: f32, bits: u64) -> bool {
+        M::HOMOGENEOUS
+            || rng.next_f32() * majorant < self.medium.sigma_t_random(self.ray.at(t), bits)
     }
 }
 
@@ -212,8 +217,8 @@ struct RatioProduct<'a, M> {
 
 impl<M: Medium> TentativeCollision for &mut RatioProduct<'_, M> {
     #[inline(always)]
-    fn stop_at(&mut self, rng: &mut Rng, t: f32, majorant: f32) -> bool {
-        self.transmittance *= 1.0 - self.medium.sigma_t(self.ray.at(t)) / majorant;
+    fn stop_at(&mut self, rng: &mut Rng, t: f32, majorant: f32, bits: u64) -> bool {
+        self.transmittance *= 1.0 - self.medium.sigma_t_random(self.ray.at(t), bits) / majorant;
         if self.transmittance < 0.125 {
             if rng.next_f32() < 0.5 {
                 self.transmittance *= 2.0;

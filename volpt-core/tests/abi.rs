@@ -117,7 +117,12 @@ fn settings_survive_the_device_encoding() {
 fn grid_lookups_travel_as_their_documented_codes() {
     assert_eq!(GridLookup::Trilinear.code(), 0);
     assert_eq!(GridLookup::Nearest.code(), 1);
-    for lookup in [GridLookup::Trilinear, GridLookup::Nearest] {
+    assert_eq!(GridLookup::Stochastic.code(), 2);
+    for lookup in [
+        GridLookup::Trilinear,
+        GridLookup::Nearest,
+        GridLookup::Stochastic,
+    ] {
         assert_eq!(GridLookup::from_code(lookup.code()), lookup);
     }
 }
@@ -239,7 +244,11 @@ fn a_grid_survives_the_device_encoding() {
         GridMapping::vertex_centred(bounds, res),
         GridMapping::cell_centred(bounds, res),
     ] {
-        for lookup in [GridLookup::Trilinear, GridLookup::Nearest] {
+        for lookup in [
+            GridLookup::Trilinear,
+            GridLookup::Nearest,
+            GridLookup::Stochastic,
+        ] {
             let grid: Grid<'_, 1> = Grid::new(&data, res, mapping).with_lookup(lookup);
             let mut in_place = |values: &[f32]| values.as_ptr() as u64;
             let params = GridParams::new(&grid, &mut in_place, GridPlacement::AnyLayout);

@@ -157,7 +157,11 @@ impl CudaRenderer {
         if !unsafe { sys::is_culib_present() } {
             return Err(CudaError::NoDriver);
         }
+        let started = Instant::now();
         let ctx = CudaContext::new(ordinal).doing("opening the GPU")?;
+        // Start-up's parts (with `RUST_LOG=volpt_cuda=debug`): this, the kernel's cut and JIT
+        // below, the first launch.
+        tracing::debug!(ordinal, context = ?started.elapsed(), "opened the GPU");
         let device_name = ctx.name().doing("reading the GPU's name")?;
         let multiprocessors = ctx
             .attribute(sys::CUdevice_attribute::CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT)
@@ -225,6 +229,11 @@ impl CudaRenderer {
 
     pub fn device_name(&self) -> &str {
         &self.device_name
+    }
+
+    /// The device memory free now (`cuMemGetInfo`), if the driver says.
+    pub fn free_memory(&self) -> Option<u64> {
+        self.ctx.mem_get_info().ok().map(|(free, _)| free as u64)
     }
 
     /// Renders `scene` as `schedule` says with the kernel of `S`, calling `progress(done, total)` in

@@ -132,6 +132,10 @@ pub enum GridLookup {
     Texture,
     /// `Texture` of samples held in half precision (rounded toward zero; at most 65504).
     TextureHalf,
+    /// One of the eight samples around a point, chosen with probability equal to its trilinear
+    /// weight: an unbiased estimate of `Trilinear` for one read (on a GPU through the texture
+    /// unit, one texel unfiltered; bricked grids in software).
+    Stochastic,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]

@@ -9,12 +9,13 @@ use volpt_render::factory::{
     MajorantChoice, MajorantRule, MediumKind, Parts,
 };
 use volpt_scene::{
-    AlbedoDesc, BsdfDesc, DensityDesc, EnvironmentDesc, GridDesc, PhaseDesc, SceneDescription,
+    AlbedoDesc, BsdfDesc, DensityDesc, EnvironmentDesc, GridDesc, GridLookup, PhaseDesc,
+    SceneDescription,
 };
 
 /// A scene described field by field, in `volpt info`'s order: `scene`, `variant`, `film`,
 /// `camera`, `integrator`, `bounds`, `boundary`, `density`, `majorant`, `tracking`, `estimator`,
-/// `albedo`, `phase`, `light`. A value of several lines (the variant's specialisations, the
+/// `albedo`, `lookup` (a medium with grids), `math`, `phase`, `light`. A value of several lines (the variant's specialisations, the
 /// tracking's default rule) has them separated by `\n`. [`fmt::Display`] writes `volpt info`'s
 /// text: each key in a column of 11 characters, later lines of a value indented to it.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -136,6 +137,30 @@ pub fn describe(
         AlbedoDesc::Grid(g) => grid(g),
     };
     field("albedo", albedo);
+    let grids =
+        matches!(m.density, DensityDesc::Grid(_)) || matches!(m.albedo, AlbedoDesc::Grid(_));
+    if grids {
+        let lookup = match m.lookup {
+            GridLookup::Trilinear => {
+                "trilinear (without --lookup, a GPU with fast math reads stochastic lookups \
+                 instead where the grids fit in its memory)"
+            }
+            GridLookup::Nearest => "nearest (biased: a blockier field)",
+            GridLookup::Texture => "texture (the texture unit's filter, 8-bit weights: biased)",
+            GridLookup::TextureHalf => "texture-f16 (half-precision texels, 8-bit weights: biased)",
+            GridLookup::Stochastic => {
+                "stochastic (one sample chosen by its trilinear weight: unbiased)"
+            }
+        };
+        field("lookup", lookup.to_owned());
+    }
+    field(
+        "math",
+        format!(
+            "GPU {} (default; --math exact computes the CPU's bits), CPU exact",
+            crate::backend::DEFAULT_GPU_MATH
+        ),
+    );
     let phase = match m.phase {
         PhaseDesc::Isotropic => "isotropic".to_owned(),
         PhaseDesc::HenyeyGreenstein { g } => format!("Henyey-Greenstein, g {g}"),

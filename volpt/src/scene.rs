@@ -35,6 +35,9 @@ pub struct Scene {
     /// set. A look-at frame forgets the up it was built from, and re-deriving it from the frame
     /// would roll the camera at every move.
     up: [f32; 3],
+    /// Whether the grid lookup was chosen (a setting, [`Scene::set_lookup`]) rather than left to
+    /// the backend's default ([`crate::Backend::prepare`]).
+    lookup_chosen: bool,
     /// What is known of the grids, which no method changes once the scene is built.
     data: Arc<DataFacts>,
 }
@@ -81,6 +84,7 @@ impl Clone for Scene {
             seed: self.seed,
             threads: self.threads,
             up: self.up,
+            lookup_chosen: self.lookup_chosen,
             data: Arc::new(data),
         }
     }
@@ -163,6 +167,7 @@ impl Scene {
             effects: settings.effects,
             seed: settings.seed,
             threads: settings.threads,
+            lookup_chosen: settings.lookup.is_some(),
             desc,
             data: Arc::new(DataFacts::new(checked)),
         })
@@ -246,10 +251,43 @@ impl Scene {
     }
 
     /// How the grids are reconstructed; refused where the grids' values do not fit the lookup.
+    /// A lookup set here is kept by [`crate::Backend::prepare`].
     pub fn set_lookup(&mut self, lookup: GridLookup) -> Result<(), Error> {
         let before = std::mem::replace(&mut self.desc.medium.lookup, lookup);
         check_lookup(&self.desc, self.data.checked)
             .inspect_err(|_| self.desc.medium.lookup = before)
+            .map(|()| self.lookup_chosen = true)
+    }
+
+    /// Whether the lookup was chosen, by a setting or [`Scene::set_lookup`].
+    pub fn lookup_chosen(&self) -> bool {
+        self.lookup_chosen
+    }
+
+    /// A backend's default lookup for a scene whose lookup nobody chose (every default lookup
+    /// fits every grid).
+    pub(crate) fn set_default_lookup(&mut self, lookup: GridLookup) {
+        debug_assert!(!self.lookup_chosen);
+        self.desc.medium.lookup = lookup;
+    }
+
+    /// The device bytes of the medium's grids as f32 textures (an RGB albedo takes four
+    /// channels; constants none).
+    pub(crate) fn texture_bytes(&self) -> u64 {
+        let bytes = |g: &volpt_scene::GridDesc| {
+            let channels = if g.channels == 1 { 1 } else { 4 };
+            g.resolution.iter().map(|&r| u64::from(r)).product::<u64>() * channels * 4
+        };
+        let m = &self.desc.medium;
+        let density = match &m.density {
+            DensityDesc::Grid(g) => bytes(g),
+            DensityDesc::Constant(_) => 0,
+        };
+        let albedo = match &m.albedo {
+            AlbedoDesc::Grid(g) => bytes(g),
+            AlbedoDesc::Constant(_) => 0,
+        };
+        density + albedo
     }
 
     /// How a GPU stores the grids (the backend's choice: [`crate::Backend::prepare`]).

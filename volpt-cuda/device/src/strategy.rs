@@ -505,6 +505,13 @@ fn step_with_sorted_albedo_reads<S: Scene>(scene: &S, path: &mut PathState, acti
         Some(p) => {
             // SAFETY: one point per thread of the block.
             unsafe { points.add(thread).write(p.to_array()) };
+            // The random bits of a stochastic albedo lookup (those `scatter` would peek at),
+            // parked in the albedo's slot for the lane that reads this point.
+            let bits = path.rng.peek_u64();
+            // SAFETY: as above; the slot holds 12 bytes.
+            unsafe {
+                (albedos.add(thread) as *mut [u32; 3]).write([bits as u32, (bits >> 32) as u32, 0])
+            };
             morton30(p, &scene.bounds())
         }
         None => INACTIVE_KEY,
@@ -514,7 +521,10 @@ fn step_with_sorted_albedo_reads<S: Scene>(scene: &S, path: &mut PathState, acti
     if sorted != INACTIVE_KEY {
         // SAFETY: `source` is a thread of the block that wrote its point.
         let p = Vec3::from_array(unsafe { points.add(source as usize).read() });
-        let albedo = scene.medium().albedo(p).to_array();
+        // SAFETY: the source lane wrote its bits before the sort's barriers.
+        let [lo, hi, _] = unsafe { (albedos.add(source as usize) as *const [u32; 3]).read() };
+        let bits = u64::from(lo) | (u64::from(hi) << 32);
+        let albedo = scene.medium().albedo_random(p, bits).to_array();
         // SAFETY: one albedo per thread of the block.
         unsafe { albedos.add(source as usize).write(albedo) };
     }

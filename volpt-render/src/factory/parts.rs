@@ -73,7 +73,7 @@ pub(super) fn medium<'a>(
         },
         AlbedoDesc::Constant(rgb) => Albedo::Constant(rgb),
     };
-    let dense_trilinear = texel(medium.lookup).is_none() && !any_layout(medium);
+    let dense_trilinear = !texture_reads(medium) && !any_layout(medium);
     match (density, albedo) {
         (Density::Constant(density), Albedo::Constant(albedo)) => {
             MediumPart::Homogeneous(HomogeneousMedium {
@@ -110,11 +110,21 @@ fn any_layout(medium: &MediumDesc) -> bool {
     medium.lookup == GridLookupDesc::Nearest || medium.storage != GridStorage::Dense
 }
 
+/// Whether the medium's grids are read through textures ([`TextureTrilinear`]): the texture
+/// lookups, and stochastic lookups of dense grids (one unfiltered texel; bricked grids are read
+/// in software by [`AnyLayout`]).
+fn texture_reads(medium: &MediumDesc) -> bool {
+    match medium.lookup {
+        GridLookupDesc::Stochastic => medium.storage == GridStorage::Dense,
+        lookup => texel(lookup).is_some(),
+    }
+}
+
 /// What a texture holds per sample, if the lookup reads grids through textures
 /// ([`TextureTrilinear`]).
 fn texel(lookup: GridLookupDesc) -> Option<TexelFormat> {
     match lookup {
-        GridLookupDesc::Texture => Some(TexelFormat::F32),
+        GridLookupDesc::Texture | GridLookupDesc::Stochastic => Some(TexelFormat::F32),
         GridLookupDesc::TextureHalf => Some(TexelFormat::F16),
         GridLookupDesc::Trilinear | GridLookupDesc::Nearest => None,
     }
@@ -142,7 +152,7 @@ fn albedo_grid_medium<'a>(
     density: Density<'a>,
     albedo: Grid<'a, 3>,
 ) -> MediumPart<'a> {
-    if texel(desc.medium.lookup).is_some() {
+    if texture_reads(&desc.medium) {
         MediumPart::GridTexture(grid_medium(
             desc,
             density,
@@ -290,9 +300,9 @@ fn grid<const C: usize>(g: &GridDesc, lookup: GridLookupDesc) -> Grid<'_, C> {
     };
     let grid =
         Grid::new(&g.data, g.resolution, mapping).with_texel(texel(lookup).unwrap_or_default());
-    if lookup == GridLookupDesc::Nearest {
-        grid.with_lookup(GridLookup::Nearest)
-    } else {
-        grid
+    match lookup {
+        GridLookupDesc::Nearest => grid.with_lookup(GridLookup::Nearest),
+        GridLookupDesc::Stochastic => grid.with_lookup(GridLookup::Stochastic),
+        _ => grid,
     }
 }
