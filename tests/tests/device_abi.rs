@@ -18,6 +18,7 @@ use volpt_tests::cube_scene;
 fn grid(channels: u32, bounds: Bounds, convention: GridConvention) -> GridDesc {
     let n = 4 * 3 * 2 * channels as usize;
     GridDesc {
+ layout: volpt_scene::SampleLayout::Dense,
         resolution: [4, 3, 2],
         channels,
         bounds,
