@@ -348,7 +348,7 @@ pub fn topology(c: &mut Cursor<'_>, d: &Descriptor, version: u32) -> Result<Topo
     if buffer_count != 1 {
         return Err(format!("the tree has {buffer_count} buffers: expected 1"));
     }
-    t.background = values(c, channels, false, "the background")?;
+    t.background = values(c, channels, "the background")?;
     let tiles = c.u32("the root's tile count")? as usize;
     let children = c.u32("the root's child count")? as usize;
     let tile_bytes = 12 + 4 * channels + 1;
@@ -360,7 +360,7 @@ pub fn topology(c: &mut Cursor<'_>, d: &Descriptor, version: u32) -> Result<Topo
     let root_dim = 1u32 << (LOG2[0] + LOG2[1] + LOG2[2]);
     for _ in 0..tiles {
         let origin = coord(c, "a root tile")?;
-        let value = values(c, channels, false, "a root tile")?;
+        let value = values(c, channels, "a root tile")?;
         c.u8("a root tile's state")?;
         if value != t.background {
             t.tiles.push(Tile {
@@ -396,12 +396,7 @@ fn coord(c: &mut Cursor<'_>, what: &str) -> Result<[i32; 3], Problem> {
 }
 
 /// `channels` plain `f32` values (backgrounds and root tiles are never stored as half).
-fn values(
-    c: &mut Cursor<'_>,
-    channels: usize,
-    _half: bool,
-    what: &str,
-) -> Result<Vec<f32>, Problem> {
+fn values(c: &mut Cursor<'_>, channels: usize, what: &str) -> Result<Vec<f32>, Problem> {
     (0..channels).map(|_| c.f32(what)).collect()
 }
 
@@ -499,7 +494,6 @@ fn compressed_values(
     what: &str,
 ) -> Result<Vec<f32>, Problem> {
     const NO_MASK_OR_INACTIVE_VALS: u8 = 0;
-    const NO_MASK_AND_MINUS_BG: u8 = 1;
     const NO_MASK_AND_ONE_INACTIVE_VAL: u8 = 2;
     const MASK_AND_NO_INACTIVE_VALS: u8 = 3;
     const MASK_AND_ONE_INACTIVE_VAL: u8 = 4;
@@ -522,9 +516,9 @@ fn compressed_values(
         meta,
         NO_MASK_AND_ONE_INACTIVE_VAL | MASK_AND_ONE_INACTIVE_VAL | MASK_AND_TWO_INACTIVE_VALS
     ) {
-        inactive0 = values(c, ch, false, what)?;
+        inactive0 = values(c, ch, what)?;
         if meta == MASK_AND_TWO_INACTIVE_VALS {
-            inactive1 = values(c, ch, false, what)?;
+            inactive1 = values(c, ch, what)?;
         }
     }
     let selection = if matches!(
@@ -535,7 +529,6 @@ fn compressed_values(
     } else {
         None
     };
-    let _ = NO_MASK_AND_MINUS_BG;
     let active_only = t.compression & COMPRESS_ACTIVE_MASK != 0 && meta != NO_MASK_AND_ALL_VALS;
     let stored = if active_only {
         value_mask.iter().map(|w| w.count_ones() as usize).sum()
@@ -544,7 +537,12 @@ fn compressed_values(
     };
     let scalar = if t.half { 2 } else { 4 };
     let bytes = stored * ch * scalar;
-    let raw = data(c, t.compression, bytes, scalar * ch, what)?;
+    // OpenVDB's HalfReader reads nothing at all for no values (its readData would read a length).
+    let raw = if t.half && stored == 0 {
+        Vec::new()
+    } else {
+        data(c, t.compression, bytes, what)?
+    };
     let read: Vec<f32> = if t.half {
         raw.chunks_exact(2)
             .map(|h| half::f16::from_le_bytes([h[0], h[1]]).to_f32())
@@ -577,10 +575,8 @@ fn data(
     c: &mut Cursor<'_>,
     compression: u32,
     bytes: usize,
-    typesize: usize,
     what: &str,
 ) -> Result<Vec<u8>, Problem> {
-    let _ = typesize;
     if compression & (COMPRESS_BLOSC | COMPRESS_ZIP) == 0 {
         return Ok(c.take(bytes, what)?.to_vec());
     }
