@@ -42,8 +42,9 @@ fn uniform<'g>(grid: &'g GridDesc, bounds: &Bounds) -> Option<&'g [f32]> {
     let covers =
         (0..3).all(|i| grid.bounds.min[i] <= bounds.min[i] && grid.bounds.max[i] >= bounds.max[i]);
     let channels = grid.channels as usize;
-    let first = grid.data.get(..channels)?;
-    let same = grid.data.chunks_exact(channels).all(|v| v == first);
+    let samples = grid.samples();
+    let first = samples.get(..channels)?;
+    let same = samples.chunks_exact(channels).all(|v| v == first);
     (covers && same).then_some(first)
 }
 
@@ -104,10 +105,14 @@ pub(super) fn medium<'a>(
 }
 
 /// Whether the medium's grids need the any-layout reads ([`AnyLayout`]): nearest-sample lookups,
-/// or bricked storage on a GPU. Every other grid is read dense and trilinear, with only that code
-/// in the kernel.
+/// bricked storage on a GPU, or a sparse grid. Every other grid is read dense and trilinear, with
+/// only that code in the kernel.
 fn any_layout(medium: &MediumDesc) -> bool {
-    medium.lookup == GridLookupDesc::Nearest || medium.storage != GridStorage::Dense
+    let sparse = |g: &GridDesc| g.layout == SampleLayout::Sparse;
+    medium.lookup == GridLookupDesc::Nearest
+        || medium.storage != GridStorage::Dense
+        || matches!(&medium.density, DensityDesc::Grid(g) if sparse(g))
+        || matches!(&medium.albedo, AlbedoDesc::Grid(g) if sparse(g))
 }
 
 /// What a texture holds per sample, if the lookup reads grids through textures
@@ -189,7 +194,7 @@ fn grid_medium<'a, R: GridReads>(
         Density::Grid(density) => grid::<1>(density, desc.medium.lookup),
         Density::Constant(sigma) => one_voxel(desc, std::slice::from_ref(sigma)),
     };
-    let max_density = density.data.iter().copied().fold(0.0, f32::max);
+    let max_density = density.samples().iter().copied().fold(0.0, f32::max);
     GridMedium {
         density,
         scale: desc.medium.scale,
@@ -288,8 +293,11 @@ fn grid<const C: usize>(g: &GridDesc, lookup: GridLookupDesc) -> Grid<'_, C> {
         GridConvention::Vertex => GridMapping::vertex_centred(bounds, g.resolution),
         GridConvention::Cell => GridMapping::cell_centred(bounds, g.resolution),
     };
-    let grid =
-        Grid::new(&g.data, g.resolution, mapping).with_texel(texel(lookup).unwrap_or_default());
+    let grid = match g.layout {
+        SampleLayout::Dense => Grid::new(&g.data, g.resolution, mapping),
+        SampleLayout::Sparse => Grid::sparse(&g.data, g.resolution, mapping),
+    }
+    .with_texel(texel(lookup).unwrap_or_default());
     if lookup == GridLookupDesc::Nearest {
         grid.with_lookup(GridLookup::Nearest)
     } else {
