@@ -165,3 +165,120 @@ pub fn check(grid: &GridDesc) -> Result<(), String> {
     }
     Ok(())
 }
+
+impl GridDesc {
+    /// The same grid in the sparse layout: bricks whose samples are all zero point at one zero
+    /// brick (slot 0), the others are stored; where no brick is all zero, slot 0 is the first
+    /// brick. Samples past the edge of the grid (padding, never read) repeat the edge, so that
+    /// the stored samples hold only the grid's own values. A sparse grid is returned as it is.
+    pub fn sparsified(&self) -> GridDesc {
+        if self.layout == SampleLayout::Sparse {
+            return self.clone();
+        }
+        let ch = self.channels as usize;
+        let [rx, ry, rz] = self.resolution;
+        let [bx, by, bz] = bricks(self.resolution);
+        let size = BRICK_SAMPLES * ch;
+        let mut bricks_data: Vec<Vec<f32>> = Vec::new();
+        let mut table = Vec::with_capacity((bx * by * bz) as usize);
+        let mut zero_slot = None;
+        for kz in 0..bz {
+            for ky in 0..by {
+                for kx in 0..bx {
+                    let mut brick = vec![0.0; size];
+                    for z in 0..BRICK {
+                        for y in 0..BRICK {
+                            for x in 0..BRICK {
+                                let at = |o: u32, v: u32, r: u32| (o * BRICK + v).min(r - 1);
+                                let (sx, sy, sz) = (at(kx, x, rx), at(ky, y, ry), at(kz, z, rz));
+                                for c in 0..ch {
+                                    brick[inner(x, y, z) * ch + c] =
+                                        self.sample(sx, sy, sz, c as u32);
+                                }
+                            }
+                        }
+                    }
+                    let slot = if brick.iter().all(|&v| v == 0.0) {
+                        *zero_slot.get_or_insert_with(|| {
+                            bricks_data.push(brick);
+                            bricks_data.len() - 1
+                        })
+                    } else {
+                        bricks_data.push(brick);
+                        bricks_data.len() - 1
+                    };
+                    table.push(slot);
+                }
+            }
+        }
+        // Slot 0 is the brick empty regions point at: the zero brick, if there is one.
+        if let Some(zero) = zero_slot.filter(|&z| z != 0) {
+            bricks_data.swap(0, zero);
+            for slot in &mut table {
+                *slot = match *slot {
+                    s if s == zero => 0,
+                    0 => zero,
+                    s => s,
+                };
+            }
+        }
+        let mut data: Vec<f32> = bricks_data.into_iter().flatten().collect();
+        data.extend(table.into_iter().map(|s| f32::from_bits(s as u32)));
+        GridDesc {
+            data,
+            layout: SampleLayout::Sparse,
+            ..self.clone_header()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::description::{Bounds, GridConvention, GridDesc, SampleLayout};
+
+    fn grid(res: [u32; 3], channels: u32, f: impl Fn(u32, u32, u32, u32) -> f32) -> GridDesc {
+        let mut data = Vec::new();
+        for z in 0..res[2] {
+            for y in 0..res[1] {
+                for x in 0..res[0] {
+                    for c in 0..channels {
+                        data.push(f(x, y, z, c));
+                    }
+                }
+            }
+        }
+        GridDesc {
+            resolution: res,
+            channels,
+            bounds: Bounds {
+                min: [0.0; 3],
+                max: [1.0; 3],
+            },
+            convention: GridConvention::Cell,
+            data,
+            layout: SampleLayout::Dense,
+        }
+    }
+
+    #[test]
+    fn sparsified_grids_hold_the_same_samples_and_densify_back() {
+        for (res, channels) in [([20, 9, 17], 1), ([8, 8, 8], 3), ([30, 3, 9], 3)] {
+            // Zero except a slab: most bricks are empty.
+            let dense = grid(res, channels, |x, y, z, c| {
+                if x >= 9 && x < 14 {
+                    (x + 2 * y + 3 * z + c) as f32 * 0.5
+                } else {
+                    0.0
+                }
+            });
+            let sparse = dense.sparsified();
+            super::check(&sparse).unwrap();
+            assert_eq!(sparse.densified(), dense, "{res:?}");
+            assert!(sparse.samples().len() < sparse.data.len());
+        }
+        let uniform = grid([9, 9, 9], 1, |_, _, _, _| 2.5);
+        let sparse = uniform.sparsified();
+        assert!(sparse.samples().iter().all(|&v| v == 2.5), "padding repeats the edge");
+        assert_eq!(sparse.densified(), uniform);
+    }
+}
