@@ -9,10 +9,15 @@ use volpt_scene::raw::{read_raw, RawLayout, ScalarType};
 use volpt_scene::vdb::{list_grids, read_vdb, Sparsity, VdbOptions};
 use volpt_scene::{Bounds, GridDesc, SceneError};
 
+/// The committed fixtures, or those `scripts/vdb-fixtures.sh` has just written with OpenVDB
+/// (`VOLPT_VDB_FIXTURES`, set by CI).
 fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../scenes/vdb/fixtures")
-        .join(name)
+    match std::env::var_os("VOLPT_VDB_FIXTURES") {
+        Some(dir) => PathBuf::from(dir).join(name),
+        None => Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../scenes/vdb/fixtures")
+            .join(name),
+    }
 }
 
 fn read(name: &str, grid: Option<&str>, sparsity: Sparsity) -> GridDesc {
@@ -187,7 +192,8 @@ fn truncated_and_corrupted_files_are_errors_not_panics() {
             }
         }
     }
-    let error = read_vdb(&fixture("../../bucky/Bucky.raw"), &VdbOptions::default()).unwrap_err();
+    let bucky = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/bucky/Bucky.raw");
+    let error = read_vdb(&bucky, &VdbOptions::default()).unwrap_err();
     assert!(
         matches!(error, SceneError::Grid { .. }) && error.to_string().contains("magic number"),
         "{error}"
