@@ -109,26 +109,26 @@ def sparse_cloud(out):
 
 
 def large_cloud(out, n, seed=7):
-    """Clouds of smooth blobs filling a few percent of an n^3 box, leaf by leaf (fast enough in
-    Python for tens of millions of voxels): the benchmark's sparse volume, never committed."""
+    """Smooth blobs filling a few percent of an n^3 box: the benchmark's sparse volume, never
+    committed. One blob in each of 24 of the 27 cells of a 3^3 lattice, so that no two blobs'
+    arrays overlap (copyFromArray overwrites); values quantised to 1/64, as simulation output
+    often is, so that blosc finds repeats."""
     rng = np.random.default_rng(seed)
     grid = vdb.FloatGrid(0.0)
-    blobs = []
-    for _ in range(24):
-        c = rng.uniform(0.15 * n, 0.85 * n, 3)
-        r = rng.uniform(0.03 * n, 0.07 * n)
-        blobs.append((c, r))
-    for c, r in blobs:
+    cell = n / 3.0
+    cells = [(a, b, c) for a in range(3) for b in range(3) for c in range(3)]
+    for index in rng.permutation(len(cells))[:24]:
+        r = rng.uniform(0.06 * n, 0.08 * n)
+        c = np.array(cells[index], dtype=float) * cell + cell / 2 + rng.uniform(-0.05, 0.05, 3) * n
         lo = np.maximum(np.floor(c - r).astype(int), 0)
         hi = np.minimum(np.ceil(c + r).astype(int) + 1, n)
-        i, j, k = np.meshgrid(*[np.arange(lo[a], hi[a]) for a in range(3)], indexing="ij")
+        i, j, k = np.meshgrid(*[np.arange(lo[a], hi[a]) for a in range(3)], indexing="ij",
+                              sparse=True)
         d2 = ((i - c[0]) ** 2 + (j - c[1]) ** 2 + (k - c[2]) ** 2) / (r * r)
-        values = np.where(d2 < 1.0, (1.0 - d2) ** 2 * 4.0, 0.0).astype(np.float32)
-        # Quantised so that blosc finds repeats, as simulation output does after its own rounding.
+        values = np.where(d2 < 1.0, (1.0 - d2) ** 2 * 4.0, 0.0)
         values = (np.round(values * 64.0) / 64.0).astype(np.float32)
-        part = vdb.FloatGrid(0.0)
-        part.copyFromArray(values, ijk=tuple(int(v) for v in lo), tolerance=0.0)
-        grid.combine(part, lambda a, b: max(a, b))
+        grid.copyFromArray(values, ijk=tuple(int(v) for v in lo), tolerance=0.0)
+        del values, d2
     grid.name = "density"
     grid.transform = vdb.createLinearTransform(voxelSize=1.0 / n)
     path = os.path.join(out, f"large-cloud-{n}.vdb")

@@ -278,7 +278,10 @@ mod tests {
         }
         let uniform = grid([9, 9, 9], 1, |_, _, _, _| 2.5);
         let sparse = uniform.sparsified();
-        assert!(sparse.samples().iter().all(|&v| v == 2.5), "padding repeats the edge");
+        assert!(
+            sparse.samples().iter().all(|&v| v == 2.5),
+            "padding repeats the edge"
+        );
         assert_eq!(sparse.densified(), uniform);
     }
 }

@@ -9,6 +9,15 @@ fn scenes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes")
 }
 
+/// The committed fixtures, or those `scripts/vdb-fixtures.sh` has just written with OpenVDB
+/// (`VOLPT_VDB_FIXTURES`, set by CI).
+fn fixture(name: &str) -> PathBuf {
+    match std::env::var_os("VOLPT_VDB_FIXTURES") {
+        Some(dir) => PathBuf::from(dir).join(name),
+        None => scenes().join("vdb/fixtures").join(name),
+    }
+}
+
 fn small() -> RenderSettings {
     RenderSettings {
         resolution: Some((16, 16)),
@@ -45,10 +54,11 @@ fn bucky_from_vdb_renders_bit_for_bit_as_bucky_raw() {
     let raw = Scene::load(scenes().join("bucky/scene.toml"), &small()).unwrap();
     let expected = render(&raw);
     assert!(expected.sums.iter().any(|s| s[0] > 0.0));
-    for vdb in ["fixtures/bucky.vdb", "fixtures/bucky-half.vdb"] {
+    for vdb in ["bucky.vdb", "bucky-half.vdb"] {
+        let file = fixture(vdb).display().to_string();
         let scene = Scene::load(
             scenes().join("vdb/bucky.toml"),
-            &with(small(), &[("vdb", vdb)]),
+            &with(small(), &[("vdb", &file)]),
         )
         .unwrap();
         let info = scene.info();
@@ -68,7 +78,7 @@ fn bucky_from_vdb_renders_bit_for_bit_as_bucky_raw() {
 #[test]
 fn a_sparse_cloud_renders_as_its_dense_copy() {
     let dir = tempfile::tempdir().unwrap();
-    let cloud = scenes().join("vdb/fixtures/cloud-rgb.vdb");
+    let cloud = fixture("cloud-rgb.vdb");
     let load = |sparse: &str| {
         let path = dir.path().join(format!("{sparse}.toml"));
         std::fs::write(
@@ -111,7 +121,7 @@ fn a_bare_vdb_file_renders_sparse() {
         spp: Some(1),
         ..RenderSettings::default()
     };
-    let scene = Scene::load(scenes().join("vdb/fixtures/sparse-cloud.vdb"), &settings).unwrap();
+    let scene = Scene::load(fixture("sparse-cloud.vdb"), &settings).unwrap();
     let memory = scene.info().get("memory").unwrap().to_owned();
     assert!(memory.contains("dense 512.00 MiB"), "{memory}");
     render(&scene);
