@@ -189,7 +189,7 @@ fn assemble(path: &Path, params: Vec<(String, String)>) {
 
 fn small_grid() -> GridDesc {
     GridDesc {
- layout: volpt_scene::SampleLayout::Dense,
+        layout: volpt_scene::SampleLayout::Dense,
         resolution: [2, 2, 2],
         channels: 1,
         bounds: Bounds {

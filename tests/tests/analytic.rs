@@ -69,7 +69,7 @@ fn wavy_density_grid(convention: GridConvention) -> GridDesc {
         }
     }
     GridDesc {
- layout: volpt_scene::SampleLayout::Dense,
+        layout: volpt_scene::SampleLayout::Dense,
         resolution: res,
         channels: 1,
         bounds: Bounds {

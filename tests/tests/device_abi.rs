@@ -18,7 +18,7 @@ use volpt_tests::cube_scene;
 fn grid(channels: u32, bounds: Bounds, convention: GridConvention) -> GridDesc {
     let n = 4 * 3 * 2 * channels as usize;
     GridDesc {
- layout: volpt_scene::SampleLayout::Dense,
+        layout: volpt_scene::SampleLayout::Dense,
         resolution: [4, 3, 2],
         channels,
         bounds,
@@ -212,7 +212,12 @@ fn every_variant_with_bricked_grids_renders_bit_for_bit() {
 #[test]
 fn every_variant_with_sparse_grids_renders_bit_for_bit() {
     let mut descs = descriptions();
-    descs.retain(|d| !matches!(d.medium.lookup, GridLookup::Texture | GridLookup::TextureHalf));
+    descs.retain(|d| {
+        !matches!(
+            d.medium.lookup,
+            GridLookup::Texture | GridLookup::TextureHalf
+        )
+    });
     for desc in &mut descs {
         if let DensityDesc::Grid(g) = &mut desc.medium.density {
             *g = g.sparsified();

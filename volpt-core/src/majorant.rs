@@ -171,12 +171,23 @@ fn sparse_max(density: &Grid<'_, 1>, ranges: [RangeInclusive<u32>; 3]) -> f32 {
                     continue;
                 }
                 let clip = |r: &RangeInclusive<u32>, o: u32| {
-                    (*r.start()).max(o)..=(*r.end()).min(o + BRICK - 1)
+                    (*r.start()).max(o) - o..=(*r.end()).min(o + BRICK - 1) - o
                 };
-                for z in clip(&rz, z0) {
-                    for y in clip(&ry, y0) {
-                        for x in clip(&rx, x0) {
-                            max = max.max(density.sample(x, y, z)[0]);
+                // The brick's samples, read directly: one table lookup per brick, not per sample.
+                let samples = (BRICK * BRICK * BRICK) as usize;
+                let brick = &density.data[slot as usize * samples..][..samples];
+                let (cx, cy, cz) = (clip(&rx, x0), clip(&ry, y0), clip(&rz, z0));
+                let whole = |r: &RangeInclusive<u32>| *r.start() == 0 && *r.end() == BRICK - 1;
+                if whole(&cx) && whole(&cy) && whole(&cz) {
+                    // Most bricks lie inside the cell's range: one pass over 512 contiguous values.
+                    max = brick.iter().fold(max, |m, &v| m.max(v));
+                    continue;
+                }
+                for z in cz {
+                    for y in cy.clone() {
+                        let row = ((z * BRICK + y) * BRICK) as usize;
+                        for x in cx.clone() {
+                            max = max.max(brick[row + x as usize]);
                         }
                     }
                 }

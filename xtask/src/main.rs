@@ -297,7 +297,10 @@ fn device_bundle() -> Result<()> {
         copy_dir(&vdb_bench, &bundle.join("vdb-bench"), &|p| {
             let large = p.metadata().is_ok_and(|m| m.len() > 48 << 20);
             if large {
-                eprintln!("xtask: leaving {} (over 48 MiB) out of the bundle", p.display());
+                eprintln!(
+                    "xtask: leaving {} (over 48 MiB) out of the bundle",
+                    p.display()
+                );
             }
             large || p.extension().is_none_or(|e| e != "vdb")
         })?;
