@@ -199,3 +199,48 @@ fn truncated_and_corrupted_files_are_errors_not_panics() {
         "{error}"
     );
 }
+
+/// A Mitsuba 3 `gridvolume` whose file is a `.vdb`: the grid (chosen by `grid`), on the box its
+/// own transform gives, then moved by `to_world`; an albedo `gridvolume` reads the vec3 grid.
+#[test]
+fn a_mitsuba_gridvolume_reads_a_vdb() {
+    let dir = tempfile::tempdir().unwrap();
+    let xml = dir.path().join("scene.xml");
+    let (transform, cloud) = (fixture("transform.vdb"), fixture("cloud-rgb.vdb"));
+    std::fs::write(
+        &xml,
+        format!(
+            r#"<scene version="3.0.0">
+    <sensor type="perspective"><float name="fov" value="30"/></sensor>
+    <medium type="heterogeneous" id="m">
+        <volume name="sigma_t" type="gridvolume">
+            <string name="filename" value="{}"/>
+            <string name="grid" value="smoke"/>
+            <transform name="to_world"><translate value="10, 0, 0"/></transform>
+        </volume>
+        <volume name="albedo" type="gridvolume">
+            <string name="filename" value="{}"/>
+        </volume>
+    </medium>
+    <shape type="cube"><bsdf type="null"/><ref name="interior" id="m"/></shape>
+</scene>"#,
+            transform.display(),
+            cloud.display()
+        ),
+    )
+    .unwrap();
+    let desc = volpt_scene::load_mitsuba(&xml).unwrap_or_else(|e| panic!("{e}"));
+    let volpt_scene::DensityDesc::Grid(density) = &desc.medium.density else {
+        panic!("a grid density");
+    };
+    assert_eq!(density.resolution, [16, 8, 24]);
+    assert_eq!(density.convention, GridConvention::Cell);
+    assert_eq!(
+        density.bounds.min,
+        [10.0 + 1.0 + 0.5 * -8.5, 2.0 + 0.25 * 15.5, 2.0]
+    );
+    let volpt_scene::AlbedoDesc::Grid(albedo) = &desc.medium.albedo else {
+        panic!("a grid albedo");
+    };
+    assert_eq!((albedo.channels, albedo.resolution), (3, [24; 3]));
+}
