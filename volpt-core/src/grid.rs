@@ -241,7 +241,7 @@ impl<'a, const C: usize> Grid<'a, C> {
         let brick = (BRICK * BRICK * BRICK) as usize * C;
         let table = sparse_table_len(res).expect("sparse grid table overflows") as usize;
         assert!(
-            data.len() >= table + brick && (data.len() - table) % brick == 0,
+            data.len() >= table + brick && (data.len() - table).is_multiple_of(brick),
             "sparse grid data does not match its resolution"
         );
         let slots = (data.len() - table) / brick;
@@ -823,10 +823,7 @@ mod tests {
             let grid = Grid::<1>::sparse(&sparse, res, mapping);
             crate::majorant::build_majorants(&grid, 2.0, bounds, cells, &mut b);
             assert_eq!(a, b, "{cells:?}");
-            assert!(
-                a.iter().any(|&m| m == 0.0),
-                "{cells:?}: no empty cell tested"
-            );
+            assert!(a.contains(&0.0), "{cells:?}: no empty cell tested");
         }
     }
 

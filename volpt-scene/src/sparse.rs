@@ -145,7 +145,7 @@ pub fn check(grid: &GridDesc) -> Result<(), String> {
             grid.data.len()
         ));
     };
-    if brick == 0 || stored < brick || stored % brick != 0 {
+    if brick == 0 || stored < brick || !stored.is_multiple_of(brick) {
         return Err(format!(
             "{stored} stored values are not whole bricks of {brick} values (at least one)"
         ));
@@ -265,7 +265,7 @@ mod tests {
         for (res, channels) in [([20, 9, 17], 1), ([8, 8, 8], 3), ([30, 3, 9], 3)] {
             // Zero except a slab: most bricks are empty.
             let dense = grid(res, channels, |x, y, z, c| {
-                if x >= 9 && x < 14 {
+                if (9..14).contains(&x) {
                     (x + 2 * y + 3 * z + c) as f32 * 0.5
                 } else {
                     0.0
