@@ -238,10 +238,12 @@ pub fn seeds(target: Target) -> Vec<Vec<u8>> {
             join(&[&fixture("scenes/example/cube.xml")]),
         ],
         // Files written by the real OpenVDB library (scenes/vdb/make_fixtures.py): float and half
-        // leaves, blosc, transforms, a vec3 grid, a sparse box.
+        // leaves, blosc, zip and uncompressed, transforms, a vec3 grid, a sparse box.
         Target::Vdb => [
             "bucky.vdb",
             "bucky-half.vdb",
+            "bucky-zip.vdb",
+            "bucky-half-none.vdb",
             "halves.vdb",
             "transform.vdb",
             "cloud-rgb.vdb",

@@ -11,6 +11,10 @@ said otherwise):
   (-0.5 + (i + 0.5) / 32, ...), so the grid's box is scenes/bucky's [-0.5, 0.5]^3; zero voxels are
   inactive background (pruned leaves), the 8 corner voxels active so the stored box is the whole
   32^3 grid. bucky-half.vdb: the same, leaves saved as half (integers up to 2048 are exact).
+- bucky-zip.vdb (float leaves, zip with active-mask compression) and bucky-half-none.vdb (half
+  leaves, uncompressed): bucky.vdb and bucky-half.vdb rewritten by OpenVDB's C++ library with
+  another compression (recompress.cc, built here with g++ against Debian's libopenvdb-dev: the
+  Python module does not expose the file's compression).
 - halves.vdb: a 16^3 float grid "density" of values (i + j + k) * 0.1 + 0.01, saved as half,
   so that values are rounded to half by OpenVDB.
 - transform.vdb: a float grid "smoke" (and a second float grid "other") over index box
@@ -22,7 +26,9 @@ said otherwise):
 
 import math
 import os
+import subprocess
 import sys
+import tempfile
 
 import numpy as np
 import pyopenvdb as vdb
@@ -138,6 +144,18 @@ def large_cloud(out, n, seed=7):
           f"{os.path.getsize(path)} bytes")
 
 
+def recompress(out):
+    """bucky.vdb as zip, bucky-half.vdb uncompressed, by OpenVDB's own C++ writer."""
+    with tempfile.TemporaryDirectory() as tmp:
+        tool = os.path.join(tmp, "recompress")
+        subprocess.run(["g++", "-std=c++17", "-O1", os.path.join(HERE, "recompress.cc"), "-o", tool,
+                        "-lopenvdb", "-ltbb"], check=True)
+        for source, target, how in [("bucky.vdb", "bucky-zip.vdb", "zip"),
+                                    ("bucky-half.vdb", "bucky-half-none.vdb", "none")]:
+            subprocess.run([tool, os.path.join(out, source), os.path.join(out, target), how],
+                           check=True)
+
+
 def main():
     out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
@@ -146,6 +164,7 @@ def main():
         return
     bucky(out, half=False)
     bucky(out, half=True)
+    recompress(out)
     halves(out)
     transform(out)
     cloud_rgb(out)

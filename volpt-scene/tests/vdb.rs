@@ -48,7 +48,21 @@ fn bucky_raw() -> GridDesc {
 #[test]
 fn bucky_vdb_holds_the_raw_grid_in_its_box() {
     let raw = bucky_raw();
-    for name in ["bucky.vdb", "bucky-half.vdb"] {
+    // OpenVDB records each grid's compression in its metadata (`file_compression`).
+    for (name, compression) in [
+        ("bucky.vdb", "blosc + active values"),
+        ("bucky-half.vdb", "blosc + active values"),
+        ("bucky-zip.vdb", "zip + active values"),
+        ("bucky-half-none.vdb", "none"),
+    ] {
+        let bytes = std::fs::read(fixture(name)).unwrap();
+        let said = format!("file_compression\x06\0\0\0string{}\0\0\0{compression}", {
+            char::from(compression.len() as u8)
+        });
+        assert!(
+            bytes.windows(said.len()).any(|w| w == said.as_bytes()),
+            "{name} is not {compression}"
+        );
         let sparse = read(name, None, Sparsity::Always);
         assert_eq!(sparse.layout, SampleLayout::Sparse);
         assert_eq!(sparse.resolution, [32; 3], "{name}");
@@ -165,7 +179,14 @@ fn a_vec3_grid_is_an_rgb_albedo() {
 fn truncated_and_corrupted_files_are_errors_not_panics() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("bad.vdb");
-    for name in ["bucky.vdb", "halves.vdb", "transform.vdb", "cloud-rgb.vdb"] {
+    for name in [
+        "bucky.vdb",
+        "bucky-zip.vdb",
+        "bucky-half-none.vdb",
+        "halves.vdb",
+        "transform.vdb",
+        "cloud-rgb.vdb",
+    ] {
         let bytes = std::fs::read(fixture(name)).unwrap();
         let step = (bytes.len() / 300).max(1);
         for len in (0..bytes.len()).step_by(step) {

@@ -46,7 +46,8 @@ fn with(settings: RenderSettings, params: &[(&str, &str)]) -> RenderSettings {
 }
 
 /// `scenes/vdb/bucky.toml` is `scenes/bucky/scene.toml` with its grid from `bucky.vdb` (float
-/// leaves) or `bucky-half.vdb` (half leaves: Bucky's integer values are exact in half): the same
+/// leaves) or `bucky-half.vdb` (half leaves: Bucky's integer values are exact in half), blosc
+/// compressed, or their zip (`bucky-zip.vdb`) and uncompressed (`bucky-half-none.vdb`) copies: the same
 /// values, box and transfer function, so the same image bit for bit, through the sparse layout
 /// and the any-layout medium where the raw grid takes the dense one.
 #[test]
@@ -54,7 +55,12 @@ fn bucky_from_vdb_renders_bit_for_bit_as_bucky_raw() {
     let raw = Scene::load(scenes().join("bucky/scene.toml"), &small()).unwrap();
     let expected = render(&raw);
     assert!(expected.sums.iter().any(|s| s[0] > 0.0));
-    for vdb in ["bucky.vdb", "bucky-half.vdb"] {
+    for vdb in [
+        "bucky.vdb",
+        "bucky-half.vdb",
+        "bucky-zip.vdb",
+        "bucky-half-none.vdb",
+    ] {
         let file = fixture(vdb).display().to_string();
         let scene = Scene::load(
             scenes().join("vdb/bucky.toml"),
