@@ -81,7 +81,8 @@ else
         # shellcheck disable=SC2086
         if run "bench-$name" "$VOLPT" bench "$dir/$mode.toml" --backend cuda --strategy regeneration-sk \
             --resolution "$RES" --spp "$SPP" --trials "$TRIALS" $flags; then
-            log "   $name: $(grep -iE 'mean|median|time' "$WORK/logs/bench-$name.log" | head -n 3 | tr '\n' ' ')"
+            # volpt bench's table row: time +- spread, paths, segments and steps per second.
+            log "   $name: $(grep -E ' s \+- ' "$WORK/logs/bench-$name.log" | head -n 1 | tr -s ' ')"
             grep -o 'volume: .*' "$WORK/logs/bench-$name.log" | head -n 1 | sed 's/^/     /' | tee -a "$OUT/summary.txt"
         else
             fail "cloud $name bench: $(tail_of "bench-$name")"
