@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use volpt::{Backend, Film, Quiet, RenderSettings, Scene};
+use volpt::{Backend, Film, GridLookup, Quiet, RenderSettings, Scene};
 
 fn scenes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes")
@@ -131,4 +131,21 @@ fn a_bare_vdb_file_renders_sparse() {
     let memory = scene.info().get("memory").unwrap().to_owned();
     assert!(memory.contains("dense 512.00 MiB"), "{memory}");
     render(&scene);
+}
+
+/// Textures hold dense grids: a texture lookup of a sparse grid is refused, at load and when set
+/// on a loaded scene, and the scene keeps its lookup.
+#[test]
+fn texture_lookups_of_a_sparse_grid_are_refused() {
+    let settings = |lookup| RenderSettings { lookup, ..small() };
+    for lookup in [GridLookup::Texture, GridLookup::TextureHalf] {
+        let error = Scene::load(fixture("sparse-cloud.vdb"), &settings(Some(lookup)))
+            .err()
+            .expect("refused")
+            .to_string();
+        assert!(error.contains("sparse"), "{error}");
+        let mut scene = Scene::load(fixture("sparse-cloud.vdb"), &settings(None)).unwrap();
+        assert!(scene.set_lookup(lookup).is_err());
+        assert_eq!(scene.description().medium.lookup, GridLookup::Trilinear);
+    }
 }

@@ -135,7 +135,7 @@ fn pick<'d>(
     };
     let available = grids
         .iter()
-        .map(|d| format!("{:?} ({})", d.name, d.type_name))
+        .map(|d| format!("{} ({})", d.name, d.type_name))
         .collect::<Vec<_>>()
         .join(", ");
     let kind = if options.vector { "vec3s" } else { "float" };
