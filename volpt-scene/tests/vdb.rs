@@ -114,9 +114,13 @@ fn scale_and_translation_place_the_grid() {
             max: [1.0 + 0.5 * 7.5, 2.0 + 0.25 * 23.5, 3.0 + 2.0 * 23.5],
         }
     );
-    for (x, y, z) in [(0, 0, 0), (15, 7, 23), (3, 5, 11)] {
-        let expected = 1.0 + x as f32 + 2.0 * y as f32 + 3.0 * z as f32;
-        assert_eq!(grid.sample(x, y, z, 0), expected, "({x}, {y}, {z})");
+    for z in 0..24 {
+        for y in 0..8 {
+            for x in 0..16 {
+                let expected = 1.0 + x as f32 + 2.0 * y as f32 + 3.0 * z as f32;
+                assert_eq!(grid.sample(x, y, z, 0), expected, "({x}, {y}, {z})");
+            }
+        }
     }
     let other = read("transform.vdb", Some("other"), Sparsity::Auto);
     assert_eq!(other.resolution, [8; 3]);
