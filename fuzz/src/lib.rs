@@ -44,10 +44,12 @@ pub enum Target {
     TransferFunction,
     /// An OpenEXR environment map under a fixed scene.
     ExrEnvmap,
+    /// A bare OpenVDB `.vdb` grid, as `volpt render cloud.vdb` loads it.
+    Vdb,
 }
 
 impl Target {
-    pub const ALL: [Target; 8] = [
+    pub const ALL: [Target; 9] = [
         Self::MitsubaXml,
         Self::Vol,
         Self::MetaImage,
@@ -56,6 +58,7 @@ impl Target {
         Self::TomlRaw,
         Self::TransferFunction,
         Self::ExrEnvmap,
+        Self::Vdb,
     ];
 
     /// The name `fuzz/run` knows the target by.
@@ -69,6 +72,7 @@ impl Target {
             Self::TomlRaw => "toml_raw",
             Self::TransferFunction => "transfer_function",
             Self::ExrEnvmap => "exr_envmap",
+            Self::Vdb => "vdb",
         }
     }
 
@@ -94,6 +98,7 @@ impl Target {
                 assemble(&write(dir, "scene.xml", part(0)), params);
             }
             Self::Vol => assemble(&write(dir, "g.vol", data), Vec::new()),
+            Self::Vdb => assemble(&write(dir, "g.vdb", data), Vec::new()),
             Self::MetaImage => {
                 let path = if parts.len() > 1 {
                     write(dir, "d.raw", part(1));
@@ -184,6 +189,7 @@ fn assemble(path: &Path, params: Vec<(String, String)>) {
 
 fn small_grid() -> GridDesc {
     GridDesc {
+        layout: volpt_scene::SampleLayout::Dense,
         resolution: [2, 2, 2],
         channels: 1,
         bounds: Bounds {
@@ -231,6 +237,21 @@ pub fn seeds(target: Target) -> Vec<Vec<u8>> {
             join(&[&fixture("scenes/homogeneous-cube/scene.xml")]),
             join(&[&fixture("scenes/example/cube.xml")]),
         ],
+        // Files written by the real OpenVDB library (scenes/vdb/make_fixtures.py): float and half
+        // leaves, blosc, zip and uncompressed, transforms, a vec3 grid, a sparse box.
+        Target::Vdb => [
+            "bucky.vdb",
+            "bucky-half.vdb",
+            "bucky-zip.vdb",
+            "bucky-half-none.vdb",
+            "halves.vdb",
+            "transform.vdb",
+            "cloud-rgb.vdb",
+            "sparse-cloud.vdb",
+        ]
+        .iter()
+        .map(|f| fixture(&format!("scenes/vdb/fixtures/{f}")))
+        .collect(),
         Target::Vol => vec![{
             written("g.vol", &|p| {
                 volpt_scene::write_vol(

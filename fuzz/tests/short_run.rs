@@ -64,3 +64,8 @@ fn transfer_function() {
 fn exr_envmap() {
     short_run(Target::ExrEnvmap);
 }
+
+#[test]
+fn vdb() {
+    short_run(Target::Vdb);
+}

@@ -39,6 +39,7 @@ pub fn density_with_holes(seed: u32) -> GridDesc {
         }
     }
     GridDesc {
+        layout: volpt_scene::SampleLayout::Dense,
         resolution: res,
         channels: 1,
         bounds: UNIT,
@@ -53,6 +54,7 @@ pub fn varying_albedo(seed: u32, (lo, hi): (f32, f32)) -> GridDesc {
     let mut rng = Rng::new(seed, 1, 0);
     let n = (res[0] * res[1] * res[2] * 3) as usize;
     GridDesc {
+        layout: volpt_scene::SampleLayout::Dense,
         resolution: res,
         channels: 3,
         bounds: UNIT,

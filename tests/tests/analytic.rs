@@ -69,6 +69,7 @@ fn wavy_density_grid(convention: GridConvention) -> GridDesc {
         }
     }
     GridDesc {
+        layout: volpt_scene::SampleLayout::Dense,
         resolution: res,
         channels: 1,
         bounds: Bounds {

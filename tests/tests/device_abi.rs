@@ -18,6 +18,7 @@ use volpt_tests::cube_scene;
 fn grid(channels: u32, bounds: Bounds, convention: GridConvention) -> GridDesc {
     let n = 4 * 3 * 2 * channels as usize;
     GridDesc {
+        layout: volpt_scene::SampleLayout::Dense,
         resolution: [4, 3, 2],
         channels,
         bounds,
@@ -211,6 +212,34 @@ fn every_variant_with_bricked_grids_renders_bit_for_bit() {
     round_trips(GridLayout::Bricked);
 }
 
+/// Grids in the sparse layout (stored bricks and a brick table, `volpt_core::GridLayout::Sparse`)
+/// travel to the device as they are and are read by the device code exactly as the dense grids
+/// they came from; they select the any-layout medium, as bricked storage does.
+#[test]
+fn every_variant_with_sparse_grids_renders_bit_for_bit() {
+    let mut descs = descriptions();
+    descs.retain(|d| {
+        !matches!(
+            d.medium.lookup,
+            GridLookup::Texture | GridLookup::TextureHalf
+        )
+    });
+    for desc in &mut descs {
+        if let DensityDesc::Grid(g) = &mut desc.medium.density {
+            *g = g.sparsified();
+        }
+        if let AlbedoDesc::Grid(g) = &mut desc.medium.albedo {
+            *g = g.sparsified();
+        }
+    }
+    let mut expected: BTreeSet<String> = volpt_core::variant::NAMES
+        .iter()
+        .map(|names| names.join("/"))
+        .collect();
+    expected.retain(|v| v.starts_with("homogeneous/") || v.starts_with("grid_any_layout/"));
+    check_round_trips(descs, expected, GridLayout::Dense);
+}
+
 fn round_trips(layout: GridLayout) {
     let mut descs = descriptions();
     // Dense: every variant of the registry. Bricked storage selects the any-layout grid medium for
@@ -227,6 +256,12 @@ fn round_trips(layout: GridLayout) {
         }
         expected.retain(|v| v.starts_with("homogeneous/") || v.starts_with("grid_any_layout/"));
     }
+    check_round_trips(descs, expected, layout);
+}
+
+/// Each description renders the same through the device ABI (grids placed in `layout` where
+/// the medium reads any layout), and the descriptions cover exactly the `expected` variants.
+fn check_round_trips(descs: Vec<SceneDescription>, expected: BTreeSet<String>, layout: GridLayout) {
     let variants: BTreeSet<String> = descs.iter().map(|d| Variant::of(d).to_string()).collect();
     assert_eq!(
         variants, expected,

@@ -76,6 +76,7 @@ fn compare(a: &[(f64, f64)], b: &[(f64, f64)]) -> (f64, f64) {
 fn grid(value: &[f32], res: [u32; 3]) -> GridDesc {
     let n = (res[0] * res[1] * res[2]) as usize;
     GridDesc {
+        layout: volpt_scene::SampleLayout::Dense,
         resolution: res,
         channels: value.len() as u32,
         bounds: Bounds {

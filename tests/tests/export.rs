@@ -34,6 +34,7 @@ fn grid(
     let mut rng = Lcg(resolution.iter().map(|&r| r as u64).product::<u64>() + channels as u64);
     let n = (resolution.iter().product::<u32>() * channels) as usize;
     GridDesc {
+        layout: volpt_scene::SampleLayout::Dense,
         resolution,
         channels,
         bounds,

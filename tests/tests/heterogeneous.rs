@@ -251,6 +251,7 @@ fn white_furnace_with_grid_and_nee() {
     for phase in [PhaseDesc::Isotropic, PhaseDesc::HenyeyGreenstein { g: 0.8 }] {
         let medium = MediumDesc {
             density: DensityDesc::Grid(GridDesc {
+                layout: volpt_scene::SampleLayout::Dense,
                 resolution: res,
                 channels: 1,
                 bounds: Bounds {

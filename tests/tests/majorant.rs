@@ -63,6 +63,7 @@ fn rod_grid(convention: GridConvention) -> GridDesc {
         }
     }
     GridDesc {
+        layout: volpt_scene::SampleLayout::Dense,
         resolution: [n; 3],
         channels: 1,
         bounds: Bounds {
@@ -173,6 +174,7 @@ fn random_grid(cases: &mut Cases, channels: u32) -> GridDesc {
     let min = [0; 3].map(|_| cases.range(-0.8, 0.2));
     let max = min.map(|m| m + cases.range(0.05, 1.2));
     GridDesc {
+        layout: volpt_scene::SampleLayout::Dense,
         resolution,
         channels,
         bounds: Bounds { min, max },

@@ -26,6 +26,7 @@ fn grid_scene(density: impl Fn(f32, f32, f32) -> f32) -> SceneDescription {
     }
     let medium = MediumDesc {
         density: DensityDesc::Grid(GridDesc {
+            layout: volpt_scene::SampleLayout::Dense,
             resolution: [RES; 3],
             channels: 1,
             bounds: Bounds {

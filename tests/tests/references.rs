@@ -175,6 +175,7 @@ fn smooth_grid() -> GridDesc {
         }
     }
     GridDesc {
+        layout: volpt_scene::SampleLayout::Dense,
         resolution: [n; 3],
         channels: 1,
         bounds: unit_cube(),
@@ -202,6 +203,7 @@ fn plateau_grid(convention: GridConvention) -> GridDesc {
         }
     }
     GridDesc {
+        layout: volpt_scene::SampleLayout::Dense,
         resolution: [n; 3],
         channels: 1,
         bounds: unit_cube(),

@@ -82,6 +82,7 @@ fn unit_bounds() -> Bounds {
 
 fn grid(resolution: [u32; 3], data: Vec<f32>) -> GridDesc {
     GridDesc {
+        layout: volpt_scene::SampleLayout::Dense,
         resolution,
         channels: 1,
         bounds: unit_bounds(),

@@ -107,7 +107,7 @@ enum SceneCommand {
 
 #[derive(Args)]
 struct SceneArgs {
-    /// Scene file: Mitsuba XML, a volpt TOML scene, or a grid file (.mha, .mhd, .vtk, .vti, .vol).
+    /// Scene file: Mitsuba XML, a volpt TOML scene, or a grid file (.mha, .mhd, .vtk, .vti, .vol, .vdb).
     scene: PathBuf,
     /// Scene parameter, as Mitsuba's `-D name=value` (fills `$name` and overrides `<default>`).
     #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_param)]

@@ -31,6 +31,7 @@ fn scene(g: f32, last: f32, last_green: f32, int_ior: f32) -> SceneDescription {
         let at = data.len() - last.len();
         data[at..].copy_from_slice(last);
         GridDesc {
+            layout: volpt_scene::SampleLayout::Dense,
             resolution,
             channels: sample.len() as u32,
             bounds,

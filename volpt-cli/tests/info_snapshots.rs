@@ -63,6 +63,11 @@ fn included_scenes() {
         )
     );
     insta::assert_snapshot!("bucky", info(&root, "scenes/bucky/scene.toml", &[]));
+    insta::assert_snapshot!("bucky-vdb", info(&root, "scenes/vdb/bucky.toml", &[]));
+    insta::assert_snapshot!(
+        "sparse-cloud-vdb",
+        info(&root, "scenes/vdb/fixtures/sparse-cloud.vdb", &[])
+    );
 }
 
 /// cgg-logo and ad read generated grids, envmap-cube a generated sky, smoke a generated stand-in

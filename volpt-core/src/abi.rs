@@ -244,14 +244,26 @@ impl GridLookup {
 
 impl GridParams {
     /// The parameters of `grid`, whose values `upload` places on the device as `placement` (the
-    /// reading medium's) says. `grid` must be dense (the host's grids are).
+    /// reading medium's) says. `grid` must be dense or sparse (the host's grids are).
     pub fn new<const C: usize>(
         grid: &Grid<'_, C>,
         upload: &mut Upload<'_>,
         placement: GridPlacement,
     ) -> Self {
-        debug_assert_eq!(grid.layout, GridLayout::Dense);
-        let placed = upload.grid(grid.data, grid.res, C as u32, placement, grid.texel);
+        // A sparse grid is already laid out for the any-layout reads (the factory gives it no
+        // other), and its table and bricks travel as they are: it is small by construction.
+        let placed = if grid.layout == GridLayout::Sparse {
+            debug_assert_eq!(placement, GridPlacement::AnyLayout);
+            PlacedGrid {
+                address: upload.values(grid.data),
+                len: grid.data.len() as u64,
+                layout: GridLayout::Sparse,
+                texture: 0,
+            }
+        } else {
+            debug_assert_eq!(grid.layout, GridLayout::Dense);
+            upload.grid(grid.data, grid.res, C as u32, placement, grid.texel)
+        };
         debug_assert!(placement == GridPlacement::AnyLayout || placed.layout == GridLayout::Dense);
         Self {
             data: placed.address,

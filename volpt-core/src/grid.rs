@@ -72,6 +72,22 @@ pub enum GridLayout {
     /// the grid over PCIe (zero-copy, managed memory) fetches fewer, fuller lines.
     /// Axes that are not a multiple of [`BRICK`] are padded; padding is never read.
     Bricked,
+    /// Only the bricks that hold something: a sparse volume (a VDB's active 8^3 leaves) without
+    /// a dense copy of its box. `data` is the stored bricks, each [`BRICK`]^3 samples laid out as
+    /// in [`GridLayout::Bricked`], followed by a *brick table*: one entry per brick of the box
+    /// (x fastest), the `f32` bits of the `u32` slot of that brick among the stored ones
+    /// ([`sparse_table_len`], [`Grid::sparse`]). Slot 0 is the background brick, one value
+    /// everywhere, which every empty brick of the box points at: an empty region costs 4 bytes
+    /// per brick and reads like any other, so the lookup has no extra branch.
+    Sparse,
+}
+
+/// Entries of a [`GridLayout::Sparse`] grid's brick table for a grid of `res` samples (one per
+/// brick of its box), or `None` if that does not fit in `u64`.
+pub fn sparse_table_len(res: [u32; 3]) -> Option<u64> {
+    res.iter().try_fold(1u64, |acc, &r| {
+        acc.checked_mul(u64::from(r.div_ceil(BRICK)))
+    })
 }
 
 /// Samples along each edge of a brick of [`GridLayout::Bricked`].
@@ -80,11 +96,13 @@ const BRICK_SHIFT: u32 = BRICK.trailing_zeros();
 
 impl GridLayout {
     /// Values a grid of `res` samples of `channels` channels takes in this layout (with its
-    /// padding), or `None` if that does not fit in `u64`.
+    /// padding), or `None` if that does not fit in `u64` or, for [`GridLayout::Sparse`], depends
+    /// on how many bricks are stored.
     pub fn values(self, res: [u32; 3], channels: u32) -> Option<u64> {
         let samples = match self {
             GridLayout::Dense => res.map(u64::from),
             GridLayout::Bricked => res.map(|r| u64::from(r.div_ceil(BRICK)) * u64::from(BRICK)),
+            GridLayout::Sparse => return None,
         };
         samples
             .iter()
@@ -93,12 +111,13 @@ impl GridLayout {
 
     /// The sample index (before multiplying by the channel count) of `(x, y, z)` in a grid of
     /// `res` samples. Arithmetic is `u32`, as the lookup's: a grid's padded sample count must be
-    /// below 2^32 ([`GridLayout::values`]).
+    /// below 2^32 ([`GridLayout::values`]). A [`GridLayout::Sparse`] grid's index depends on its
+    /// brick table: this is its index in the box's bricked layout, and [`Grid::sample`] reads it.
     #[inline]
     pub fn index(self, res: [u32; 3], x: u32, y: u32, z: u32) -> u32 {
         match self {
             GridLayout::Dense => dense_index(res, x, y, z),
-            GridLayout::Bricked => bricked_index(res, x, y, z),
+            GridLayout::Bricked | GridLayout::Sparse => bricked_index(res, x, y, z),
         }
     }
 
@@ -107,12 +126,14 @@ impl GridLayout {
         match self {
             GridLayout::Dense => 0,
             GridLayout::Bricked => 1,
+            GridLayout::Sparse => 2,
         }
     }
 
     pub fn from_u32(n: u32) -> Self {
         match n {
             1 => GridLayout::Bricked,
+            2 => GridLayout::Sparse,
             _ => GridLayout::Dense,
         }
     }
@@ -132,6 +153,23 @@ fn bricked_index(res: [u32; 3], x: u32, y: u32, z: u32) -> u32 {
     let mask = BRICK - 1;
     let inner = (((z & mask) << BRICK_SHIFT) + (y & mask)) << BRICK_SHIFT | (x & mask);
     (brick << (3 * BRICK_SHIFT)) | inner
+}
+
+/// The sample index of `(x, y, z)` in a [`GridLayout::Sparse`] grid's `data`: the brick's slot
+/// from the table at the end of `data`, then the sample's place inside the brick. `u32` like the
+/// other layouts: the stored samples must number below 2^32 (checked on the host).
+#[inline(always)]
+fn sparse_index(data: &[f32], res: [u32; 3], x: u32, y: u32, z: u32) -> u32 {
+    let bricks_x = (res[0] + BRICK - 1) >> BRICK_SHIFT;
+    let bricks_y = (res[1] + BRICK - 1) >> BRICK_SHIFT;
+    let bricks_z = (res[2] + BRICK - 1) >> BRICK_SHIFT;
+    let table = data.len() - (bricks_x * bricks_y * bricks_z) as usize;
+    let brick =
+        ((z >> BRICK_SHIFT) * bricks_y + (y >> BRICK_SHIFT)) * bricks_x + (x >> BRICK_SHIFT);
+    let slot = data[table + brick as usize].to_bits();
+    let mask = BRICK - 1;
+    let inner = (((z & mask) << BRICK_SHIFT) + (y & mask)) << BRICK_SHIFT | (x & mask);
+    (slot << (3 * BRICK_SHIFT)) | inner
 }
 
 /// How a grid reconstructs values between its samples (Mitsuba 3's `filter_type`).
@@ -200,6 +238,65 @@ impl<'a, const C: usize> Grid<'a, C> {
         }
     }
 
+    /// A [`GridLayout::Sparse`] grid: `data` is whole bricks of `C`-channel samples (at least
+    /// the background brick, slot 0) followed by [`sparse_table_len`]`(res)` table entries, each
+    /// the `f32` bits of a stored brick's slot. Panics if `data` is not shaped so or a table entry
+    /// names a brick that is not stored (the loaders check both and return errors first).
+    pub fn sparse(data: &'a [f32], res: [u32; 3], mapping: GridMapping) -> Self {
+        let brick = (BRICK * BRICK * BRICK) as usize * C;
+        let table = sparse_table_len(res).expect("sparse grid table overflows") as usize;
+        assert!(
+            data.len() >= table + brick && (data.len() - table).is_multiple_of(brick),
+            "sparse grid data does not match its resolution"
+        );
+        let slots = (data.len() - table) / brick;
+        assert!(
+            data[data.len() - table..]
+                .iter()
+                .all(|s| (s.to_bits() as usize) < slots),
+            "sparse grid table names a brick that is not stored"
+        );
+        Self {
+            data,
+            res,
+            mapping,
+            layout: GridLayout::Sparse,
+            lookup: GridLookup::Trilinear,
+            texture: 0,
+            texel: TexelFormat::F32,
+        }
+    }
+
+    /// The stored samples without a sparse grid's brick table (all of `data` otherwise).
+    pub fn samples(&self) -> &'a [f32] {
+        match self.layout {
+            GridLayout::Sparse => {
+                let table = sparse_table_len(self.res).unwrap_or(0) as usize;
+                &self.data[..self.data.len() - table]
+            }
+            _ => self.data,
+        }
+    }
+
+    /// The sample `(x, y, z)` (inside the grid) in any layout.
+    pub fn sample(&self, x: u32, y: u32, z: u32) -> [f32; C] {
+        let i = match self.layout {
+            GridLayout::Sparse => sparse_index(self.data, self.res, x, y, z),
+            layout => layout.index(self.res, x, y, z),
+        } as usize
+            * C;
+        let mut v = [0.0; C];
+        v.copy_from_slice(&self.data[i..i + C]);
+        v
+    }
+
+    /// The slot of the brick holding sample `(x, y, z)` of a [`GridLayout::Sparse`] grid (0: the
+    /// background brick).
+    pub fn sample_slot(&self, x: u32, y: u32, z: u32) -> u32 {
+        debug_assert_eq!(self.layout, GridLayout::Sparse);
+        sparse_index(self.data, self.res, x, y, z) >> (3 * BRICK_SHIFT)
+    }
+
     /// The same grid, in a texture of `texel`s when read by [`TextureTrilinear`].
     pub fn with_texel(self, texel: TexelFormat) -> Self {
         Self { texel, ..self }
@@ -219,6 +316,12 @@ impl<'a, const C: usize> Grid<'a, C> {
         match self.layout {
             GridLayout::Dense => self.interpolate(p, dense_index, self.lookup, None),
             GridLayout::Bricked => self.interpolate(p, bricked_index, self.lookup, None),
+            GridLayout::Sparse => self.interpolate(
+                p,
+                |res, x, y, z| sparse_index(self.data, res, x, y, z),
+                self.lookup,
+                None,
+            ),
         }
     }
 
@@ -230,6 +333,12 @@ impl<'a, const C: usize> Grid<'a, C> {
         match self.layout {
             GridLayout::Dense => self.interpolate(p, dense_index, self.lookup, Some(bits)),
             GridLayout::Bricked => self.interpolate(p, bricked_index, self.lookup, Some(bits)),
+            GridLayout::Sparse => self.interpolate(
+                p,
+                |res, x, y, z| sparse_index(self.data, res, x, y, z),
+                self.lookup,
+                Some(bits),
+            ),
         }
     }
 
@@ -724,6 +833,120 @@ mod tests {
                 assert_eq!(x[c].to_bits(), y[c].to_bits(), "{res:?} at {p:?}");
             }
         }
+    }
+
+    /// The sparse form of dense samples: bricks whose samples are all zero point at the
+    /// background brick (slot 0, zeros), the others are stored in order.
+    fn sparsify<const C: usize>(dense: &[f32], res: [u32; 3]) -> (Vec<f32>, usize) {
+        let bricked = brick::<C>(dense, res);
+        let size = 512 * C;
+        let mut stored = vec![0.0; size];
+        let mut table = Vec::new();
+        for b in bricked.chunks_exact(size) {
+            if b.iter().all(|&v| v == 0.0) {
+                table.push(f32::from_bits(0));
+            } else {
+                table.push(f32::from_bits((stored.len() / size) as u32));
+                stored.extend_from_slice(b);
+            }
+        }
+        let slots = stored.len() / size;
+        stored.extend(table);
+        (stored, slots)
+    }
+
+    /// A density with zero bricks: hashed values inside a ball, zero outside.
+    fn ball<const C: usize>(res: [u32; 3]) -> Vec<f32> {
+        let mut out = Vec::new();
+        for z in 0..res[2] {
+            for y in 0..res[1] {
+                for x in 0..res[0] {
+                    let d = |i: u32, r: u32| (i as f32 + 0.5) / r as f32 - 0.5;
+                    let r2 = d(x, res[0]).powi(2) + d(y, res[1]).powi(2) + d(z, res[2]).powi(2);
+                    for c in 0..C as u32 {
+                        let i = ((z * res[1] + y) * res[0] + x) * C as u32 + c;
+                        out.push(if r2 < 0.09 { hash(i) + 0.01 } else { 0.0 });
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn sparse_lookups_are_bit_identical_to_dense() {
+        let bounds = Aabb::new(Vec3::new(-1.0, 0.5, 2.0), Vec3::new(3.0, 1.5, 2.25));
+        for res in [[40, 33, 17], [24, 24, 24], [64, 9, 70]] {
+            let one = ball::<1>(res);
+            let (sparse, slots) = sparsify::<1>(&one, res);
+            let bricks = sparse_table_len(res).unwrap() as usize;
+            assert!(
+                slots < bricks,
+                "{res:?}: the test grid must have empty bricks"
+            );
+            for mapping in [
+                GridMapping::vertex_centred(bounds, res),
+                GridMapping::cell_centred(bounds, res),
+            ] {
+                let a = Grid::<1>::new(&one, res, mapping);
+                let b = Grid::<1>::sparse(&sparse, res, mapping);
+                assert_eq!(b.samples().len(), slots * 512);
+                let (min, extent) = (bounds.min, bounds.extent());
+                let mut nonzero = 0;
+                for i in 0..4000u32 {
+                    let u = Vec3::new(hash(3 * i), hash(3 * i + 1), hash(3 * i + 2)) * 1.1 - 0.05;
+                    let p = min + u * extent;
+                    assert_eq!(a.lookup(p)[0].to_bits(), b.lookup(p)[0].to_bits(), "{p:?}");
+                    assert_eq!(a.lookup(p), AnyLayout::lookup(&b, p));
+                    nonzero += usize::from(a.lookup(p)[0] > 0.0);
+                }
+                assert!(nonzero > 100, "{res:?}: {nonzero} lookups inside the ball");
+            }
+            let three = ball::<3>(res);
+            let (sparse3, _) = sparsify::<3>(&three, res);
+            let mapping = GridMapping::cell_centred(bounds, res);
+            let a = Grid::<3>::new(&three, res, mapping);
+            let b = Grid::<3>::sparse(&sparse3, res, mapping);
+            for i in 0..2000u32 {
+                let u = Vec3::new(hash(3 * i), hash(3 * i + 1), hash(3 * i + 2));
+                let p = min_plus(bounds, u);
+                assert_eq!(a.lookup(p), b.lookup(p), "{p:?}");
+            }
+        }
+    }
+
+    fn min_plus(bounds: Aabb, u: Vec3) -> Vec3 {
+        bounds.min + u * bounds.extent()
+    }
+
+    /// A sparse grid's majorant grid equals its dense copy's, cell for cell: the background
+    /// brick read once stands for every sample of every empty brick.
+    #[test]
+    fn sparse_majorants_equal_dense_majorants() {
+        let res = [64, 9, 70];
+        let bounds = Aabb::new(Vec3::new(-1.0, 0.5, 2.0), Vec3::new(3.0, 1.5, 2.25));
+        let dense = ball::<1>(res);
+        let (sparse, _) = sparsify::<1>(&dense, res);
+        let mapping = GridMapping::cell_centred(bounds, res);
+        for cells in [[16, 4, 16], [3, 1, 5], [64, 9, 70]] {
+            let n = cells.iter().product::<u32>() as usize;
+            let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
+            let grid = Grid::<1>::new(&dense, res, mapping);
+            crate::majorant::build_majorants(&grid, 2.0, bounds, cells, &mut a);
+            let grid = Grid::<1>::sparse(&sparse, res, mapping);
+            crate::majorant::build_majorants(&grid, 2.0, bounds, cells, &mut b);
+            assert_eq!(a, b, "{cells:?}");
+            assert!(a.contains(&0.0), "{cells:?}: no empty cell tested");
+        }
+    }
+
+    #[test]
+    #[should_panic(expected = "names a brick that is not stored")]
+    fn a_sparse_table_must_name_stored_bricks() {
+        let mut data = vec![0.0; 512];
+        data.push(f32::from_bits(1));
+        let mapping = GridMapping::cell_centred(Aabb::new(Vec3::ZERO, Vec3::ONE), [8, 8, 8]);
+        Grid::<1>::sparse(&data, [8, 8, 8], mapping);
     }
 
     #[test]

@@ -34,8 +34,8 @@ pub use camera::PerspectiveCamera;
 pub use environment::{ConstantEnvironment, Environment, LatLongEnvironment, LatLongRows};
 pub use geometry::{Aabb, Ray};
 pub use grid::{
-    AnyLayout, DenseTrilinear, Grid, GridLayout, GridLookup, GridMapping, GridPlacement, GridReads,
-    TexelFormat, TextureTrilinear,
+    sparse_table_len, AnyLayout, DenseTrilinear, Grid, GridLayout, GridLookup, GridMapping,
+    GridPlacement, GridReads, TexelFormat, TextureTrilinear,
 };
 pub use majorant::MajorantGrid;
 pub use medium::{AlbedoField, ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium, Medium};

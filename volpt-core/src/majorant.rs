@@ -9,7 +9,9 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::grid::Grid;
+use core::ops::RangeInclusive;
+
+use crate::grid::{Grid, GridLayout, BRICK};
 use crate::{Aabb, Ray, Vec3};
 
 /// Per-cell upper bounds of the extinction over `bounds`.
@@ -131,17 +133,68 @@ pub fn build_majorants(
             let to = (hi[a] as i64 + 1).clamp(0, last[a]);
             from as u32..=to as u32
         };
-        let mut max = 0.0f32;
-        for sz in range(2) {
-            for sy in range(1) {
-                for sx in range(0) {
-                    let j = ((sz * density.res[1] + sy) * density.res[0] + sx) as usize;
-                    max = max.max(density.data[j]);
+        let max = match density.layout {
+            GridLayout::Sparse => sparse_max(density, [range(0), range(1), range(2)]),
+            _ => {
+                let mut max = 0.0f32;
+                for sz in range(2) {
+                    for sy in range(1) {
+                        for sx in range(0) {
+                            max = max.max(density.sample(sx, sy, sz)[0]);
+                        }
+                    }
+                }
+                max
+            }
+        };
+        *bound = scale * max;
+    }
+}
+
+/// The largest sample of a [`GridLayout::Sparse`] grid in the index ranges `ranges`, brick by
+/// brick: the background brick holds one value, so it is read once, not once per sample (a
+/// 2048^3 box of a few percent stored bricks is otherwise billions of reads of the same value).
+/// The same maximum as reading every sample, so a sparse grid's majorants equal its dense copy's.
+fn sparse_max(density: &Grid<'_, 1>, ranges: [RangeInclusive<u32>; 3]) -> f32 {
+    let [rx, ry, rz] = ranges;
+    let bricks = |r: &RangeInclusive<u32>| (r.start() / BRICK)..=(r.end() / BRICK);
+    let mut max = 0.0f32;
+    let background = density.data[0];
+    for bz in bricks(&rz) {
+        for by in bricks(&ry) {
+            for bx in bricks(&rx) {
+                let (x0, y0, z0) = (bx * BRICK, by * BRICK, bz * BRICK);
+                // Slot 0 (the background brick) is one value: a single read stands for all.
+                let slot = density.sample_slot(x0, y0, z0);
+                if slot == 0 {
+                    max = max.max(background);
+                    continue;
+                }
+                let clip = |r: &RangeInclusive<u32>, o: u32| {
+                    (*r.start()).max(o) - o..=(*r.end()).min(o + BRICK - 1) - o
+                };
+                // The brick's samples, read directly: one table lookup per brick, not per sample.
+                let samples = (BRICK * BRICK * BRICK) as usize;
+                let brick = &density.data[slot as usize * samples..][..samples];
+                let (cx, cy, cz) = (clip(&rx, x0), clip(&ry, y0), clip(&rz, z0));
+                let whole = |r: &RangeInclusive<u32>| *r.start() == 0 && *r.end() == BRICK - 1;
+                if whole(&cx) && whole(&cy) && whole(&cz) {
+                    // Most bricks lie inside the cell's range: one pass over 512 contiguous values.
+                    max = brick.iter().fold(max, |m, &v| m.max(v));
+                    continue;
+                }
+                for z in cz {
+                    for y in cy.clone() {
+                        let row = ((z * BRICK + y) * BRICK) as usize;
+                        for x in cx.clone() {
+                            max = max.max(brick[row + x as usize]);
+                        }
+                    }
                 }
             }
         }
-        *bound = scale * max;
     }
+    max
 }
 
 /// Where a ray is in the majorant grid: the current cell and, per axis, the distance along the ray

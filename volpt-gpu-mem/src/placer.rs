@@ -45,6 +45,7 @@ impl fmt::Display for Placed {
         let layout = match self.layout {
             GridLayout::Dense => "dense",
             GridLayout::Bricked => "bricked",
+            GridLayout::Sparse => "sparse",
         };
         if let PlacedIn::Texture(texel) = self.memory {
             let texel = match texel {
@@ -285,10 +286,12 @@ impl VolumePlacer {
                 );
                 GridLayout::Dense
             }
+            // Not a policy: a sparse grid arrives laid out (`GridParams::new` uploads it as values).
+            GridLayout::Sparse => GridLayout::Dense,
             layout => layout,
         };
         let len = match layout {
-            GridLayout::Dense => values.len(),
+            GridLayout::Dense | GridLayout::Sparse => values.len(),
             GridLayout::Bricked => values_in(layout, res, channels).unwrap_or(0) as usize,
         };
         let bytes = len as u64 * 4;
@@ -394,7 +397,7 @@ impl VolumePlacer {
     fn copy_to_device(&mut self, grid: &Grid<'_>) -> Result<u64, GpuMemError> {
         let bytes = grid.len as u64 * 4;
         let copied = match grid.layout {
-            GridLayout::Dense => self.stream.clone_htod(grid.values),
+            GridLayout::Dense | GridLayout::Sparse => self.stream.clone_htod(grid.values),
             GridLayout::Bricked => {
                 let host = bricked(grid.values, grid.res, grid.channels)
                     .ok_or(GpuMemError::OutOfHostMemory { bytes })?;
@@ -464,7 +467,7 @@ impl Grid<'_> {
     /// Writes the grid in its layout into `out` (of `len` values).
     fn write_into(&self, out: &mut [f32]) {
         match self.layout {
-            GridLayout::Dense => {
+            GridLayout::Dense | GridLayout::Sparse => {
                 const CHUNK: usize = 1 << 20;
                 out.par_chunks_mut(CHUNK)
                     .zip(self.values.par_chunks(CHUNK))

@@ -61,6 +61,7 @@ impl SceneBuilder for Shell {
             },
             medium: MediumDesc {
                 density: DensityDesc::Grid(GridDesc {
+                    layout: volpt_scene::SampleLayout::Dense,
                     resolution: [n; 3],
                     channels: 1,
                     bounds,

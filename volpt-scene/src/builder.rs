@@ -49,7 +49,7 @@ impl SceneBuilder for TomlScene {
     }
 }
 
-/// A grid file on its own (`.mha`, `.mhd`, `.vtk`, `.vti`, `.vol`): the volume is scaled and
+/// A grid file on its own (`.mha`, `.mhd`, `.vtk`, `.vti`, `.vol`, `.vdb`): the volume is scaled and
 /// centred into the unit cube at the origin (keeping its aspect), its values normalised onto
 /// density `[0, 100]`, and rendered in the thesis setup of a TOML scene with only `[volume]`.
 pub struct GridFile(pub PathBuf);
@@ -86,6 +86,7 @@ impl SceneBuilder for GridFile {
 
 fn empty_grid() -> crate::GridDesc {
     crate::GridDesc {
+        layout: crate::description::SampleLayout::Dense,
         resolution: [1; 3],
         channels: 1,
         bounds: Bounds {
@@ -117,14 +118,14 @@ pub fn builder_for(path: &Path) -> Result<Box<dyn SceneBuilder>, SceneError> {
     Ok(match extension.as_deref() {
         Some("xml") => Box::new(MitsubaXml(path.to_owned())),
         Some("toml") => Box::new(TomlScene(path.to_owned())),
-        Some("mha" | "mhd" | "vtk" | "vti" | "vol") => Box::new(GridFile(path.to_owned())),
+        Some("mha" | "mhd" | "vtk" | "vti" | "vol" | "vdb") => Box::new(GridFile(path.to_owned())),
         _ => {
             return Err(SceneError::Unsupported {
                 path: path.to_owned(),
                 line: 0,
                 what: "this kind of scene file".into(),
                 reason: "expected a Mitsuba .xml, a volpt .toml scene, or a grid file \
-                         (.mha, .mhd, .vtk, .vti, .vol)"
+                         (.mha, .mhd, .vtk, .vti, .vol, .vdb)"
                     .into(),
             })
         }

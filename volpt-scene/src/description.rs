@@ -166,7 +166,8 @@ pub enum GridConvention {
     Cell,
 }
 
-/// A dense 3D grid, x fastest: `data[((z * res_y + y) * res_x + x) * channels + c]`.
+/// A 3D grid: dense, x fastest (`data[((z * res_y + y) * res_x + x) * channels + c]`), or sparse
+/// ([`SampleLayout::Sparse`], [`crate::sparse`]).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct GridDesc {
     pub resolution: [u32; 3],
@@ -177,11 +178,24 @@ pub struct GridDesc {
     /// what fingerprints a scene (the facade's `fingerprint::content`).
     #[serde(skip)]
     pub data: Vec<f32>,
+    pub layout: SampleLayout,
+}
+
+/// How a [`GridDesc`]'s `data` holds its samples.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub enum SampleLayout {
+    /// Every sample of the box, x fastest.
+    #[default]
+    Dense,
+    /// Only the 8^3 bricks that hold something, then a table of every brick's slot
+    /// (`volpt_core::GridLayout::Sparse`): a VDB's leaves without a dense copy of its box.
+    Sparse,
 }
 
 impl GridDesc {
+    /// The largest sample (0 for a grid of negative values).
     pub fn max_value(&self) -> f32 {
-        self.data.iter().copied().fold(0.0, f32::max)
+        self.samples().iter().copied().fold(0.0, f32::max)
     }
 }
 

@@ -11,6 +11,8 @@
 //! - [`generate`]: the thesis's printed-block grids (`cgg-logo`, `ad`), generated rather than stored.
 //! - [`raw`]: raw voxel files with a caller-given layout (such as `Bucky.raw`), read and written.
 //! - [`metaimage`]: MetaImage `.mha`/`.mhd` grids, read and written.
+//! - [`vdb`]: OpenVDB `.vdb` grids (float density, vec3 albedo), read sparse.
+//! - [`sparse`]: sparse grids: stored 8^3 bricks and a brick table.
 //! - [`vtk`]: VTK image data (legacy `STRUCTURED_POINTS` `.vtk`, XML `.vti`), read and written.
 //! - [`transfer`]: transfer functions from density to RGB albedo, and their text files.
 //! - [`limits`]: what untrusted input may make volpt allocate or do, checked before it does.
@@ -30,9 +32,11 @@ pub mod normalise;
 pub mod numerics;
 mod output;
 pub mod raw;
+pub mod sparse;
 pub mod toml_scene;
 pub mod transfer;
 pub mod validate;
+pub mod vdb;
 pub mod vol;
 pub mod vtk;
 
@@ -45,6 +49,7 @@ pub use metaimage::{read_metaimage, write_metaimage, MetaImageOptions};
 pub use normalise::normalise;
 pub use raw::{read_raw, read_raw_into, write_raw, ByteOrder, RawLayout, ScalarType};
 pub use transfer::TransferFunction;
+pub use vdb::{read_vdb, Sparsity, VdbOptions};
 pub use vol::{read_vol, write_vol, VolGrid};
 pub use vtk::{read_vtk, write_vtk};
 

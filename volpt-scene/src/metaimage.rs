@@ -192,6 +192,7 @@ pub fn read_metaimage(path: &Path) -> Result<GridDesc, SceneError> {
         )?
     };
     Ok(GridDesc {
+        layout: crate::description::SampleLayout::Dense,
         resolution: header.layout.resolution,
         channels: header.layout.channels,
         bounds,

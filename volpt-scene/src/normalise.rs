@@ -17,7 +17,7 @@ pub fn normalise(mut grid: GridDesc, target_max: f32) -> GridDesc {
     if max > 0.0 {
         // In f64, so that `max` itself lands exactly on `target_max` (255 -> 40.0, not 39.99999).
         let scale = f64::from(target_max) / f64::from(max);
-        for v in &mut grid.data {
+        for v in grid.samples_mut() {
             *v = (f64::from(*v) * scale) as f32;
         }
     }
@@ -31,6 +31,7 @@ mod tests {
 
     fn grid(data: Vec<f32>) -> GridDesc {
         GridDesc {
+            layout: crate::description::SampleLayout::Dense,
             resolution: [data.len() as u32, 1, 1],
             channels: 1,
             bounds: Bounds {

@@ -213,6 +213,7 @@ pub fn read_raw(path: &Path, layout: &RawLayout, bounds: Bounds) -> Result<GridD
     let what = format!("voxel data in {}", path.display());
     let data = read_values(&mut file, layout, data_bytes, path, path, &what)?;
     Ok(GridDesc {
+        layout: crate::description::SampleLayout::Dense,
         resolution: layout.resolution,
         channels: layout.channels,
         bounds,
@@ -605,6 +606,7 @@ mod tests {
         assert_eq!(bounds.min, [0.75, 1.5, 2.0]);
         assert_eq!(bounds.max, [2.75, 3.5, 4.0]);
         let grid = GridDesc {
+            layout: crate::description::SampleLayout::Dense,
             resolution: [4, 2, 1],
             channels: 1,
             bounds,

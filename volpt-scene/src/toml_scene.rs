@@ -64,6 +64,11 @@ pub struct VolumeSpec {
     pub bounds: Option<[[f32; 3]; 2]>,
     /// VTK files: the point-data array to read (default: the first scalar array).
     pub array: Option<String>,
+    /// VDB files: the float grid to read (default: `density`, or the file's only float grid).
+    pub grid: Option<String>,
+    /// VDB files: keep the grid sparse, `auto` (default: when that takes at most half the
+    /// memory, or the dense box would not fit the memory limit), `always` or `never`.
+    pub sparse: Option<String>,
     /// Map the grid's `[0, max]` linearly onto `[0, normalise]` before scaling.
     pub normalise: Option<f32>,
     /// Extinction per unit density.
@@ -79,6 +84,7 @@ pub enum VolumeFormat {
     MetaImage,
     Vtk,
     Vol,
+    Vdb,
 }
 
 /// The boundary's surface (`boundary.bsdf`), named as Mitsuba's plugins.
@@ -111,6 +117,8 @@ pub struct AlbedoSpec {
     pub transfer_function: Option<String>,
     /// A constant albedo, grey or RGB (default 0.9 grey, unless a transfer function is given).
     pub value: Option<OneOrThree>,
+    /// A vec3 grid of the volume's `.vdb` file holding the albedo (the thesis's RGB albedo grid).
+    pub grid: Option<String>,
 }
 
 #[derive(Clone, Copy, Debug, Deserialize)]
@@ -411,6 +419,8 @@ pub fn load_volume_only(
             header_bytes: 0,
             bounds: None,
             array: None,
+            grid: None,
+            sparse: None,
             normalise: None,
             scale: 1.0,
         },
@@ -436,7 +446,7 @@ fn assemble(
     let v = &file.volume;
 
     let volume_path = resolve(&v.file, "volume.file")?;
-    let mut grid = read_volume(cx, &volume_path, v)?;
+    let (mut grid, file_box) = read_volume(cx, &volume_path, v)?;
     if let Some(target) = v.normalise {
         if !(target.is_finite() && target > 0.0) {
             return Err(cx.invalid("volume.normalise", "a positive density", target));
@@ -447,7 +457,42 @@ fn assemble(
         return Err(cx.invalid("volume.scale", "a finite scale >= 0", v.scale));
     }
 
+    let albedo_grid = match &file.albedo.grid {
+        Some(_) if file.albedo.transfer_function.is_some() || file.albedo.value.is_some() => {
+            return Err(cx.invalid(
+                "albedo",
+                "one of grid, transfer_function or value",
+                "grid and another",
+            ))
+        }
+        Some(name) if crate::vdb::is_vdb(&volume_path) => {
+            let options = crate::vdb::VdbOptions {
+                grid: Some(name.clone()),
+                vector: true,
+                sparsity: sparsity(cx, v)?,
+            };
+            let mut albedo = crate::vdb::read_vdb(&volume_path, &options)?;
+            if let Some(b) = v.bounds {
+                // The albedo moves with the density's box.
+                albedo.bounds = remap(
+                    albedo.bounds,
+                    file_box,
+                    checked_box(cx, "volume.bounds", b)?,
+                );
+            }
+            Some(albedo)
+        }
+        Some(_) => {
+            return Err(cx.invalid(
+                "albedo.grid",
+                "a volume.file that is a .vdb (the grid is read from it)",
+                volume_path.display(),
+            ))
+        }
+        None => None,
+    };
     let albedo = match (&file.albedo.transfer_function, file.albedo.value) {
+        _ if albedo_grid.is_some() => AlbedoDesc::Grid(albedo_grid.unwrap()),
         (Some(_), Some(_)) => {
             return Err(cx.invalid("albedo", "either transfer_function or value", "both"))
         }
@@ -621,7 +666,29 @@ fn checked_box(cx: &Cx<'_>, field: &str, [min, max]: [[f32; 3]; 2]) -> Result<Bo
     Ok(Bounds { min, max })
 }
 
-fn read_volume(cx: &Cx<'_>, file: &Path, v: &VolumeSpec) -> Result<GridDesc, SceneError> {
+/// The `volume.sparse` setting.
+fn sparsity(cx: &Cx<'_>, v: &VolumeSpec) -> Result<crate::vdb::Sparsity, SceneError> {
+    match &v.sparse {
+        None => Ok(crate::vdb::Sparsity::Auto),
+        Some(s) => crate::vdb::Sparsity::parse(s)
+            .ok_or_else(|| cx.invalid("volume.sparse", "auto, always or never", s)),
+    }
+}
+
+/// `b` moved and scaled as the box `from` is onto `to`.
+fn remap(b: Bounds, from: Bounds, to: Bounds) -> Bounds {
+    let map = |i: usize, v: f32| {
+        let t = (f64::from(v) - f64::from(from.min[i])) / f64::from(from.max[i] - from.min[i]);
+        (f64::from(to.min[i]) + t * f64::from(to.max[i] - to.min[i])) as f32
+    };
+    Bounds {
+        min: [0, 1, 2].map(|i| map(i, b.min[i])),
+        max: [0, 1, 2].map(|i| map(i, b.max[i])),
+    }
+}
+
+/// The density grid and the box its file gave it (before `volume.bounds` replaced it).
+fn read_volume(cx: &Cx<'_>, file: &Path, v: &VolumeSpec) -> Result<(GridDesc, Bounds), SceneError> {
     let extension = file
         .extension()
         .and_then(|e| e.to_str())
@@ -631,10 +698,11 @@ fn read_volume(cx: &Cx<'_>, file: &Path, v: &VolumeSpec) -> Result<GridDesc, Sce
         (None, Some("mha" | "mhd")) => VolumeFormat::MetaImage,
         (None, Some("vtk" | "vti")) => VolumeFormat::Vtk,
         (None, Some("vol")) => VolumeFormat::Vol,
+        (None, Some("vdb")) => VolumeFormat::Vdb,
         (None, _) => {
             return Err(cx.invalid(
                 "volume.format",
-                "raw, metaimage, vtk or vol (needed when the extension does not say)",
+                "raw, metaimage, vtk, vol or vdb (needed when the extension does not say)",
                 file.display(),
             ))
         }
@@ -660,7 +728,16 @@ fn read_volume(cx: &Cx<'_>, file: &Path, v: &VolumeSpec) -> Result<GridDesc, Sce
                 byte_order: v.byte_order,
                 header_bytes: v.header_bytes,
             };
-            return read_raw(file, &layout, bounds);
+            let grid = read_raw(file, &layout, bounds)?;
+            return Ok((grid, bounds));
+        }
+        VolumeFormat::Vdb => {
+            let options = crate::vdb::VdbOptions {
+                grid: v.grid.clone(),
+                vector: false,
+                sparsity: sparsity(cx, v)?,
+            };
+            crate::vdb::read_vdb(file, &options)?
         }
         VolumeFormat::MetaImage => read_metaimage(file)?,
         VolumeFormat::Vtk => read_vtk(file, v.array.as_deref())?,
@@ -668,6 +745,7 @@ fn read_volume(cx: &Cx<'_>, file: &Path, v: &VolumeSpec) -> Result<GridDesc, Sce
             let vol = read_vol(file)?;
             vol.check_density(file)?;
             GridDesc {
+                layout: crate::description::SampleLayout::Dense,
                 resolution: vol.resolution,
                 channels: vol.channels,
                 bounds: vol.bbox,
@@ -684,10 +762,11 @@ fn read_volume(cx: &Cx<'_>, file: &Path, v: &VolumeSpec) -> Result<GridDesc, Sce
             format!("{} channels in {}", grid.channels, file.display()),
         ));
     }
+    let file_box = grid.bounds;
     if let Some(bounds) = bounds {
         grid.bounds = bounds;
     }
-    Ok(grid)
+    Ok((grid, file_box))
 }
 
 /// Mitsuba's `lookat`: camera +z towards the target, +y up, +x to the left of the image.

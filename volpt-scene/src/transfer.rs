@@ -144,11 +144,16 @@ impl TransferFunction {
     /// with more, each voxel's first channel is taken as its density.
     pub fn apply(&self, density: &GridDesc) -> GridDesc {
         let channels = density.channels.max(1) as usize;
-        let mut data = Vec::with_capacity(density.data.len() / channels * 3);
-        for voxel in density.data.chunks_exact(channels) {
+        let samples = density.samples();
+        let table: Vec<f32> = density.data[samples.len()..].to_vec();
+        let mut data = Vec::with_capacity(samples.len() / channels * 3 + table.len());
+        for voxel in samples.chunks_exact(channels) {
             data.extend_from_slice(&self.eval(voxel[0]));
         }
+        // A sparse density's albedo is sparse too, with the same bricks: the same table.
+        data.extend(table);
         GridDesc {
+            layout: density.layout,
             resolution: density.resolution,
             channels: 3,
             bounds: density.bounds,

@@ -170,6 +170,16 @@ fn check(
             };
         }
     }
+    let sparse = matches!(&medium.density, DensityDesc::Grid(g) if g.layout == SampleLayout::Sparse)
+        || matches!(&medium.albedo, AlbedoDesc::Grid(g) if g.layout == SampleLayout::Sparse);
+    if sparse && matches!(medium.lookup, GridLookup::Texture | GridLookup::TextureHalf) {
+        return Err(invalid(
+            "grid lookup",
+            "trilinear, stochastic or nearest lookups for a sparse grid (textures hold dense grids; \
+             read the VDB dense with sparse = \"never\" to use them)",
+            format!("{:?}", medium.lookup),
+        ));
+    }
     if let PhaseDesc::HenyeyGreenstein { g } = medium.phase {
         if !(g > -1.0 && g < 1.0) {
             return Err(invalid("phase g", "a number in (-1, 1)", g.to_string()));
@@ -282,7 +292,15 @@ fn check_grid(
     let expected = [y, z, grid.channels]
         .iter()
         .try_fold(u64::from(x), |acc, &n| acc.checked_mul(u64::from(n)));
-    if expected != Some(grid.data.len() as u64) {
+    if grid.layout == SampleLayout::Sparse {
+        if let Err(found) = crate::sparse::check(grid) {
+            return Err(invalid(
+                role,
+                "whole 8^3 bricks and a brick table naming them",
+                found,
+            ));
+        }
+    } else if expected != Some(grid.data.len() as u64) {
         return Err(invalid(
             role,
             "resolution x channels values",
@@ -295,7 +313,7 @@ fn check_grid(
     }
     check_bounds(grid.bounds).map_err(|found| invalid(&format!("{role} box"), BOX, found))?;
     let mut largest = 0.0f32;
-    for &v in &grid.data {
+    for &v in grid.samples() {
         if !(v >= 0.0 && v <= max) {
             return Err(invalid(
                 role,

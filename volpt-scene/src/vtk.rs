@@ -162,6 +162,7 @@ pub fn read_vtk(path: &Path, array: Option<&str>) -> Result<GridDesc, SceneError
         )
     })?;
     Ok(GridDesc {
+        layout: crate::description::SampleLayout::Dense,
         resolution,
         channels,
         bounds,

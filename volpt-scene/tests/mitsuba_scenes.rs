@@ -72,6 +72,7 @@ fn assert_smoke_scene(
     assert_eq!(scene.medium.phase, PhaseDesc::HenyeyGreenstein { g: 0.3 });
     match &scene.medium.density {
         DensityDesc::Grid(GridDesc {
+            layout: volpt_scene::SampleLayout::Dense,
             resolution,
             channels,
             bounds,

@@ -22,6 +22,7 @@ fn the_largest_extinction_is_the_scale_times_the_largest_density() {
     desc.medium.density = DensityDesc::Constant(5.0);
     assert_eq!(max_extinction(&desc.medium), 15.0);
     desc.medium.density = DensityDesc::Grid(GridDesc {
+        layout: volpt_scene::SampleLayout::Dense,
         resolution: [2, 1, 1],
         channels: 1,
         bounds: unit_bounds(),

@@ -27,6 +27,7 @@ fn layout(resolution: [u32; 3], channels: u32, scalar: ScalarType) -> RawLayout 
 
 fn grid(resolution: [u32; 3], channels: u32, data: Vec<f32>) -> GridDesc {
     GridDesc {
+        layout: volpt_scene::SampleLayout::Dense,
         resolution,
         channels,
         bounds: unit(),

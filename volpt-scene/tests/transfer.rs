@@ -68,6 +68,7 @@ fn one_point_is_a_constant() {
 fn apply_makes_an_rgb_grid_of_the_same_shape() {
     let tf = TransferFunction::read(&fixture()).unwrap();
     let density = GridDesc {
+        layout: volpt_scene::SampleLayout::Dense,
         resolution: [3, 1, 1],
         channels: 1,
         bounds: Bounds {

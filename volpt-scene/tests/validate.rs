@@ -76,6 +76,7 @@ fn an_environment_map_with_scale_one_passes_and_a_negative_scale_does_not() {
 fn a_density_grid_with_a_negative_value_is_refused() {
     let mut desc = base();
     let mut grid = GridDesc {
+        layout: volpt_scene::SampleLayout::Dense,
         resolution: [2, 1, 1],
         channels: 1,
         bounds: desc.boundary.bounds,

@@ -19,6 +19,7 @@ fn fixture(name: &str) -> PathBuf {
 fn grid(resolution: [u32; 3], channels: u32) -> GridDesc {
     let n = (resolution.iter().product::<u32>() * channels) as usize;
     GridDesc {
+        layout: volpt_scene::SampleLayout::Dense,
         resolution,
         channels,
         bounds: Bounds {

@@ -10,12 +10,13 @@ use volpt_render::factory::{
 };
 use volpt_scene::{
     AlbedoDesc, BsdfDesc, DensityDesc, EnvironmentDesc, GridDesc, GridLookup, PhaseDesc,
-    SceneDescription,
+    SampleLayout, SceneDescription,
 };
 
 /// A scene described field by field, in `volpt info`'s order: `scene`, `variant`, `film`,
 /// `camera`, `integrator`, `bounds`, `boundary`, `density`, `majorant`, `tracking`, `estimator`,
-/// `albedo`, `lookup` (a medium with grids), `math`, `phase`, `light`. A value of several lines (the variant's specialisations, the
+/// `albedo`, `memory` (only with grids), `lookup` (only with grids), `math`, `phase`, `light`. A
+/// value of several lines (the variant's specialisations, the
 /// tracking's default rule) has them separated by `\n`. [`fmt::Display`] writes `volpt info`'s
 /// text: each key in a column of 11 characters, later lines of a value indented to it.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -108,7 +109,7 @@ pub fn describe(
     field("boundary", boundary);
     let grid = |g: &GridDesc| {
         let (lo, hi) = g
-            .data
+            .samples()
             .iter()
             .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &v| {
                 (lo.min(v), hi.max(v))
@@ -137,6 +138,16 @@ pub fn describe(
         AlbedoDesc::Grid(g) => grid(g),
     };
     field("albedo", albedo);
+    let mut memory = Vec::new();
+    if let DensityDesc::Grid(g) = &m.density {
+        memory.push(grid_memory("density", g));
+    }
+    if let AlbedoDesc::Grid(g) = &m.albedo {
+        memory.push(grid_memory("albedo", g));
+    }
+    if !memory.is_empty() {
+        field("memory", memory.join("\n"));
+    }
     let grids =
         matches!(m.density, DensityDesc::Grid(_)) || matches!(m.albedo, AlbedoDesc::Grid(_));
     if grids {
@@ -263,6 +274,26 @@ fn estimator(parts: &Parts<'_>, settings: &PathSettings) -> &'static str {
             } else {
                 "path tracing (--estimator nee samples the map)"
             }
+        }
+    }
+}
+
+/// What a grid takes in memory: stored, and dense where it is sparse (a VDB kept sparse).
+fn grid_memory(name: &str, g: &GridDesc) -> String {
+    let mib = |bytes: u64| format!("{:.2} MiB", bytes as f64 / f64::from(1 << 20));
+    let stored = g.stored_bytes();
+    match g.layout {
+        SampleLayout::Dense => format!("{name} grid {} dense", mib(stored)),
+        SampleLayout::Sparse => {
+            let bricks = g.samples().len() / (512 * g.channels.max(1) as usize);
+            let table = volpt_scene::sparse::table_len(g.resolution).unwrap_or(0);
+            let dense = g
+                .dense_bytes()
+                .map_or("more than 2^64 bytes".to_owned(), mib);
+            format!(
+                "{name} grid {} sparse ({bricks} stored bricks of {table}), dense {dense}",
+                mib(stored)
+            )
         }
     }
 }

@@ -13,8 +13,8 @@ use volpt_render::{Effects, Variant};
 use volpt_scene::toml_scene::look_at;
 use volpt_scene::validate::CheckedData;
 use volpt_scene::{
-    AlbedoDesc, DensityDesc, GridLookup, GridStorage, PhaseDesc, SceneAssembler, SceneBuilder,
-    SceneDescription,
+    AlbedoDesc, DensityDesc, GridDesc, GridLookup, GridStorage, PhaseDesc, SampleLayout,
+    SceneAssembler, SceneBuilder, SceneDescription,
 };
 
 use crate::settings::RenderSettings;
@@ -526,8 +526,24 @@ fn not_here(key: &str, expected: &str, found: &str) -> Error {
     }
 }
 
-/// Refuses a lookup the medium's grids cannot take: half-precision texels end at 65504.
+/// Refuses a lookup the medium's grids cannot take: textures hold dense grids, and
+/// half-precision texels end at 65504.
 fn check_lookup(desc: &SceneDescription, checked: CheckedData) -> Result<(), Error> {
+    let texture = matches!(
+        desc.medium.lookup,
+        GridLookup::Texture | GridLookup::TextureHalf
+    );
+    let sparse = |g: &GridDesc| g.layout == SampleLayout::Sparse;
+    let sparse = matches!(&desc.medium.density, DensityDesc::Grid(g) if sparse(g))
+        || matches!(&desc.medium.albedo, AlbedoDesc::Grid(g) if sparse(g));
+    if texture && sparse {
+        return Err(Error::Settings(
+            "--lookup texture and texture-f16 read dense grids, and this scene's grid is kept \
+             sparse (a VDB): use trilinear, stochastic or nearest lookups, or read the VDB dense \
+             (sparse = \"never\" in a TOML scene)"
+                .to_owned(),
+        ));
+    }
     if desc.medium.lookup != GridLookup::TextureHalf {
         return Ok(());
     }

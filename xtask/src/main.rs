@@ -289,6 +289,22 @@ fn device_bundle() -> Result<()> {
     copy_dir(&root.join("scenes"), &bundle.join("scenes"), &|p| {
         p.extension().is_some_and(|e| e == "vol")
     })?;
+    // The large sparse VDB of bench/device/vdb.sh, written with OpenVDB beforehand
+    // (`scenes/vdb/make_fixtures.py target/vdb-bench --large N`), if there is one.
+    let vdb_bench = root.join("target/vdb-bench");
+    if vdb_bench.is_dir() {
+        // The carried bundle must stay small: a volume over 48 MiB is left out, said here.
+        copy_dir(&vdb_bench, &bundle.join("vdb-bench"), &|p| {
+            let large = p.metadata().is_ok_and(|m| m.len() > 48 << 20);
+            if large {
+                eprintln!(
+                    "xtask: leaving {} (over 48 MiB) out of the bundle",
+                    p.display()
+                );
+            }
+            large || p.extension().is_none_or(|e| e != "vdb")
+        })?;
+    }
     let shared = root.join("../shared/data");
     if shared.is_dir() {
         copy_dir(&shared, &bundle.join("data"), &|_| false)?;

@@ -54,7 +54,7 @@ use volpt_core::{
 use volpt_scene::description::{
     AlbedoDesc, Bounds, BsdfDesc, CameraDesc, DensityDesc, EnvironmentDesc, FilmDesc, FovAxis,
     GridConvention, GridDesc, GridLookup as GridLookupDesc, GridStorage, LatLongDesc, MediumDesc,
-    PhaseDesc, SceneDescription,
+    PhaseDesc, SampleLayout, SceneDescription,
 };
 
 /// What a backend can render: the CPU needs a [`Scene`] it can share between threads, a GPU backend

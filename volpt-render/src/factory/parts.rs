@@ -42,8 +42,9 @@ fn uniform<'g>(grid: &'g GridDesc, bounds: &Bounds, cache: &FactoryCache) -> Opt
     let covers =
         (0..3).all(|i| grid.bounds.min[i] <= bounds.min[i] && grid.bounds.max[i] >= bounds.max[i]);
     let channels = grid.channels as usize;
-    let first = grid.data.get(..channels)?;
-    (covers && cache.is_uniform(&grid.data, channels)).then_some(first)
+    let samples = grid.samples();
+    let first = samples.get(..channels)?;
+    (covers && cache.is_uniform(samples, channels)).then_some(first)
 }
 
 pub(super) fn medium<'a>(
@@ -104,18 +105,27 @@ pub(super) fn medium<'a>(
 }
 
 /// Whether the medium's grids need the any-layout reads ([`AnyLayout`]): nearest-sample lookups,
-/// or bricked storage on a GPU. Every other grid is read dense and trilinear, with only that code
-/// in the kernel.
+/// bricked storage on a GPU, or a sparse grid. Every other grid is read dense and trilinear, with
+/// only that code in the kernel.
 fn any_layout(medium: &MediumDesc) -> bool {
-    medium.lookup == GridLookupDesc::Nearest || medium.storage != GridStorage::Dense
+    medium.lookup == GridLookupDesc::Nearest
+        || medium.storage != GridStorage::Dense
+        || sparse_grids(medium)
+}
+
+/// Whether a grid of the medium is sparse (read in software: a texture holds dense samples).
+fn sparse_grids(medium: &MediumDesc) -> bool {
+    let sparse = |g: &GridDesc| g.layout == SampleLayout::Sparse;
+    matches!(&medium.density, DensityDesc::Grid(g) if sparse(g))
+        || matches!(&medium.albedo, AlbedoDesc::Grid(g) if sparse(g))
 }
 
 /// Whether the medium's grids are read through textures ([`TextureTrilinear`]): the texture
-/// lookups, and stochastic lookups of dense grids (one unfiltered texel; bricked grids are read
-/// in software by [`AnyLayout`]).
+/// lookups, and stochastic lookups of dense grids (one unfiltered texel; bricked and sparse grids
+/// are read in software by [`AnyLayout`]).
 fn texture_reads(medium: &MediumDesc) -> bool {
     match medium.lookup {
-        GridLookupDesc::Stochastic => medium.storage == GridStorage::Dense,
+        GridLookupDesc::Stochastic => medium.storage == GridStorage::Dense && !sparse_grids(medium),
         lookup => texel(lookup).is_some(),
     }
 }
@@ -199,7 +209,7 @@ fn grid_medium<'a, R: GridReads>(
         Density::Grid(density) => grid::<1>(density, desc.medium.lookup),
         Density::Constant(sigma) => one_voxel(desc, std::slice::from_ref(sigma)),
     };
-    let max_density = density.data.iter().copied().fold(0.0, f32::max);
+    let max_density = density.samples().iter().copied().fold(0.0, f32::max);
     GridMedium {
         density,
         scale: desc.medium.scale,
@@ -298,8 +308,11 @@ fn grid<const C: usize>(g: &GridDesc, lookup: GridLookupDesc) -> Grid<'_, C> {
         GridConvention::Vertex => GridMapping::vertex_centred(bounds, g.resolution),
         GridConvention::Cell => GridMapping::cell_centred(bounds, g.resolution),
     };
-    let grid =
-        Grid::new(&g.data, g.resolution, mapping).with_texel(texel(lookup).unwrap_or_default());
+    let grid = match g.layout {
+        SampleLayout::Dense => Grid::new(&g.data, g.resolution, mapping),
+        SampleLayout::Sparse => Grid::sparse(&g.data, g.resolution, mapping),
+    }
+    .with_texel(texel(lookup).unwrap_or_default());
     match lookup {
         GridLookupDesc::Nearest => grid.with_lookup(GridLookup::Nearest),
         GridLookupDesc::Stochastic => grid.with_lookup(GridLookup::Stochastic),

@@ -59,6 +59,16 @@ pub fn write_mitsuba3(
     // Writes `<name>-<what>.vol` and returns the `gridvolume` that reads it as Mitsuba's `param`.
     let mut grid = |grid: &GridDesc, what: &str, param: &str| -> Result<String, SceneError> {
         let file = format!("{name}-{what}.vol");
+        // Mitsuba's .vol is dense: a sparse grid is written densified, within the memory limit.
+        let [x, y, z] = grid.resolution;
+        crate::limits::check_grid_memory(
+            &dir.join(&file),
+            [x, y, z],
+            grid.channels,
+            grid.dense_bytes().unwrap_or(u64::MAX) / 4,
+        )?;
+        let dense = grid.densified();
+        let grid = &dense;
         let (bbox, to_world) = cell_centred_box(grid);
         let path = dir.join(&file);
         write_vol(

@@ -56,6 +56,45 @@ pub(crate) fn volume(arg: &Arg<'_>, ctx: &Ctx<'_>, role: Role) -> Result<VolumeV
     Ok(value)
 }
 
+/// A `gridvolume` whose file is a `.vdb`: the grid named by `<string name="grid">` (default: the
+/// density, or for an albedo the file's vec3 grid), over the box its own transform gives
+/// (voxel centres: cell-centred), mapped by `toWorld`/`to_world`, in either dialect.
+fn vdb_grid(p: &Plugin<'_>, role: Role, path: &Path) -> Result<GridDesc, SceneError> {
+    let name = match p.find(&["grid"])? {
+        Some(arg) => Some(arg.string()?.to_owned()),
+        None => None,
+    };
+    let options = crate::vdb::VdbOptions {
+        grid: name,
+        vector: role == Role::Albedo,
+        sparsity: crate::vdb::Sparsity::Auto,
+    };
+    let mut grid = crate::vdb::read_vdb(path, &options)?;
+    let to_world = match p.find(&["toWorld", "to_world"])? {
+        Some(arg) => transform(&arg)?,
+        None => IDENTITY_F64,
+    };
+    let (min, max) = (
+        grid.bounds.min.map(f64::from),
+        grid.bounds.max.map(f64::from),
+    );
+    grid.bounds = scaled_box(&to_world, min, max).ok_or_else(|| {
+        p.unsupported(
+            "its toWorld/to_world rotates, mirrors or shears the grid; volpt's grids are \
+             axis-aligned, so only positive scales and translations are allowed",
+        )
+    })?;
+    p.ignore(&[
+        "use_grid_bbox",
+        "sendData",
+        "customStepSize",
+        "raw",
+        "accel",
+    ]);
+    warn_on_lookup_settings(p)?;
+    Ok(grid)
+}
+
 fn grid(p: &Plugin<'_>, role: Role) -> Result<GridDesc, SceneError> {
     let el = p.el;
     let filename = p
@@ -68,6 +107,9 @@ fn grid(p: &Plugin<'_>, role: Role) -> Result<GridDesc, SceneError> {
         element: el.describe(),
         error: Box::new(error),
     };
+    if crate::vdb::is_vdb(&path) {
+        return vdb_grid(p, role, &path).map_err(referenced);
+    }
     let vol = read_vol(&path).map_err(referenced)?;
     match role {
         Role::Density => vol.check_density(&path),
@@ -129,6 +171,7 @@ fn grid(p: &Plugin<'_>, role: Role) -> Result<GridDesc, SceneError> {
         _ => (vol.channels, vol.data),
     };
     Ok(GridDesc {
+        layout: crate::description::SampleLayout::Dense,
         resolution: vol.resolution,
         channels,
         bounds,
