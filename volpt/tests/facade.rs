@@ -304,6 +304,7 @@ impl volpt::scene_files::SceneBuilder for GridCube {
             bounds: desc.boundary.bounds,
             convention: GridConvention::Cell,
             data: self.0.clone(),
+            layout: Default::default(),
         });
         Ok(desc)
     }
