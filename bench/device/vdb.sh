@@ -72,7 +72,7 @@ else
         printf '[volume]\nfile = "%s"\nsparse = "%s"\nnormalise = 100\n[boundary]\nbsdf = "null"\n[camera]\nfov = 0.8\n' \
             "$PWD/$cloud" "$mode" >"$dir/$mode.toml"
     done
-    run info "$VOLPT" info "$dir/always.toml" && grep -A2 '^memory' "$WORK/logs/info.log" | tee -a "$OUT/summary.txt"
+    run info "$VOLPT" info "$dir/always.toml" && grep '^memory' "$WORK/logs/info.log" | tee -a "$OUT/summary.txt"
     for v in "sparse:always:" "dense:never:" "bricked:never:--bricked"; do
         IFS=: read -r name mode flags <<<"$v"
         # shellcheck disable=SC2086
