@@ -14,9 +14,13 @@ import pytest
 import volpt
 from conftest import CUBE, SETTINGS
 
+# The child installs Python's Ctrl-C handler itself: a child of a process that ignores SIGINT (a
+# runner started in the background of a shell, a Ray driver) starts with SIGINT ignored, and an
+# interpreter that starts so installs none.
 CHILD = textwrap.dedent(
     """
-    import sys, time
+    import signal, sys, time
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     import volpt
     scene = volpt.load(sys.argv[1], {"resolution": (64, 64)})
     print("rendering", flush=True)
