@@ -83,6 +83,18 @@ impl SceneVisitor for Cpu {
     }
 }
 
+/// The plain estimator the estimator tests compare against: path tracing, no roulette, depth
+/// unlimited, a majorant grid of 16 cells along the box.
+pub fn plain_path_tracing() -> PathSettings {
+    PathSettings {
+        max_depth: PathSettings::UNLIMITED,
+        rr_depth: PathSettings::UNLIMITED,
+        majorant_resolution: 16,
+        estimator: volpt_core::Estimator::PathTracing,
+        ..PathSettings::default()
+    }
+}
+
 /// Renders `desc` on the CPU with `spp` samples and the scene's integrator settings.
 pub fn render_cpu(desc: &SceneDescription, spp: u32, seed: u32) -> (Image, RenderStats) {
     render_with(desc, spp, seed, volpt_render::path_settings(desc))

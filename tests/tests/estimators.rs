@@ -17,26 +17,15 @@ use volpt_render::{with_scene, RenderScene, SceneVisitor};
 use volpt_scene::description::*;
 use volpt_tests::agreement::{assert_agree, ImageMean, MARGIN, WINDOW};
 use volpt_tests::generated::{broad_sun_sky, framed_scene, heterogeneous_medium, LOW_ALBEDO};
+use volpt_tests::plain_path_tracing;
 
 /// Pixels per side: every pixel sees the medium.
 const SIZE: u32 = 12;
 
-/// The plain estimator: path tracing, no roulette, depth unlimited, a majorant grid of 16 cells
-/// along the box.
-fn plain() -> PathSettings {
-    PathSettings {
-        max_depth: PathSettings::UNLIMITED,
-        rr_depth: PathSettings::UNLIMITED,
-        majorant_resolution: 16,
-        estimator: Estimator::PathTracing,
-        ..PathSettings::default()
-    }
-}
-
 fn nee() -> PathSettings {
     PathSettings {
         estimator: Estimator::NextEvent,
-        ..plain()
+        ..plain_path_tracing()
     }
 }
 
@@ -81,10 +70,18 @@ fn compare(
 fn next_event_estimation_matches_path_tracing_on_a_generated_medium() {
     let constant = constant_sky();
     let candidates = [("nee, constant sky", &constant, nee())];
-    compare(SPP_CONSTANT_NEE, (&constant, plain()), &candidates);
+    compare(
+        SPP_CONSTANT_NEE,
+        (&constant, plain_path_tracing()),
+        &candidates,
+    );
     let lat_long = lat_long_sky();
     let candidates = [("nee, lat-long sky", &lat_long, nee())];
-    compare(SPP_LAT_LONG_NEE, (&lat_long, plain()), &candidates);
+    compare(
+        SPP_LAT_LONG_NEE,
+        (&lat_long, plain_path_tracing()),
+        &candidates,
+    );
 }
 
 /// Ratio tracking's error against the transmittance by quadrature, over `rays` shadow rays from
@@ -199,7 +196,7 @@ fn each_roulette_rule_matches_no_roulette_on_a_generated_medium() {
     let rule = |roulette| PathSettings {
         rr_depth: 0,
         roulette,
-        ..plain()
+        ..plain_path_tracing()
     };
     let desc = scene((0.5, 0.98), EnvironmentDesc::Constant([1.0, 0.9, 0.8]));
     let candidates = [
@@ -210,7 +207,7 @@ fn each_roulette_rule_matches_no_roulette_on_a_generated_medium() {
             rule(Roulette::Throughput),
         ),
     ];
-    compare(SPP_ROULETTE, (&desc, plain()), &candidates);
+    compare(SPP_ROULETTE, (&desc, plain_path_tracing()), &candidates);
 }
 
 /// Every grid lookup against dense trilinear reads of the same grids: the any-layout reads
@@ -230,11 +227,11 @@ fn every_grid_lookup_matches_dense_trilinear_on_a_generated_medium() {
     let texture = with(GridLookup::Texture, GridStorage::Dense);
     let half = with(GridLookup::TextureHalf, GridStorage::Dense);
     let candidates = [
-        ("any-layout reads (bricked)", &bricked, plain()),
-        ("texture filter", &texture, plain()),
-        ("half-precision texture", &half, plain()),
+        ("any-layout reads (bricked)", &bricked, plain_path_tracing()),
+        ("texture filter", &texture, plain_path_tracing()),
+        ("half-precision texture", &half, plain_path_tracing()),
     ];
-    compare(SPP_LOOKUP, (&desc, plain()), &candidates);
+    compare(SPP_LOOKUP, (&desc, plain_path_tracing()), &candidates);
 }
 
 // Samples per pixel, sized from pilot renders of 256 spp: the factor by which those fell short

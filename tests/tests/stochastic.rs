@@ -20,6 +20,7 @@ use volpt_scene::description::*;
 use volpt_tests::agreement::{assert_agree, ImageMean};
 use volpt_tests::generated::{framed_scene, heterogeneous_medium, LOW_ALBEDO};
 use volpt_tests::pixel_statistics_with;
+use volpt_tests::plain_path_tracing;
 
 const SIZE: u32 = 12;
 
@@ -27,16 +28,6 @@ const SIZE: u32 = 12;
 /// difference in the worst channel, against the 10 that `agreement::MARGIN` asks, so 256 x
 /// (10 / 2.0)^2 x 1.3 to spare.
 const SPP: u32 = 8320;
-
-fn plain() -> PathSettings {
-    PathSettings {
-        max_depth: PathSettings::UNLIMITED,
-        rr_depth: PathSettings::UNLIMITED,
-        majorant_resolution: 16,
-        estimator: Estimator::PathTracing,
-        ..PathSettings::default()
-    }
-}
 
 fn scene(lookup: GridLookup, storage: GridStorage) -> SceneDescription {
     let mut desc = framed_scene(
@@ -82,16 +73,16 @@ fn assert_pixels_agree(name: &str, a: &[[(f64, f64); 3]], b: &[[(f64, f64); 3]])
 fn stochastic_lookups_match_trilinear_on_a_generated_medium() {
     let start = std::time::Instant::now();
     let reference = scene(GridLookup::Trilinear, GridStorage::Dense);
-    let a = pixel_statistics_with(&reference, SPP, 1, plain());
+    let a = pixel_statistics_with(&reference, SPP, 1, plain_path_tracing());
     let nee = PathSettings {
         estimator: Estimator::NextEvent,
-        ..plain()
+        ..plain_path_tracing()
     };
     let a_nee = pixel_statistics_with(&reference, SPP, 2, nee);
     let dense = scene(GridLookup::Stochastic, GridStorage::Dense);
     let bricked = scene(GridLookup::Stochastic, GridStorage::Bricked);
     let candidates = [
-        ("stochastic", &dense, plain(), &a, 3),
+        ("stochastic", &dense, plain_path_tracing(), &a, 3),
         ("stochastic under nee", &dense, nee, &a_nee, 4),
     ];
     for (name, desc, settings, a, seed) in candidates {
