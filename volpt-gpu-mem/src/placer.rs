@@ -189,36 +189,17 @@ impl VolumePlacer {
         let (resident, scene) = self.keep.as_ref()?;
         let mut kept = resident.kept.lock().unwrap_or_else(|e| e.into_inner());
         if kept.scene != Some(*scene) {
-            if !kept.grids.is_empty() {
-                // The renders that read them are over (each placer waits for its kernels before
-                // it is dropped); wait anyway rather than free memory a kernel could read.
-                if let Err(e) = self.stream.synchronize() {
-                    tracing::error!(%e, "synchronising before freeing the kept volumes");
-                }
-                tracing::debug!("freeing the grids kept of the scene rendered before");
-            }
-            // Free now, though the driver said otherwise when this placer asked.
-            self.free_device += kept.grids.iter().map(|r| on_device(&r.record)).sum::<u64>();
-            kept.grids.clear();
+            // Another scene's grids: free them all, though the driver said otherwise when this
+            // placer asked.
+            self.free_device += free_kept(&self.stream, &mut kept.grids, |_| true);
             kept.scene = Some(*scene);
         }
         let Some(resident) = kept.grids.iter().find(|r| r.key == *key) else {
             // The same values placed otherwise before (another lookup or layout): this render
             // places them anew, and the scene's next render will find them so.
-            let replaced = |r: &Resident| r.key.values == key.values;
-            if kept.grids.iter().any(replaced) {
-                if let Err(e) = self.stream.synchronize() {
-                    tracing::error!(%e, "synchronising before freeing a kept volume");
-                }
-                let freed: u64 = kept
-                    .grids
-                    .iter()
-                    .filter(|r| replaced(r))
-                    .map(|r| on_device(&r.record))
-                    .sum();
-                self.free_device += freed;
-                kept.grids.retain(|r| !replaced(r));
-            }
+            self.free_device += free_kept(&self.stream, &mut kept.grids, |r| {
+                r.key.values == key.values
+            });
             return None;
         };
         let (placed, record) = (resident.placed, resident.record);
@@ -443,6 +424,30 @@ impl VolumePlacer {
         self.held.push(Box::new(buffer));
         Ok(address)
     }
+}
+
+/// Frees the kept grids that `which` selects and returns the device bytes they took. The renders
+/// that read them are over (each placer waits for its kernels before it is dropped); the stream is
+/// waited for anyway rather than free memory a kernel could read.
+fn free_kept(
+    stream: &CudaStream,
+    grids: &mut Vec<Resident>,
+    which: impl Fn(&Resident) -> bool,
+) -> u64 {
+    if !grids.iter().any(&which) {
+        return 0;
+    }
+    if let Err(e) = stream.synchronize() {
+        tracing::error!(%e, "synchronising before freeing kept volumes");
+    }
+    let freed = grids
+        .iter()
+        .filter(|r| which(r))
+        .map(|r| on_device(&r.record))
+        .sum();
+    grids.retain(|r| !which(r));
+    tracing::debug!(bytes = freed, "freed kept volumes");
+    freed
 }
 
 /// Device memory a placement takes.
