@@ -55,6 +55,14 @@ impl Packet {
         self.0.extend(v.to_le_bytes());
     }
 
+    /// The channel count and the channels' names, as both packets carry them.
+    fn channels(&mut self) {
+        self.i32(CHANNELS.len() as i32);
+        for c in CHANNELS {
+            self.string(c);
+        }
+    }
+
     fn finish(mut self) -> Vec<u8> {
         let len = u32::try_from(self.0.len()).expect("packets are at most a few MB");
         self.0[..4].copy_from_slice(&len.to_le_bytes());
@@ -67,10 +75,7 @@ pub fn create_image(name: &str, width: u32, height: u32) -> Vec<u8> {
     let mut p = Packet::new(CREATE_IMAGE, true, name);
     p.i32(width as i32);
     p.i32(height as i32);
-    p.i32(CHANNELS.len() as i32);
-    for c in CHANNELS {
-        p.string(c);
-    }
+    p.channels();
     p.finish()
 }
 
@@ -85,10 +90,7 @@ pub fn update_image(name: &str, image: &Image) -> Vec<Vec<u8>> {
         .enumerate()
         .map(|(band, pixels)| {
             let mut p = Packet::new(UPDATE_IMAGE_V3, false, name);
-            p.i32(CHANNELS.len() as i32);
-            for c in CHANNELS {
-                p.string(c);
-            }
+            p.channels();
             let y = band * rows_per_packet;
             p.i32(0);
             p.i32(y as i32);
