@@ -216,6 +216,24 @@ impl CudaRenderer {
             .map(drop)
     }
 
+    /// Places the grids of the scene numbered `grids` on this GPU now, where the next
+    /// [`CudaRenderer::render_samples_keeping`] of it finds them: several GPUs copy their grids at
+    /// once before their render's clock starts, as one GPU's render does before its own.
+    ///
+    /// # Safety
+    /// As [`CudaRenderer::render_samples_keeping`].
+    pub unsafe fn keep_grids<S: SceneAbi>(&self, scene: &S, grids: u64) -> Result<(), CudaError> {
+        // SAFETY: the grids are `scene`'s, borrowed for this whole call; `volumes` is dropped
+        // (synchronising) before it returns, and what it keeps falls under the caller's contract.
+        let mut volumes = unsafe {
+            VolumePlacer::new(self.stream.clone(), self.volumes)?
+                .keeping(self.resident.clone(), grids)
+        };
+        let _ = scene.to_params(&mut volumes);
+        volumes.check()?;
+        Ok(())
+    }
+
     pub(crate) fn stream(&self) -> &Arc<CudaStream> {
         &self.stream
     }
@@ -330,11 +348,12 @@ impl CudaRenderer {
         let mut device_film: CudaSlice<f64> = stream
             .alloc_zeros(3 * pixels as usize)
             .doing("allocating the film")?;
-        // A resumed render: the sums of the samples before `samples` continue on the device.
-        if samples.start > 0 {
-            let flat: Vec<f64> = film.sums.iter().flatten().copied().collect();
+        // A resumed render: the sums of the samples before `samples` continue on the device (as
+        // the CPU continues them), unless there are none yet, as in a batch of several GPUs,
+        // whose film starts empty: the zeroed device film is that film already.
+        if samples.start > 0 && film.holds_samples() {
             stream
-                .memcpy_htod(&flat, &mut device_film)
+                .memcpy_htod(film.flat_sums(), &mut device_film)
                 .doing("copying the film to the GPU")?;
         }
         let counters: CudaSlice<u64> = stream
@@ -491,10 +510,11 @@ impl CudaRenderer {
                 Some((key, budget.get()));
         }
 
-        let sums = stream.clone_dtoh(&device_film).doing("reading the film")?;
+        stream
+            .memcpy_dtoh(&device_film, film.flat_sums_mut())
+            .doing("reading the film")?;
         let totals = stream.clone_dtoh(&counters).doing("reading the counters")?;
         drop(volumes);
-        film.sums = sums.chunks_exact(3).map(|s| [s[0], s[1], s[2]]).collect();
         let counters = PathCounters {
             paths: totals[0],
             segments: totals[1],

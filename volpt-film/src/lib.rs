@@ -75,6 +75,22 @@ impl Film {
         }
     }
 
+    /// Whether any sum is other than `+0.0`, the bits a new film starts with: a film that holds
+    /// none holds no samples yet.
+    pub fn holds_samples(&self) -> bool {
+        self.flat_sums().iter().any(|sum| sum.to_bits() != 0)
+    }
+
+    /// The sums as one slice, red, green and blue of each pixel in turn (how devices store them).
+    pub fn flat_sums(&self) -> &[f64] {
+        self.sums.as_flattened()
+    }
+
+    /// The sums as one mutable slice, as [`Film::flat_sums`].
+    pub fn flat_sums_mut(&mut self) -> &mut [f64] {
+        self.sums.as_flattened_mut()
+    }
+
     /// The same film, adding samples in `accumulation`.
     pub fn with_accumulation(self, accumulation: Accumulation) -> Self {
         Self {
@@ -154,6 +170,21 @@ impl RenderStats {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Only a film of `+0.0` bits holds nothing: a `-0.0` or any other sum is something a
+    /// device must continue from.
+    #[test]
+    fn a_film_holds_samples_once_any_sum_has_other_bits_than_zero() {
+        let mut film = Film::new(3, 2);
+        assert!(!film.holds_samples());
+        film.sums[5][2] = -0.0;
+        assert!(film.holds_samples());
+        film.flat_sums_mut().fill(0.0);
+        assert!(!film.holds_samples());
+        film.flat_sums_mut()[1] = f64::MIN_POSITIVE;
+        assert_eq!(film.sums[0][1], f64::MIN_POSITIVE);
+        assert!(film.holds_samples());
+    }
 
     /// At 2^24 an f32 sum no longer changes by 1; an f64 sum does.
     #[test]

@@ -685,8 +685,8 @@ impl SceneVisitor for Render<'_> {
             _ => Vec::new(),
         };
         if !devices.is_empty() {
-            // Every GPU compiles its kernel at once, before the render's clock starts (as one
-            // GPU's render does before its own).
+            // Every GPU compiles its kernel and copies the scene's grids at once, before the
+            // render's clock starts (as one GPU's render does before its own).
             if let Inner::Cuda { renderers, .. } = &backend.0 {
                 std::thread::scope(|threads| {
                     let loads: Vec<_> = renderers
@@ -694,7 +694,11 @@ impl SceneVisitor for Render<'_> {
                         .zip(&schedules)
                         .filter_map(|(renderer, schedule)| {
                             let schedule = (*schedule)?;
-                            Some(threads.spawn(move || renderer.load_kernel::<S>(schedule)))
+                            Some(threads.spawn(move || {
+                                renderer.load_kernel::<S>(schedule)?;
+                                // SAFETY: as the batches' renders below.
+                                unsafe { renderer.keep_grids(scene, grids) }
+                            }))
                         })
                         .collect();
                     loads.into_iter().try_for_each(|load| {

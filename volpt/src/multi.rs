@@ -34,10 +34,12 @@ pub(crate) type Device<'a> = Box<
         + 'a,
 >;
 
-/// The smallest batch: 1/64 of a device's share of the range, so that the last batches, which
-/// decide when the slowest device finishes, are short, and the batch count stays near 2 n ln(64).
+/// The smallest batch: 1/32 of a device's share of the range, so that the last batches, which
+/// decide when the slowest device finishes, are short (the devices end within about 1/64 of the
+/// render of each other), and the batch count stays near 2 n ln(32): every batch costs a launch
+/// tail (the batch's longest paths, a few milliseconds) and a film read back.
 fn smallest(samples: u32, devices: u32) -> u32 {
-    samples.div_ceil(64 * devices).max(1)
+    samples.div_ceil(32 * devices).max(1)
 }
 
 /// How many batches may be handed out past the oldest one not yet added to the film: two per
@@ -142,6 +144,9 @@ pub(crate) fn render_shared(
         smallest: smallest(samples.end - samples.start, n),
         window: window(n, pixels * 24),
     };
+    // Films already added to the render's film, zeroed again by the thread that added them:
+    // batches reuse them instead of allocating (and faulting in) a film each.
+    let spare: Mutex<Vec<Film>> = Mutex::new(Vec::new());
     // Paths of finished batches, and of each device's batch in flight.
     let finished = AtomicU64::new(0);
     let in_flight: Vec<AtomicU64> = devices.iter().map(|_| AtomicU64::new(0)).collect();
@@ -161,7 +166,8 @@ pub(crate) fn render_shared(
         let (send, receive) = mpsc::channel();
         for (d, device) in devices.iter().enumerate() {
             let send = send.clone();
-            let (queue, finished, in_flight, report) = (&queue, &finished, &in_flight, &report);
+            let (queue, finished, in_flight, report, spare) =
+                (&queue, &finished, &in_flight, &report, &spare);
             let accumulation = film.accumulation;
             scope.spawn(move || {
                 let mut cap = observer.check_every().map(|_| 1u32);
@@ -182,7 +188,10 @@ pub(crate) fn render_shared(
                         in_flight[d].store(part, Ordering::Relaxed);
                         report();
                     };
-                    let mut batch_film = Film::new(width, height).with_accumulation(accumulation);
+                    let reused = spare.lock().unwrap_or_else(|e| e.into_inner()).pop();
+                    let mut batch_film = reused.unwrap_or_else(|| {
+                        Film::new(width, height).with_accumulation(accumulation)
+                    });
                     let batch_started = Instant::now();
                     match device(&mut batch_film, batch.clone(), &progress) {
                         Ok(stats) => {
@@ -243,15 +252,20 @@ pub(crate) fn render_shared(
                     counters = counters.merge(stats.counters);
                     pending.insert(index, (batch, batch_film));
                     let before = next_index;
-                    while let Some((batch, batch_film)) = pending.remove(&next_index) {
+                    while let Some((batch, mut batch_film)) = pending.remove(&next_index) {
                         debug_assert_eq!(batch.start, done, "batches are numbered in sample order");
-                        for (sum, add) in film.sums.iter_mut().zip(&batch_film.sums) {
-                            for c in 0..3 {
-                                sum[c] += add[c];
-                            }
+                        for (sum, add) in
+                            film.flat_sums_mut().iter_mut().zip(batch_film.flat_sums())
+                        {
+                            *sum += add;
                         }
                         done = batch.end;
                         next_index += 1;
+                        batch_film.flat_sums_mut().fill(0.0);
+                        spare
+                            .lock()
+                            .unwrap_or_else(|e| e.into_inner())
+                            .push(batch_film);
                     }
                     if next_index > before {
                         queue.merged_up_to(next_index);
