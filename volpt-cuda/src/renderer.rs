@@ -112,6 +112,50 @@ pub struct CudaRenderer {
     /// (scene, kernel, image size): the next render of that scene starts there instead of with
     /// [`FIRST_LAUNCH_PATHS`] (several GPUs render many batches, each a render of its own).
     launch_budget: Mutex<Option<(BudgetKey, u64)>>,
+    /// The last render's film and counters on the device, which the next render of an image of
+    /// the same size zeroes and reuses: a viewer's frames and several GPUs' batches are many
+    /// short renders, and allocating them anew cost milliseconds each.
+    buffers: Mutex<Option<RenderBuffers>>,
+}
+
+/// A render's device memory besides its grids and queues.
+struct RenderBuffers {
+    /// Three `f64` sums per pixel.
+    film: CudaSlice<f64>,
+    counters: CudaSlice<u64>,
+    next_path: CudaSlice<u64>,
+    queue_state: CudaSlice<u64>,
+}
+
+impl RenderBuffers {
+    fn new(stream: &Arc<CudaStream>, pixels: u64) -> Result<Self, CudaError> {
+        Ok(Self {
+            film: stream
+                .alloc_zeros(3 * pixels as usize)
+                .doing("allocating the film")?,
+            counters: stream
+                .alloc_zeros(COUNTERS)
+                .doing("allocating the counters")?,
+            next_path: stream.alloc_zeros(1).doing("allocating the path counter")?,
+            queue_state: stream
+                .alloc_zeros(size_of::<Wavefront>() / 8)
+                .doing("allocating the queue counters")?,
+        })
+    }
+
+    /// Zeroes what a render reads before it writes: the counters, and the film unless the
+    /// caller copies sums into it.
+    fn zero(&mut self, stream: &Arc<CudaStream>, film: bool) -> Result<(), CudaError> {
+        if film {
+            stream
+                .memset_zeros(&mut self.film)
+                .doing("zeroing the film")?;
+        }
+        stream
+            .memset_zeros(&mut self.counters)
+            .doing("zeroing the counters")?;
+        Ok(())
+    }
 }
 
 /// What a launch budget was measured on.
@@ -176,6 +220,7 @@ impl CudaRenderer {
             volumes: VolumePolicy::default(),
             resident: Arc::default(),
             launch_budget: Mutex::default(),
+            buffers: Mutex::default(),
         })
     }
 
@@ -325,6 +370,7 @@ impl CudaRenderer {
         progress: &dyn Fn(u64, u64),
         keep: Option<u64>,
     ) -> Result<RenderStats, CudaError> {
+        let called = Instant::now();
         let (width, height) = (scene.camera().width, scene.camera().height);
         film.check_pass((width, height), &samples)?;
         let schedule = schedule.into();
@@ -345,22 +391,27 @@ impl CudaRenderer {
         volumes.check()?;
 
         let pixels = width as u64 * height as u64;
-        let mut device_film: CudaSlice<f64> = stream
-            .alloc_zeros(3 * pixels as usize)
-            .doing("allocating the film")?;
+        let reused = self.buffers.lock().unwrap_or_else(|e| e.into_inner()).take();
+        let mut buffers = match reused {
+            Some(buffers) if buffers.film.len() == 3 * pixels as usize => buffers,
+            _ => RenderBuffers::new(stream, pixels)?,
+        };
         // A resumed render: the sums of the samples before `samples` continue on the device (as
         // the CPU continues them), unless there are none yet, as in a batch of several GPUs,
-        // whose film starts empty: the zeroed device film is that film already.
-        if samples.start > 0 && film.holds_samples() {
+        // whose film starts empty.
+        let resumed = samples.start > 0 && film.holds_samples();
+        buffers.zero(stream, !resumed)?;
+        if resumed {
             stream
-                .memcpy_htod(film.flat_sums(), &mut device_film)
+                .memcpy_htod(film.flat_sums(), &mut buffers.film)
                 .doing("copying the film to the GPU")?;
         }
-        let counters: CudaSlice<u64> = stream
-            .alloc_zeros(COUNTERS)
-            .doing("allocating the counters")?;
-        let mut next_path: CudaSlice<u64> =
-            stream.alloc_zeros(1).doing("allocating the path counter")?;
+        let RenderBuffers {
+            film: device_film,
+            counters,
+            next_path,
+            queue_state,
+        } = &mut buffers;
         let per_sm = kernel
             .occupancy_max_active_blocks_per_multiprocessor(BLOCK_SIZE, 0, None)
             .doing("querying the kernel's occupancy")?;
@@ -383,9 +434,6 @@ impl CudaRenderer {
         let queues: CudaSlice<u8> = stream
             .alloc_zeros(queue_bytes.max(1))
             .doing("allocating the path queues")?;
-        let mut queue_state: CudaSlice<u64> = stream
-            .alloc_zeros(size_of::<Wavefront>() / 8)
-            .doing("allocating the queue counters")?;
 
         let mut params = LaunchParams {
             scene: scene_params,
@@ -440,7 +488,7 @@ impl CudaRenderer {
                 params.samples = count;
                 params.total_paths = tile_pixels * count as u64;
                 stream
-                    .memset_zeros(&mut next_path)
+                    .memset_zeros(next_path)
                     .doing("resetting the path counter")?;
                 // SAFETY: the kernel takes one `LaunchParams` of this scene type by value, whose
                 // film, counters, path counter, queues and grids are the live allocations above,
@@ -454,7 +502,7 @@ impl CudaRenderer {
                 };
                 if wavefront {
                     stream
-                        .memset_zeros(&mut queue_state)
+                        .memset_zeros(queue_state)
                         .doing("resetting the queue counters")?;
                     let plan = LaunchConfig {
                         grid_dim: (1, 1, 1),
@@ -476,7 +524,7 @@ impl CudaRenderer {
                             iteration += 1;
                         }
                         let state = stream
-                            .clone_dtoh(&queue_state)
+                            .clone_dtoh(queue_state)
                             .doing("reading the queue counters")?;
                         let state: Wavefront =
                             bytemuck::pod_read_unaligned(bytemuck::cast_slice(&state));
@@ -511,10 +559,11 @@ impl CudaRenderer {
         }
 
         stream
-            .memcpy_dtoh(&device_film, film.flat_sums_mut())
+            .memcpy_dtoh(device_film, film.flat_sums_mut())
             .doing("reading the film")?;
-        let totals = stream.clone_dtoh(&counters).doing("reading the counters")?;
+        let totals = stream.clone_dtoh(counters).doing("reading the counters")?;
         drop(volumes);
+        *self.buffers.lock().unwrap_or_else(|e| e.into_inner()) = Some(buffers);
         let counters = PathCounters {
             paths: totals[0],
             segments: totals[1],
@@ -522,6 +571,13 @@ impl CudaRenderer {
             truncated: totals[3],
             truncated_tracking: totals[4],
         };
+        // Where a short render's time goes outside its kernels (`RUST_LOG=volpt_cuda=debug`).
+        tracing::debug!(
+            setup_s = (start - called).as_secs_f64(),
+            kernels_s = elapsed.as_secs_f64(),
+            read_back_s = (called.elapsed() - (start - called) - elapsed).as_secs_f64(),
+            "render"
+        );
         Ok(RenderStats { elapsed, counters })
     }
 }

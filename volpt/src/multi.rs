@@ -11,9 +11,11 @@
 //! The cost is memory for batches finished ahead of an earlier one still rendering: at most
 //! [`window`] batch films exist at once (a device waits rather than take a batch beyond it).
 //!
-//! Batch sizes are guided self-scheduling: each batch is the remaining samples over twice the
-//! device count, at least [`smallest`]: large batches first (few kernel tails, few grid copies),
-//! small ones at the end, so that devices finish within about one small batch of each other.
+//! Batch sizes are guided self-scheduling: each batch is two thirds of the remaining samples over
+//! the device count ([`batch_size`]), at least [`smallest`]: large batches first, small ones at the
+//! end, so that devices finish within about one small batch of each other. Every batch costs its
+//! kernel's tail (the launch waits for its longest path: 25 ms on `ad`, an H100, 2026-11-26) and a
+//! film read back, so there are few: about 6 per device.
 
 use std::collections::BTreeMap;
 use std::ops::Range;
@@ -34,12 +36,20 @@ pub(crate) type Device<'a> = Box<
         + 'a,
 >;
 
-/// The smallest batch: 1/32 of a device's share of the range, so that the last batches, which
-/// decide when the slowest device finishes, are short (the devices end within about 1/64 of the
-/// render of each other), and the batch count stays near 2 n ln(32): every batch costs a launch
-/// tail (the batch's longest paths, a few milliseconds) and a film read back.
+/// The smallest batch: 1/16 of a device's share of the range. The last batches decide when the
+/// slowest device finishes, so they are short; but every batch pays a tail, and in a simulation
+/// with the tails measured on two H100s (`bench/multigpu/schedule_sim.py`, `ad`) fewer, larger
+/// batches came closer to the ideal time on alike GPUs, the common case: 0.974 with these rules
+/// against 0.957 with 1/32 and half of an even share, at the price of 0.912 against 0.930 when one
+/// GPU is twice as fast as the other.
 fn smallest(samples: u32, devices: u32) -> u32 {
-    samples.div_ceil(32 * devices).max(1)
+    samples.div_ceil(16 * devices).max(1)
+}
+
+/// A batch's size when `remaining` samples are left to `devices`: two thirds of an even share.
+fn batch_size(remaining: u32, devices: u32) -> u32 {
+    let share = u64::from(remaining) * 2 / (3 * u64::from(devices));
+    share.max(1) as u32
 }
 
 /// How many batches may be handed out past the oldest one not yet added to the film: two per
@@ -80,8 +90,7 @@ impl Queue {
             return None;
         }
         let remaining = s.end - s.next;
-        let mut size = remaining
-            .div_ceil(2 * self.devices)
+        let mut size = batch_size(remaining, self.devices)
             .max(self.smallest)
             .min(remaining);
         if let Some(cap) = cap {
@@ -144,9 +153,28 @@ pub(crate) fn render_shared(
         smallest: smallest(samples.end - samples.start, n),
         window: window(n, pixels * 24),
     };
-    // Films already added to the render's film, zeroed again by the thread that added them:
-    // batches reuse them instead of allocating (and faulting in) a film each.
-    let spare: Mutex<Vec<Film>> = Mutex::new(Vec::new());
+    // Films for batches: made before the clock, as one device's render gets its film from the
+    // caller, and written once, since a new allocation's pages are mapped by the first write to
+    // each (for 800x800 on the device machine that cost 25 ms, more than reading a film back).
+    // Films added to the render's film are zeroed by the thread that added them and come back
+    // here; a batch finds one unless more than these are pending.
+    let spare: Mutex<Vec<Film>> = Mutex::new(std::thread::scope(|threads| {
+        let makers: Vec<_> = (0..queue.window.min(2 * u64::from(n)))
+            .map(|_| {
+                threads.spawn(|| {
+                    let mut film = Film::new(width, height).with_accumulation(film.accumulation);
+                    // Opaque to the optimiser, which knows that a new film's memory is zeroed
+                    // and would drop the writes.
+                    std::hint::black_box(film.flat_sums_mut()).fill(0.0);
+                    film
+                })
+            })
+            .collect();
+        makers
+            .into_iter()
+            .map(|maker| maker.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+            .collect()
+    }));
     // Paths of finished batches, and of each device's batch in flight.
     let finished = AtomicU64::new(0);
     let in_flight: Vec<AtomicU64> = devices.iter().map(|_| AtomicU64::new(0)).collect();
