@@ -19,9 +19,13 @@ fn mix64(mut z: u64) -> u64 {
 }
 
 /// [`Rng::next_f32`] of a number already drawn: its top 24 bits as a uniform in [0, 1).
+///
+/// Converted from 32 bits: the value is below 2^24, so both conversions are exact and give the
+/// same `f32`, but a GPU converts a 64-bit integer with a slower instruction (`I2F.U64`) than a
+/// 32-bit one, three times a segment.
 #[inline(always)]
 pub fn unit_f32(r: u64) -> f32 {
-    (r >> 40) as f32 * (1.0 / (1u32 << 24) as f32)
+    ((r >> 40) as u32) as f32 * (1.0 / (1u32 << 24) as f32)
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -69,6 +73,26 @@ impl Rng {
     #[inline]
     pub fn peek_u64(&self) -> u64 {
         mix64(self.state.wrapping_add(GOLDEN_GAMMA))
+    }
+
+    /// The uniform [`Rng::next_f32`] will return after `k` more draws (`k = 0`: the next one),
+    /// without drawing anything: a step that may need it computes it before it knows whether it
+    /// will (`path::advance`), and then draws it with [`Rng::skip`].
+    #[inline(always)]
+    pub fn peek_f32(&self, k: u64) -> f32 {
+        unit_f32(mix64(
+            self.state
+                .wrapping_add(k.wrapping_add(1).wrapping_mul(GOLDEN_GAMMA)),
+        ))
+    }
+
+    /// Draws `n` numbers without computing them (their values were peeked).
+    #[inline(always)]
+    pub fn skip(&mut self, n: u32) {
+        self.dimension += n;
+        self.state = self
+            .state
+            .wrapping_add((n as u64).wrapping_mul(GOLDEN_GAMMA));
     }
 
     #[inline]
