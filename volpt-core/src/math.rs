@@ -80,6 +80,40 @@ pub fn evaluated_here(v: f32) -> f32 {
     }
 }
 
+/// `v`, which the compiler cannot see through (on a GPU a pure assembly statement holding only
+/// a comment; it may still move or drop it): [`crate::rng::unit_f32`] keeps its conversion from
+/// 32 bits with it. Elsewhere `v` itself.
+#[inline(always)]
+pub fn opaque_u32(v: u32) -> u32 {
+    #[cfg(target_arch = "nvptx64")]
+    {
+        let mut v = v;
+        // SAFETY: a comment (no instruction) naming a register.
+        unsafe { core::arch::asm!("// {v}", v = inout(reg32) v, options(pure, nomem, nostack)) };
+        v
+    }
+    #[cfg(not(target_arch = "nvptx64"))]
+    {
+        v
+    }
+}
+
+/// [`evaluated_here`] of a 64-bit integer.
+#[inline(always)]
+pub fn evaluated_here_u64(v: u64) -> u64 {
+    #[cfg(target_arch = "nvptx64")]
+    {
+        let mut v = v;
+        // SAFETY: a comment (no instruction) naming a register.
+        unsafe { core::arch::asm!("// {v}", v = inout(reg64) v, options(nomem, nostack)) };
+        v
+    }
+    #[cfg(not(target_arch = "nvptx64"))]
+    {
+        v
+    }
+}
+
 /// `sqrt(max(x, 0))`: rounding can push a quantity that is non-negative in exact arithmetic below 0.
 #[inline]
 pub fn safe_sqrt(x: f32) -> f32 {

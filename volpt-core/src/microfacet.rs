@@ -53,7 +53,11 @@ impl Ggx {
         p.y = lerp(0.5 * (1.0 + wh.z), h, p.y);
         let pz = safe_sqrt(1.0 - p.length_squared());
         let nh = t1 * p.x + t2 * p.y + wh * pz;
-        normalize(Vec3::new(self.alpha * nh.x, self.alpha * nh.y, nh.z.max(1e-6)))
+        normalize(Vec3::new(
+            self.alpha * nh.x,
+            self.alpha * nh.y,
+            nh.z.max(1e-6),
+        ))
     }
 
     /// The density of [`Self::sample_visible_normal`] with respect to solid angle around `m`.

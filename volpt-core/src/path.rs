@@ -28,8 +28,8 @@ use core::ops::Range;
 use crate::bsdf::Bsdf;
 use crate::environment::Environment;
 use crate::geometry::BoxHit;
-use crate::medium::Medium;
 use crate::math::evaluated_here;
+use crate::medium::Medium;
 use crate::phase::{PhaseFunction, PhaseSample};
 use crate::rng::Rng;
 use crate::scene::Scene;
@@ -302,24 +302,22 @@ fn early_phase_sample<S: Scene, const DEFER_SCATTER: bool>(
     scene: &S,
     path: &PathState,
 ) -> Option<PhaseSample> {
-    if DEFER_SCATTER
-        || !S::Medium::HOMOGENEOUS
-        || scene.medium().majorant_grid().is_some()
-        || PathState::uses_next_event(scene)
-    {
+    if DEFER_SCATTER || !S::Medium::HOMOGENEOUS || scene.medium().majorant_grid().is_some() {
         return None;
     }
     let u = Vec2::new(path.rng.peek_f32(1), path.rng.peek_f32(2));
     let sample = scene.phase().sample(path.ray.dir, u);
-    // Kept before the flight's branch (see `evaluated_here`).
-    Some(PhaseSample {
+    // Kept before the flight's branch (see `evaluated_here`), and before the test of the
+    // estimator (a branch too, which would split it from the flight's number).
+    let sample = PhaseSample {
         wo: Vec3::new(
             evaluated_here(sample.wo.x),
             evaluated_here(sample.wo.y),
             evaluated_here(sample.wo.z),
         ),
         pdf: sample.pdf,
-    })
+    };
+    (!PathState::uses_next_event(scene)).then_some(sample)
 }
 
 /// Runs `path` to its end.

@@ -25,7 +25,9 @@ fn mix64(mut z: u64) -> u64 {
 /// 32-bit one, three times a segment.
 #[inline(always)]
 pub fn unit_f32(r: u64) -> f32 {
-    ((r >> 40) as u32) as f32 * (1.0 / (1u32 << 24) as f32)
+    // LLVM folds the truncation back into a 64-bit conversion unless it cannot see through it.
+    let k = crate::math::opaque_u32((r >> 40) as u32);
+    k as f32 * (1.0 / (1u32 << 24) as f32)
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
