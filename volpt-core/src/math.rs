@@ -61,25 +61,6 @@ pub fn floor_non_negative(x: f32) -> f32 {
     (x as u32) as f32
 }
 
-/// `v`, evaluated here: on a GPU an empty assembly statement that the compiler may neither
-/// delete nor move, so that work computed for a later, conditional use (a speculative phase
-/// sample, `path::advance`) stays before the branch instead of being sunk into it, where its
-/// dependent chain would add to a path's latency. Elsewhere `v` itself.
-#[inline(always)]
-pub fn evaluated_here(v: f32) -> f32 {
-    #[cfg(target_arch = "nvptx64")]
-    {
-        let mut v = v;
-        // SAFETY: a comment (no instruction) naming a register.
-        unsafe { core::arch::asm!("// {v}", v = inout(reg32) v, options(nomem, nostack)) };
-        v
-    }
-    #[cfg(not(target_arch = "nvptx64"))]
-    {
-        v
-    }
-}
-
 /// `v`, which the compiler cannot see through (on a GPU a pure assembly statement holding only
 /// a comment; it may still move or drop it): [`crate::rng::unit_f32`] keeps its conversion from
 /// 32 bits with it. Elsewhere `v` itself.
@@ -90,22 +71,6 @@ pub fn opaque_u32(v: u32) -> u32 {
         let mut v = v;
         // SAFETY: a comment (no instruction) naming a register.
         unsafe { core::arch::asm!("// {v}", v = inout(reg32) v, options(pure, nomem, nostack)) };
-        v
-    }
-    #[cfg(not(target_arch = "nvptx64"))]
-    {
-        v
-    }
-}
-
-/// [`evaluated_here`] of a 64-bit integer.
-#[inline(always)]
-pub fn evaluated_here_u64(v: u64) -> u64 {
-    #[cfg(target_arch = "nvptx64")]
-    {
-        let mut v = v;
-        // SAFETY: a comment (no instruction) naming a register.
-        unsafe { core::arch::asm!("// {v}", v = inout(reg64) v, options(nomem, nostack)) };
         v
     }
     #[cfg(not(target_arch = "nvptx64"))]

@@ -28,13 +28,12 @@ use core::ops::Range;
 use crate::bsdf::Bsdf;
 use crate::environment::Environment;
 use crate::geometry::BoxHit;
-use crate::math::evaluated_here;
 use crate::medium::Medium;
-use crate::phase::{PhaseFunction, PhaseSample};
+use crate::phase::PhaseFunction;
 use crate::rng::Rng;
 use crate::scene::Scene;
 use crate::tracking::{delta_tracking, ratio_tracking, FreeFlight};
-use crate::{Ray, Spectrum, Vec2, Vec3};
+use crate::{Ray, Spectrum, Vec3};
 
 /// The integrator's limits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -247,7 +246,6 @@ fn advance<S: Scene, const DEFER_SCATTER: bool>(scene: &S, path: &mut PathState)
     }
     if path.inside {
         let t_exit = scene.bounds().exit_distance(&path.ray);
-        let phase = early_phase_sample::<S, DEFER_SCATTER>(scene, path);
         let collision = delta_tracking(
             scene.medium(),
             &path.ray,
@@ -262,7 +260,7 @@ fn advance<S: Scene, const DEFER_SCATTER: bool>(scene: &S, path: &mut PathState)
                 if DEFER_SCATTER {
                     return Some(p);
                 }
-                scatter_sampled(scene, path, p, None, phase);
+                scatter(scene, path, p, None);
             }
             FreeFlight::Escaped => {
                 let exit = scene.bounds().exit(&path.ray);
@@ -285,39 +283,6 @@ fn advance<S: Scene, const DEFER_SCATTER: bool>(scene: &S, path: &mut PathState)
         }
     }
     None
-}
-
-/// The phase function's sample at a collision of this free flight, computed before the flight
-/// when that is cheap to know in advance: in a homogeneous medium without next-event estimation a
-/// collision draws exactly one number (the distance), so the phase's two are the stream's second
-/// and third from here, whatever happens. Computed speculatively (wasted when the flight escapes,
-/// 1 flight in ~86 on the index-matched cube, and drawn, [`Rng::skip`], only on a collision), the
-/// three random numbers' multiply chains, the direction's square root and sine/cosine and the
-/// exit distance no longer wait for one another: on a GPU a path's segments are a chain of
-/// dependent instructions, whose length sets the pace of a launch's last, longest paths
-/// (docs/strategies.md, "The launch's tail"). The same numbers and arithmetic as sampling in
-/// [`scatter`], so the same bits.
-#[inline(always)]
-fn early_phase_sample<S: Scene, const DEFER_SCATTER: bool>(
-    scene: &S,
-    path: &PathState,
-) -> Option<PhaseSample> {
-    if DEFER_SCATTER || !S::Medium::HOMOGENEOUS || scene.medium().majorant_grid().is_some() {
-        return None;
-    }
-    let u = Vec2::new(path.rng.peek_f32(1), path.rng.peek_f32(2));
-    let sample = scene.phase().sample(path.ray.dir, u);
-    // Kept before the flight's branch (see `evaluated_here`), and before the test of the
-    // estimator (a branch too, which would split it from the flight's number).
-    let sample = PhaseSample {
-        wo: Vec3::new(
-            evaluated_here(sample.wo.x),
-            evaluated_here(sample.wo.y),
-            evaluated_here(sample.wo.z),
-        ),
-        pdf: sample.pdf,
-    };
-    (!PathState::uses_next_event(scene)).then_some(sample)
 }
 
 /// Runs `path` to its end.
@@ -358,19 +323,6 @@ pub fn sample_pixel<S: Scene>(
 /// Always inlined: a GPU call taking the scene by address moves it into local memory.
 #[inline(always)]
 pub fn scatter<S: Scene>(scene: &S, path: &mut PathState, p: Vec3, albedo: Option<Spectrum>) {
-    scatter_sampled(scene, path, p, albedo, None);
-}
-
-/// [`scatter`], with the phase function's sample already computed (`phase`, from the numbers the
-/// stream would draw for it: [`early_phase_sample`]) or not.
-#[inline(always)]
-fn scatter_sampled<S: Scene>(
-    scene: &S,
-    path: &mut PathState,
-    p: Vec3,
-    albedo: Option<Spectrum>,
-    phase: Option<PhaseSample>,
-) {
     let settings = scene.settings();
     if !path.begin_interaction(settings) {
         return;
@@ -390,13 +342,7 @@ fn scatter_sampled<S: Scene>(
     if next_event && !next_event_estimate(scene, path, p) {
         return;
     }
-    let sample = match phase {
-        Some(sample) => {
-            path.rng.skip(2);
-            sample
-        }
-        None => scene.phase().sample(path.ray.dir, path.rng.next_2d()),
-    };
+    let sample = scene.phase().sample(path.ray.dir, path.rng.next_2d());
     path.ray = Ray::new(p, sample.wo);
     if next_event {
         path.mis_pdf = sample.pdf;

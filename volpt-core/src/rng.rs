@@ -77,26 +77,6 @@ impl Rng {
         mix64(self.state.wrapping_add(GOLDEN_GAMMA))
     }
 
-    /// The uniform [`Rng::next_f32`] will return after `k` more draws (`k = 0`: the next one),
-    /// without drawing anything: a step that may need it computes it before it knows whether it
-    /// will (`path::advance`), and then draws it with [`Rng::skip`].
-    #[inline(always)]
-    pub fn peek_f32(&self, k: u64) -> f32 {
-        unit_f32(mix64(
-            self.state
-                .wrapping_add(k.wrapping_add(1).wrapping_mul(GOLDEN_GAMMA)),
-        ))
-    }
-
-    /// Draws `n` numbers without computing them (their values were peeked).
-    #[inline(always)]
-    pub fn skip(&mut self, n: u32) {
-        self.dimension += n;
-        self.state = self
-            .state
-            .wrapping_add((n as u64).wrapping_mul(GOLDEN_GAMMA));
-    }
-
     #[inline]
     pub fn next_2d(&mut self) -> crate::Vec2 {
         let x = self.next_f32();

@@ -2,7 +2,7 @@
 //! the medium's majorants: one global bound, or a majorant grid walked cell by cell.
 
 use crate::majorant::Dda;
-use crate::math::{evaluated_here_u64, exp, ln};
+use crate::math::{exp, ln};
 use crate::medium::Medium;
 use crate::rng::{unit_f32, Rng};
 use crate::Ray;
@@ -63,10 +63,6 @@ pub fn walk_majorants<M: Medium>(
     mut at: impl TentativeCollision,
 ) -> FreeFlight {
     let Some(grid) = medium.majorant_grid() else {
-        // Each step's number is computed before it is drawn, the first before the test of the
-        // majorant (a branch, which kept its multiply chain from overlapping the caller's work
-        // before the flight, `path::early_phase_sample`); drawn, `skip`, as the step takes it.
-        let mut bits = evaluated_here_u64(rng.peek_u64());
         let majorant = medium.majorant();
         if majorant <= 0.0 {
             return FreeFlight::Escaped;
@@ -75,7 +71,7 @@ pub fn walk_majorants<M: Medium>(
         let inv_majorant = 1.0 / majorant;
         let mut t = 0.0;
         loop {
-            rng.skip(1);
+            let bits = rng.next_u64();
             t -= ln(1.0 - unit_f32(bits)) * inv_majorant;
             if t >= t_max {
                 return FreeFlight::Escaped;
@@ -87,7 +83,6 @@ pub fn walk_majorants<M: Medium>(
             if at.stop_at(rng, t, majorant, bits) {
                 return FreeFlight::Collision(t);
             }
-            bits = rng.peek_u64();
         }
     };
     // One loop, not a loop over cells around a loop over the steps in a cell: each iteration
