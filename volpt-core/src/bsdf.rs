@@ -131,7 +131,7 @@ fn scatter_off_microfacet(
         return None;
     }
     Some(BsdfSample {
-        wo: frame.to_world(wo).normalize(),
+        wo: crate::math::normalize(frame.to_world(wo)),
         weight,
         transmitted: !reflected,
         eta: relative_eta,

@@ -26,7 +26,7 @@ impl PerspectiveCamera {
         let sy = (py as f32 + u.y) / self.height as f32;
         let x = (1.0 - 2.0 * sx) * self.tan_half_fov.x;
         let y = (1.0 - 2.0 * sy) * self.tan_half_fov.y;
-        let dir = (self.axis_x * x + self.axis_y * y + self.axis_z).normalize();
+        let dir = crate::math::normalize(self.axis_x * x + self.axis_y * y + self.axis_z);
         Ray::new(self.origin, dir)
     }
 }

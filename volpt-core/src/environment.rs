@@ -246,13 +246,11 @@ impl Environment for LatLongEnvironment<'_> {
             return None;
         }
         let (sin_phi, cos_phi) = sin_cos_2pi(cu);
-        let dir = self
-            .map_dir_to_world(Vec3::new(
-                sin_theta * sin_phi,
-                cos_theta,
-                -sin_theta * cos_phi,
-            ))
-            .normalize();
+        let dir = crate::math::normalize(self.map_dir_to_world(Vec3::new(
+            sin_theta * sin_phi,
+            cos_theta,
+            -sin_theta * cos_phi,
+        )));
         Some(LightSample {
             dir,
             radiance: self.radiance(dir),

@@ -2,6 +2,13 @@
 
 use crate::{Aabb, Vec3};
 
+/// [`crate::math::floor_non_negative`] per component.
+#[inline(always)]
+fn floor_non_negative(q: Vec3) -> Vec3 {
+    use crate::math::floor_non_negative as floor;
+    Vec3::new(floor(q.x), floor(q.y), floor(q.z))
+}
+
 /// Maps world positions to continuous voxel coordinates, in which sample `i` sits at coordinate `i`.
 ///
 /// Mitsuba 0.5/0.6 place samples on the box's faces (`i / (res - 1)`); Mitsuba 3 at cell centres
@@ -409,7 +416,8 @@ pub fn stochastic_corner(q: Vec3, max_index: Vec3, res: [u32; 3], bits: u64) -> 
     const STEPS: f32 = (1u32 << STOCHASTIC_BITS) as f32;
     const MASK: u64 = (1 << STOCHASTIC_BITS) - 1;
     // The same cell and fractions as `trilinear`.
-    let base = q.floor().min((max_index - Vec3::ONE).max(Vec3::ZERO));
+    // `q` is clamped into [0, max_index]: truncation is its floor.
+    let base = floor_non_negative(q).min((max_index - Vec3::ONE).max(Vec3::ZERO));
     let f = q - base;
     let axis = |base: f32, f: f32, shift: u32, res: u32| {
         let u = ((bits >> shift) & MASK) as f32 * (1.0 / STEPS) + 0.5 / STEPS;
@@ -710,7 +718,8 @@ fn trilinear<const C: usize>(
     res: [u32; 3],
     at: impl Fn(u32, u32, u32) -> [f32; C],
 ) -> [f32; C] {
-    let base = q.floor().min((max_index - Vec3::ONE).max(Vec3::ZERO));
+    // `q` is clamped into [0, max_index]: truncation is its floor.
+    let base = floor_non_negative(q).min((max_index - Vec3::ONE).max(Vec3::ZERO));
     let f = q - base;
     let (x0, y0, z0) = (base.x as u32, base.y as u32, base.z as u32);
     let x1 = (x0 + 1).min(res[0] - 1);

@@ -212,7 +212,10 @@ pub struct Dda {
 /// boundaries; infinite along an axis the ray does not move on.
 #[inline(always)]
 fn start_axis(origin: f32, dir: f32, res: f32) -> (i32, f32, f32) {
-    let cell = libm::floorf(origin).clamp(0.0, res - 1.0);
+    // Clamped first, then truncated: the same cell as `floor` then clamp, in one conversion
+    // instead of libm's software `floorf` (a GPU has no `floorf`); a NaN origin, whose cell
+    // becomes 0 instead of NaN, leaves the crossing NaN either way.
+    let cell = crate::math::floor_non_negative(origin.clamp(0.0, res - 1.0));
     if dir > 0.0 {
         (cell as i32, (cell + 1.0 - origin) / dir, 1.0 / dir)
     } else if dir < 0.0 {

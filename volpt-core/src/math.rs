@@ -44,6 +44,41 @@ pub fn sqrt(x: f32) -> f32 {
     }
 }
 
+/// `v / |v|`, computed as glam's `Vec3::normalize` computes it (`v * (1 / sqrt(v . v))`, the dot
+/// product summed x, y, z) but with this module's [`sqrt`]: glam's is libm's software square root,
+/// which a GPU ran as ~40 instructions with a table read and 64-bit multiplies (four times per
+/// rough-dielectric interaction, once per camera ray) where `sqrt.rn` is one. Correctly rounded
+/// either way, so every backend's bits stay those of `normalize`.
+#[inline(always)]
+pub fn normalize(v: crate::Vec3) -> crate::Vec3 {
+    v * (1.0 / sqrt(v.dot(v)))
+}
+
+/// `floor(x)` for `x` in `[0, 2^24)` (a grid's index coordinate, clamped): truncation, exact
+/// there, one conversion each way where libm's `floorf` is a software routine on a GPU.
+#[inline(always)]
+pub fn floor_non_negative(x: f32) -> f32 {
+    (x as u32) as f32
+}
+
+/// `v`, which the compiler cannot see through (on a GPU a pure assembly statement holding only
+/// a comment; it may still move or drop it): [`crate::rng::unit_f32`] keeps its conversion from
+/// 32 bits with it. Elsewhere `v` itself.
+#[inline(always)]
+pub fn opaque_u32(v: u32) -> u32 {
+    #[cfg(target_arch = "nvptx64")]
+    {
+        let mut v = v;
+        // SAFETY: a comment (no instruction) naming a register.
+        unsafe { core::arch::asm!("// {v}", v = inout(reg32) v, options(pure, nomem, nostack)) };
+        v
+    }
+    #[cfg(not(target_arch = "nvptx64"))]
+    {
+        v
+    }
+}
+
 /// `sqrt(max(x, 0))`: rounding can push a quantity that is non-negative in exact arithmetic below 0.
 #[inline]
 pub fn safe_sqrt(x: f32) -> f32 {

@@ -1,7 +1,7 @@
 //! The GGX (Trowbridge-Reitz) microfacet distribution with Smith's masking, in the local frame of the
 //! macro-surface (normal = +z).
 
-use crate::math::{lerp, safe_sqrt, sqr, sqrt, PI};
+use crate::math::{lerp, normalize, safe_sqrt, sqr, sqrt, PI};
 use crate::sampling::sample_uniform_disk_polar;
 use crate::{Vec2, Vec3};
 
@@ -41,9 +41,9 @@ impl Ggx {
     /// the hemisphere configuration, sample the projected disk, unstretch.
     #[inline]
     pub fn sample_visible_normal(&self, wi: Vec3, u: Vec2) -> Vec3 {
-        let wh = Vec3::new(self.alpha * wi.x, self.alpha * wi.y, wi.z).normalize();
+        let wh = normalize(Vec3::new(self.alpha * wi.x, self.alpha * wi.y, wi.z));
         let t1 = if wh.z < 0.99999 {
-            Vec3::Z.cross(wh).normalize()
+            normalize(Vec3::Z.cross(wh))
         } else {
             Vec3::X
         };
@@ -53,7 +53,11 @@ impl Ggx {
         p.y = lerp(0.5 * (1.0 + wh.z), h, p.y);
         let pz = safe_sqrt(1.0 - p.length_squared());
         let nh = t1 * p.x + t2 * p.y + wh * pz;
-        Vec3::new(self.alpha * nh.x, self.alpha * nh.y, nh.z.max(1e-6)).normalize()
+        normalize(Vec3::new(
+            self.alpha * nh.x,
+            self.alpha * nh.y,
+            nh.z.max(1e-6),
+        ))
     }
 
     /// The density of [`Self::sample_visible_normal`] with respect to solid angle around `m`.

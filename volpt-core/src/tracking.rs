@@ -85,36 +85,66 @@ pub fn walk_majorants<M: Medium>(
             }
         }
     };
+    // One loop, not a loop over cells around a loop over the steps in a cell: each iteration
+    // takes one step and, if it left the cell (or the cell is empty), moves to the next cell, so
+    // the lanes of a GPU warp, whose paths cross cells at different steps, take their steps
+    // together instead of waiting at the inner loop's end for the lane with the most steps in
+    // its cell. The same numbers drawn in the same order, the same arithmetic.
     let mut dda = Dda::new(grid, ray);
     let mut start = 0.0f32;
+    let mut cell = Cell::new(&dda, grid, t_max, start);
     loop {
-        let (majorant, cell_end) = dda.segment(grid);
-        let end = cell_end.min(t_max);
-        if majorant > 0.0 {
-            let majorant = normal_majorant(majorant);
-            let inv_majorant = 1.0 / majorant;
-            let mut t = start;
-            loop {
-                let bits = rng.next_u64();
-                t -= ln(1.0 - unit_f32(bits)) * inv_majorant;
-                if t >= end {
-                    break;
-                }
+        if cell.majorant > 0.0 {
+            let bits = rng.next_u64();
+            cell.t -= ln(1.0 - unit_f32(bits)) * cell.inv_majorant;
+            // Not `t < end`: a NaN `t` or `end` takes the step (the budget ends such a walk).
+            #[allow(clippy::neg_cmp_op_on_partial_ord)]
+            if !(cell.t >= cell.end) {
                 if *steps >= max_steps {
                     return FreeFlight::OutOfSteps;
                 }
                 *steps += 1;
-                if at.stop_at(rng, t, majorant, bits) {
-                    return FreeFlight::Collision(t);
+                if at.stop_at(rng, cell.t, cell.majorant, bits) {
+                    return FreeFlight::Collision(cell.t);
                 }
+                continue;
             }
         }
         // Anything but `end < t_max` ends the walk, a NaN `end` or `t_max` included.
-        if end.partial_cmp(&t_max) != Some(core::cmp::Ordering::Less) {
+        if cell.end.partial_cmp(&t_max) != Some(core::cmp::Ordering::Less) {
             return FreeFlight::Escaped;
         }
-        start = start.max(end);
+        start = start.max(cell.end);
         dda.advance(grid, ray.dir);
+        cell = Cell::new(&dda, grid, t_max, start);
+    }
+}
+
+/// The majorant-grid walk's current cell: its bound (raised by [`normal_majorant`] where
+/// positive), the bound's reciprocal, where the walk leaves it and the distance sampled so far.
+struct Cell {
+    majorant: f32,
+    inv_majorant: f32,
+    end: f32,
+    t: f32,
+}
+
+impl Cell {
+    #[inline(always)]
+    fn new(dda: &Dda, grid: &crate::majorant::MajorantGrid<'_>, t_max: f32, start: f32) -> Self {
+        let (majorant, cell_end) = dda.segment(grid);
+        // A cell of bound 0 (or NaN) is crossed without a step; its bound is left as it is.
+        let majorant = if majorant > 0.0 {
+            normal_majorant(majorant)
+        } else {
+            majorant
+        };
+        Self {
+            majorant,
+            inv_majorant: 1.0 / majorant,
+            end: cell_end.min(t_max),
+            t: start,
+        }
     }
 }
 
