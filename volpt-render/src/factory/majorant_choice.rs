@@ -139,7 +139,7 @@ pub fn default_majorants(desc: &SceneDescription) -> MajorantChoice {
         rule,
         costs,
     };
-    if Parts::of(desc, Effects::Specialised).medium.kind() == MediumKind::Homogeneous {
+    if Parts::of(desc, Effects::Specialised).medium.kind().homogeneous() {
         return choice(1, MajorantRule::Homogeneous, Vec::new());
     }
     let cost = |resolution| {
