@@ -243,7 +243,7 @@ fn every_variant_with_sparse_grids_renders_bit_for_bit() {
         .iter()
         .map(|names| names.join("/"))
         .collect();
-    expected.retain(reads_any_layout_or_no_grid);
+    expected.retain(|v| reads_any_layout_or_no_grid(v));
     check_round_trips(descs, expected, GridLayout::Dense);
 }
 
@@ -261,7 +261,7 @@ fn round_trips(layout: GridLayout) {
         for desc in &mut descs {
             desc.medium.storage = GridStorage::Bricked;
         }
-        expected.retain(reads_any_layout_or_no_grid);
+        expected.retain(|v| reads_any_layout_or_no_grid(v));
     }
     check_round_trips(descs, expected, layout);
 }
@@ -269,7 +269,7 @@ fn round_trips(layout: GridLayout) {
 /// Whether the variant `v` (`medium/boundary/phase/environment`) has a medium that reads no grid
 /// or reads its grids in any layout (its composed name ends with [`AnyLayout`]'s): the media that
 /// bricked and sparse grids select.
-fn reads_any_layout_or_no_grid(v: &String) -> bool {
+fn reads_any_layout_or_no_grid(v: &str) -> bool {
     let medium = v.split('/').next().unwrap_or_default();
     medium == HomogeneousMedium::NAME || medium.ends_with(&format!("__{}", AnyLayout::NAME))
 }
