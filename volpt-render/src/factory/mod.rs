@@ -358,8 +358,9 @@ pub fn with_scene_cached<V: SceneVisitor>(
     dispatch(shared, parts.with(&derived), visitor)
 }
 
-/// What the factory computes from the built parts for the integrator: the majorant grid of a grid
-/// medium and the sampling distribution of a lat-long map. Neither changes the variant.
+/// What the factory computes from the built parts for the integrator: the majorant grid of a
+/// medium with a density grid ([`TrackedMedium`]) and the sampling distribution of an environment
+/// that has one ([`SampledEnvironment`]). Neither changes the variant.
 pub struct Derived {
     /// Per-cell majorants and the grid's resolution, if the medium tracks with a grid.
     majorants: Option<Arc<Majorants>>,
@@ -380,7 +381,9 @@ impl Derived {
         settings: &PathSettings,
         cache: &FactoryCache,
     ) -> Self {
-        let majorants = (parts.medium.density())
+        let majorants = parts
+            .medium
+            .density()
             .filter(|_| settings.majorant_resolution > 1)
             .map(|(density, scale)| {
                 let res = MajorantGrid::resolution_for(bounds, settings.majorant_resolution);
