@@ -26,7 +26,7 @@ build() { # build NAME: the exact PTX of the working tree, cut down, as bundle/a
         cargo build -q -Zbuild-std=core --target nvptx64-nvidia-cuda --profile nvptx -p volpt-kernels \
         --target-dir target-ptx/ab
     python3 bench/device/ptx_cut.py target-ptx/ab/nvptx64-nvidia-cuda/nvptx/deps/volpt_kernels.s \
-        "bundle/ab/$prefix$1.ptx" "^regeneration_sk__(homogeneous__index_matched__isotropic|homogeneous__rough_dielectric__isotropic|grid_density_albedo__rough_dielectric__isotropic|grid_density__index_matched__isotropic|grid_density_albedo__rough_dielectric__henyey_greenstein)__constant$"
+        "bundle/ab/$prefix$1.ptx" "^regeneration_sk__(homogeneous__index_matched__isotropic|homogeneous__rough_dielectric__isotropic|grid_density__grid_albedo__dense_trilinear__rough_dielectric__isotropic|grid_density__constant_albedo__dense_trilinear__index_matched__isotropic|grid_density__grid_albedo__dense_trilinear__rough_dielectric__henyey_greenstein)__constant$"
 }
 
 replace() { # replace FILE OLD NEW: one literal replacement, or fail

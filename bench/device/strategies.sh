@@ -48,7 +48,7 @@ ARCH=sm_$(nvidia-smi --query-gpu=compute_cap --format=csv,noheader | head -n 1 |
 # for regeneration-sk and naive-sk and of three variants for the other strategies.
 subset() { # subset IN.ptx OUT.ptx
     python3 ptx_cut.py "$1" "$2" \
-        "^(regeneration_sk|naive_sk)__|__(homogeneous__index_matched__isotropic|grid_density__index_matched__isotropic|grid_density_albedo__rough_dielectric__isotropic)__constant$" >/dev/null
+        "^(regeneration_sk|naive_sk)__|__(homogeneous__index_matched__isotropic|grid_density__constant_albedo__dense_trilinear__index_matched__isotropic|grid_density__grid_albedo__dense_trilinear__rough_dielectric__isotropic)__constant$" >/dev/null
 }
 for f in volpt_kernels volpt_kernels_fast; do
     [ -f $f.ptx ] || gunzip -kf $f.ptx.gz

@@ -118,7 +118,7 @@ LOOKUPS="trilinear texture texture-f16"
     [ "$MATH" = exact ] && ptx=volpt_kernels.ptx
     if [ -f "$ptx" ] && command -v ptxas >/dev/null; then
         python3 ptx_cut.py "$ptx" "$WORK/cut.ptx" \
-            '^regeneration_sk__grid_(texture|density|density_albedo)__(index_matched|rough_dielectric)__(isotropic|henyey_greenstein)__constant$'
+            '^regeneration_sk__grid_density__(grid_albedo__texture_trilinear|constant_albedo__dense_trilinear|grid_albedo__dense_trilinear)__(index_matched|rough_dielectric)__(isotropic|henyey_greenstein)__constant$'
         ptxas -arch=sm_90 -v "$WORK/cut.ptx" -o /dev/null 2>&1 \
             | grep -E "Compiling entry|registers" | paste - - \
             | sed -E "s/.*entry function '([^']*)'.*Used ([0-9]+) registers.*/\1 \2 registers/"

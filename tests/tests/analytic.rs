@@ -95,7 +95,7 @@ fn grid_absorber_transmits_beer_lambert_for_both_grid_conventions() {
         let desc = cube_scene(32, 32, medium, BsdfDesc::Null, 1.0);
         assert_eq!(
             volpt_render::Variant::of(&desc).medium,
-            volpt_render::factory::MediumKind::GridDensity
+            volpt_render::factory::MediumKind::GridDensityConstantAlbedoDenseTrilinear
         );
         let (image, _) = render_cpu(&desc, BEER_LAMBERT_SPP, seed);
         assert_matches_transmittance(&desc, &image);

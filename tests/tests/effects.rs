@@ -279,7 +279,8 @@ fn edges() -> Vec<Edge> {
                     density(&short_of_the_box),
                 ),
             ],
-            general: "grid_density/index_matched/isotropic/constant",
+            general:
+                "grid_density__constant_albedo__dense_trilinear/index_matched/isotropic/constant",
         },
         Edge {
             rule: Simplification::ConstantAlbedoGrid,
@@ -295,7 +296,7 @@ fn edges() -> Vec<Edge> {
                     albedo(&short_of_the_box),
                 ),
             ],
-            general: "grid_density_albedo/index_matched/isotropic/constant",
+            general: "grid_density__grid_albedo__dense_trilinear/index_matched/isotropic/constant",
         },
     ]
 }

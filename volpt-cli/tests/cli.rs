@@ -149,7 +149,10 @@ fn half_texels_refuse_a_grid_beyond_their_range() {
     let out = volpt(&["info", scene, "--lookup", "texture"]);
     assert_success(&out);
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(stdout.contains("grid_texture/"), "{stdout}");
+    assert!(
+        stdout.contains("grid_density__grid_albedo__texture_trilinear/"),
+        "{stdout}"
+    );
 }
 
 #[test]

@@ -11,9 +11,12 @@
 //! padding either ([`SceneParams::LAYOUT`]). Device memory travels as `u64` addresses; only
 //! `from_params` turns them back into references.
 //!
-//! [`Component::NAME`] is the part's name in kernel entry points (`homogeneous`, `rough_dielectric`):
-//! the host derives the entry point of a scene type from its parts' names ([`SceneAbi::names`]),
-//! and the kernels export the same names from the variant registry ([`crate::variant`]).
+//! [`Component::NAME`] is the part's name in kernel entry points (`homogeneous`, `rough_dielectric`;
+//! a generic part's is composed from its parameters' names, [`name`]): the host derives the entry
+//! point of a scene type from its parts' names ([`SceneAbi::names`]), and the kernels export the
+//! same names from the variant registry ([`crate::variant`]).
+
+pub mod name;
 
 use bytemuck::{Pod, Zeroable};
 
@@ -74,7 +77,9 @@ pub type Upload<'u> = dyn Uploader + 'u;
 
 /// A scene part that can travel to a GPU kernel.
 pub trait Component {
-    /// The part's name in kernel entry points: lower case, words joined by `_`.
+    /// The part's name in kernel entry points: lower case, words joined by `_`; a generic part's
+    /// is its own name and its type parameters' names, joined by [`name::SEPARATOR`]
+    /// ([`name::Joined`]).
     const NAME: &'static str;
     /// What the kernel receives. Its size must be a multiple of 8 bytes.
     type Params: Pod;

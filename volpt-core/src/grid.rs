@@ -444,8 +444,9 @@ const STOCHASTIC_BITS: u32 = 13;
 /// interpolation at every read (8-9% of the time of cgg-logo and bucky on an H100,
 /// `docs/strategies.md`).
 pub trait GridReads: Copy + Default + core::fmt::Debug {
-    /// The kernel-entry name of a grid medium that reads this way, if not its albedo's.
-    const MEDIUM_NAME: Option<&'static str>;
+    /// The name of these reads in the composed name of a medium that reads this way
+    /// ([`crate::abi::name`]).
+    const NAME: &'static str;
 
     /// Where the uploader must put a grid read this way.
     const PLACEMENT: GridPlacement;
@@ -533,7 +534,7 @@ pub fn half_toward_zero(x: f32) -> f32 {
 pub struct DenseTrilinear;
 
 impl GridReads for DenseTrilinear {
-    const MEDIUM_NAME: Option<&'static str> = None;
+    const NAME: &'static str = "dense_trilinear";
     const PLACEMENT: GridPlacement = GridPlacement::Dense;
 
     #[inline(always)]
@@ -547,7 +548,7 @@ impl GridReads for DenseTrilinear {
 pub struct AnyLayout;
 
 impl GridReads for AnyLayout {
-    const MEDIUM_NAME: Option<&'static str> = Some("grid_any_layout");
+    const NAME: &'static str = "any_layout";
     const PLACEMENT: GridPlacement = GridPlacement::AnyLayout;
 
     #[inline(always)]
@@ -576,7 +577,7 @@ impl GridReads for AnyLayout {
 pub struct TextureTrilinear;
 
 impl GridReads for TextureTrilinear {
-    const MEDIUM_NAME: Option<&'static str> = Some("grid_texture");
+    const NAME: &'static str = "texture_trilinear";
     const PLACEMENT: GridPlacement = GridPlacement::Texture;
 
     #[inline(always)]

@@ -38,7 +38,9 @@ pub use grid::{
     GridPlacement, GridReads, TexelFormat, TextureTrilinear,
 };
 pub use majorant::MajorantGrid;
-pub use medium::{AlbedoField, ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium, Medium};
+pub use medium::{
+    AlbedoField, ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium, Medium, ReadAs,
+};
 pub use path::{Estimator, PathCounters, PathSettings, PathState, Roulette};
 pub use phase::{HenyeyGreenstein, Isotropic, PhaseFunction};
 pub use rng::Rng;

@@ -5,6 +5,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
+use crate::abi::name::Joined;
 use crate::abi::{Component, GridParams, Upload};
 use crate::grid::{DenseTrilinear, Grid, GridReads};
 use crate::majorant::{MajorantGrid, MajorantGridParams};
@@ -72,8 +73,6 @@ impl Medium for HomogeneousMedium {
 
 /// Where a grid medium's albedo comes from: a constant never reads memory.
 pub trait AlbedoField {
-    /// The name of a [`GridMedium`] with this albedo, in kernel entry points.
-    const GRID_MEDIUM_NAME: &'static str;
     /// See [`Medium::CONSTANT_ALBEDO`].
     const CONSTANT: bool;
 
@@ -90,7 +89,6 @@ pub trait AlbedoField {
 pub struct ConstantAlbedo(pub Spectrum);
 
 impl AlbedoField for ConstantAlbedo {
-    const GRID_MEDIUM_NAME: &'static str = "grid_density";
     const CONSTANT: bool = true;
 
     #[inline]
@@ -99,12 +97,11 @@ impl AlbedoField for ConstantAlbedo {
     }
 }
 
-/// An albedo grid, read as `R` says (the medium's own [`GridReads`]).
+/// An albedo grid, read as `R` says: the medium's own [`GridReads`] ([`ReadAs`]).
 #[derive(Clone, Copy, Debug)]
 pub struct GridAlbedo<'a, R = DenseTrilinear>(pub Grid<'a, 3>, pub R);
 
 impl<R: GridReads> AlbedoField for GridAlbedo<'_, R> {
-    const GRID_MEDIUM_NAME: &'static str = "grid_density_albedo";
     const CONSTANT: bool = false;
 
     #[inline(always)]
@@ -117,6 +114,15 @@ impl<R: GridReads> AlbedoField for GridAlbedo<'_, R> {
         Spectrum::from_array(R::lookup_random(&self.0, p, bits))
     }
 }
+
+/// An albedo that a [`GridMedium`] reading its grids as `R` can carry: one that reads no grid,
+/// or reads its grid as the medium does. The medium's name then names the reads once
+/// (`grid_density__grid_albedo__any_layout`), and two media of one name are one type.
+pub trait ReadAs<R: GridReads>: AlbedoField + Component {}
+
+impl<R: GridReads> ReadAs<R> for ConstantAlbedo {}
+
+impl<R: GridReads> ReadAs<R> for GridAlbedo<'_, R> {}
 
 /// A heterogeneous medium: `sigma_t(p) = scale * density(p)` from a grid, read as `R` says.
 #[derive(Clone, Copy, Debug)]
@@ -203,7 +209,7 @@ pub struct ConstantAlbedoParams {
 }
 
 impl Component for ConstantAlbedo {
-    const NAME: &'static str = "constant";
+    const NAME: &'static str = "constant_albedo";
     type Params = ConstantAlbedoParams;
 
     fn to_params(&self, _upload: &mut Upload<'_>) -> ConstantAlbedoParams {
@@ -218,8 +224,9 @@ impl Component for ConstantAlbedo {
     }
 }
 
+/// Named without its reads, which are its medium's ([`ReadAs`]).
 impl<R: GridReads> Component for GridAlbedo<'_, R> {
-    const NAME: &'static str = "grid";
+    const NAME: &'static str = "grid_albedo";
     type Params = GridParams;
 
     fn to_params(&self, upload: &mut Upload<'_>) -> GridParams {
@@ -260,11 +267,13 @@ unsafe impl<A: Pod> Zeroable for GridMediumParams<A> {}
 // SAFETY: as above.
 unsafe impl<A: Pod> Pod for GridMediumParams<A> {}
 
-impl<A: AlbedoField + Component, R: GridReads> Component for GridMedium<'_, A, R> {
-    const NAME: &'static str = match R::MEDIUM_NAME {
-        Some(name) => name,
-        None => A::GRID_MEDIUM_NAME,
-    };
+impl<A: ReadAs<R>, R: GridReads> GridMedium<'_, A, R> {
+    /// The density grid's name, then the albedo's and the reads'.
+    const COMPOSED_NAME: Joined = Joined::new(&["grid_density", A::NAME, R::NAME]);
+}
+
+impl<A: ReadAs<R>, R: GridReads> Component for GridMedium<'_, A, R> {
+    const NAME: &'static str = Self::COMPOSED_NAME.as_str();
     type Params = GridMediumParams<A::Params>;
 
     fn to_params(&self, upload: &mut Upload<'_>) -> Self::Params {

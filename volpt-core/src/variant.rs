@@ -26,8 +26,10 @@
 //! ```
 //!
 //! Each value is `(CamelCase name, snake_case name, type)`. The snake-case name is the part's
-//! [`Component::NAME`](crate::abi::Component::NAME) (a test checks it) and so appears in kernel
-//! entry points; types that borrow grids take the caller's lifetime `'a` (`'_` inside function
+//! [`Component::NAME`](crate::abi::Component::NAME), which a generic part composes from its type
+//! parameters' names ([`crate::abi::name`]), and so appears in kernel entry points; the CamelCase
+//! name (the factory's enum variants) is the same words. Tests check both, so neither can drift
+//! from the type; types that borrow grids take the caller's lifetime `'a` (`'_` inside function
 //! bodies, `'static` for type-level questions).
 
 /// Calls `$callback!` with the registry's axes and every combination of their values; see the
@@ -39,13 +41,18 @@ macro_rules! variants {
             { ($callback) { $($args)* } axes {
                 medium [
                     (Homogeneous, homogeneous, $crate::HomogeneousMedium)
-                    (GridDensity, grid_density, $crate::GridMedium<$lt, $crate::ConstantAlbedo>)
-                    (GridDensityAlbedo, grid_density_albedo,
+                    (GridDensityConstantAlbedoDenseTrilinear,
+                        grid_density__constant_albedo__dense_trilinear,
+                        $crate::GridMedium<$lt, $crate::ConstantAlbedo>)
+                    (GridDensityGridAlbedoDenseTrilinear, grid_density__grid_albedo__dense_trilinear,
                         $crate::GridMedium<$lt, $crate::GridAlbedo<$lt>>)
-                    (GridAnyLayout, grid_any_layout, $crate::GridMedium<$lt,
-                        $crate::GridAlbedo<$lt, $crate::AnyLayout>, $crate::AnyLayout>)
-                    (GridTexture, grid_texture, $crate::GridMedium<$lt,
-                        $crate::GridAlbedo<$lt, $crate::TextureTrilinear>, $crate::TextureTrilinear>)
+                    (GridDensityGridAlbedoAnyLayout, grid_density__grid_albedo__any_layout,
+                        $crate::GridMedium<$lt, $crate::GridAlbedo<$lt, $crate::AnyLayout>,
+                        $crate::AnyLayout>)
+                    (GridDensityGridAlbedoTextureTrilinear,
+                        grid_density__grid_albedo__texture_trilinear,
+                        $crate::GridMedium<$lt, $crate::GridAlbedo<$lt, $crate::TextureTrilinear>,
+                        $crate::TextureTrilinear>)
                 ]
                 boundary [
                     (IndexMatched, index_matched, $crate::NullBoundary)
@@ -104,11 +111,17 @@ mod tests {
     use super::COUNT;
     use crate::abi::Component;
 
-    /// `(registry name, Component::NAME)` of every part of every variant.
+    /// `(registry name, Component::NAME)` of every part of every variant, and `(CamelCase,
+    /// snake_case)` of every axis value.
     macro_rules! registry_facts {
-        (axes $axes:tt variants [$([$(($camel:ident, $snake:ident, $ty:ty))*])*]) => {
+        (axes { $($axis:ident [$(($c:ident, $s:ident, $t:ty))*])* }
+         variants [$([$(($camel:ident, $snake:ident, $ty:ty))*])*]) => {
             fn facts() -> [[(&'static str, &'static str); 4]; COUNT] {
                 [$([$((stringify!($snake), <$ty as Component>::NAME)),*]),*]
+            }
+
+            fn spellings() -> &'static [(&'static str, &'static str)] {
+                &[$($((stringify!($c), stringify!($s)),)*)*]
             }
         };
     }
@@ -121,6 +134,25 @@ mod tests {
             for (registry, component) in parts {
                 assert_eq!(registry, component);
             }
+        }
+    }
+
+    #[test]
+    fn camel_case_names_are_the_snake_case_names_words() {
+        for &(camel, snake) in spellings() {
+            // Each word of the snake-case name, its first letter upper case, in order.
+            let mut rest = camel.as_bytes();
+            for word in snake.split('_').filter(|w| !w.is_empty()) {
+                let word = word.as_bytes();
+                assert!(
+                    rest.len() >= word.len()
+                        && rest[0] == word[0].to_ascii_uppercase()
+                        && rest[1..word.len()] == word[1..],
+                    "{camel} is not {snake}"
+                );
+                rest = &rest[word.len()..];
+            }
+            assert!(rest.is_empty(), "{camel} is not {snake}");
         }
     }
 
@@ -141,7 +173,7 @@ mod tests {
             }
         }
         assert!(variants.contains(&[
-            "grid_density_albedo",
+            "grid_density__grid_albedo__dense_trilinear",
             "rough_dielectric",
             "henyey_greenstein",
             "lat_long"

@@ -224,11 +224,31 @@ fn a_scene_type_names_its_parts_in_registry_order() {
     assert_eq!(
         Other::names(),
         [
-            "grid_density_albedo",
+            "grid_density__grid_albedo__dense_trilinear",
             "rough_dielectric",
             "isotropic",
             "lat_long"
         ]
+    );
+}
+
+/// A generic part's name is composed from its type parameters' names, so every instantiation has
+/// its own: a constant albedo read in any layout is not the grid albedo read so, nor the constant
+/// albedo read dense.
+#[test]
+fn a_generic_part_is_named_by_its_parameters() {
+    use volpt_core::{AnyLayout, ConstantAlbedo, DenseTrilinear};
+    assert_eq!(
+        <GridMedium<'static, ConstantAlbedo, AnyLayout> as Component>::NAME,
+        "grid_density__constant_albedo__any_layout"
+    );
+    assert_eq!(
+        <GridMedium<'static, GridAlbedo<'static, AnyLayout>, AnyLayout> as Component>::NAME,
+        "grid_density__grid_albedo__any_layout"
+    );
+    assert_eq!(
+        <GridMedium<'static, ConstantAlbedo, DenseTrilinear> as Component>::NAME,
+        "grid_density__constant_albedo__dense_trilinear"
     );
 }
 

@@ -70,7 +70,7 @@ mod tests {
         >;
         assert_eq!(
             entry_name::<Scene>(Strategy::RegenerationSk),
-            "regeneration_sk__grid_density_albedo__rough_dielectric__henyey_greenstein__lat_long"
+            "regeneration_sk__grid_density__grid_albedo__dense_trilinear__rough_dielectric__henyey_greenstein__lat_long"
         );
     }
 

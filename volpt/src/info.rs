@@ -5,8 +5,8 @@ use std::fmt::{self, Write};
 
 use volpt_core::{Estimator, PathSettings};
 use volpt_render::factory::{
-    default_majorants, tracking_cost, BoundaryKind, Derived, Effects, EnvironmentKind,
-    MajorantChoice, MajorantRule, MediumKind, Parts,
+    default_majorants, tracking_cost, Derived, Effects, EnvironmentKind, MajorantChoice,
+    MajorantRule, Parts,
 };
 use volpt_scene::{
     AlbedoDesc, BsdfDesc, DensityDesc, EnvironmentDesc, GridDesc, GridLookup, PhaseDesc,
@@ -190,7 +190,7 @@ pub fn describe(
 
 /// The majorants delta and ratio tracking use, and what they cost along camera rays.
 fn tracking(desc: &SceneDescription, parts: &Parts<'_>, settings: &PathSettings) -> String {
-    if parts.medium.kind() == MediumKind::Homogeneous {
+    if parts.medium.kind().homogeneous() {
         return "homogeneous: every tentative collision is real".to_owned();
     }
     let bounds = &desc.boundary.bounds;
@@ -258,7 +258,7 @@ fn majorant_rule(choice: &MajorantChoice) -> String {
 
 /// The estimator the paths use, and why.
 fn estimator(parts: &Parts<'_>, settings: &PathSettings) -> &'static str {
-    let index_matched = parts.boundary.kind() == BoundaryKind::IndexMatched;
+    let index_matched = parts.boundary.kind().index_matched();
     match (settings.estimator, index_matched) {
         (_, false) => {
             "path tracing: the dielectric boundary reflects and refracts, so no straight shadow ray \

@@ -139,7 +139,8 @@ pub fn default_majorants(desc: &SceneDescription) -> MajorantChoice {
         rule,
         costs,
     };
-    if Parts::of(desc, Effects::Specialised).medium.kind() == MediumKind::Homogeneous {
+    let medium = Parts::of(desc, Effects::Specialised).medium.kind();
+    if medium.homogeneous() {
         return choice(1, MajorantRule::Homogeneous, Vec::new());
     }
     let cost = |resolution| {

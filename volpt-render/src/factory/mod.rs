@@ -5,13 +5,16 @@
 //! or grid albedo, index-matched, smooth or rough boundary, isotropic or Henyey-Greenstein phase,
 //! constant or lat-long environment. The axes and their values are the variant registry's
 //! ([`volpt_core::variant`]): from it this module generates one enum per axis ([`MediumPart`], ...,
-//! holding the built part) and the one exhaustive `match` that turns four built parts into a scene
-//! type. The description is read once, by one function per axis ([`Parts::of`]); a backend receives
-//! the scene through [`SceneVisitor`], so one generic function serves every variant.
+//! holding the built part), the choice of each axis's part (the first in registry order whose
+//! [`Part`] rule represents the description) and the one exhaustive `match` that turns four built
+//! parts into a scene type. Nothing here names a part: a registry line and the part's [`Part`] rule
+//! are all a new part needs. A backend receives the scene through [`SceneVisitor`], so one generic
+//! function serves every variant.
 //!
-//! - this file: the axis enums, the dispatch, [`Parts`] and what is derived from them;
-//! - [`parts`]: one function per axis from the description to a part, with the [`Simplification`]
-//!   rules;
+//! - this file: the axis enums, the choice and the dispatch, [`Parts`] and what is derived from
+//!   them;
+//! - [`parts`]: each part's rule from the description to the part, by axis, with the
+//!   [`Simplification`] rules;
 //! - [`cache`]: what the factory reads from a scene's grids, kept between builds of one scene
 //!   ([`FactoryCache`]);
 //! - [`camera`](camera()) and [`path_settings`]: the camera and integrator settings a file asks for;
@@ -28,10 +31,10 @@ pub use camera::camera;
 pub use majorant_choice::{
     default_majorants, tracking_cost, MajorantChoice, MajorantRule, TrackingCost,
 };
-pub use parts::Simplification;
+pub use parts::{Part, ReadsRule, Simplification};
 pub use settings::{default_estimator, path_settings};
 
-use parts::{aabb, boundary, environment, general_medium, lat_long, medium, phase};
+use parts::{aabb, BoundaryInput, MediumInput, SampledEnvironment, TrackedMedium};
 
 use std::fmt;
 
@@ -69,10 +72,12 @@ pub trait SceneVisitor {
     fn visit<S: RenderScene>(self, scene: &S) -> Self::Output;
 }
 
-/// One axis: the enum of its built parts and the enum of its kinds (the part without its data).
-/// Axes whose parts borrow grids or maps from the description take its lifetime `'a`.
+/// One axis: the enum of its built parts, the enum of its kinds (the part without its data), and
+/// the choice of its part for a description: the first part of the registry's order whose
+/// [`Part`] rule accepts. Axes whose parts borrow grids or maps from the description take its
+/// lifetime `'a`.
 macro_rules! axis {
-    ($(#[$doc:meta])* $part:ident $(<$lt:lifetime>)?, $kind:ident,
+    ($(#[$doc:meta])* $part:ident $(<$lt:lifetime>)?, $kind:ident, $input:ty,
      [$(($camel:ident, $snake:ident, $ty:ty))*]) => {
         $(#[$doc])*
         pub enum $part $(<$lt>)? {
@@ -84,11 +89,34 @@ macro_rules! axis {
             $($camel,)*
         }
 
-        impl $(<$lt>)? $part $(<$lt>)? {
+        impl<'a> $part $(<$lt>)? {
             pub fn kind(&self) -> $kind {
                 match self {
                     $($part::$camel(_) => $kind::$camel,)*
                 }
+            }
+
+            /// The first part of the axis, in registry order, that represents `input` (its
+            /// general form for [`Effects::General`]).
+            ///
+            /// # Panics
+            /// If no part does: the registry's axis then leaves a description unrendered, which
+            /// the device-ABI test's descriptions find.
+            fn choose(
+                input: &$input,
+                effects: Effects,
+                fired: &mut dyn FnMut(Simplification),
+            ) -> Self {
+                $(
+                    let part = match effects {
+                        Effects::Specialised => <$ty as Part<'a>>::specialised(input, fired),
+                        Effects::General => <$ty as Part<'a>>::general(input),
+                    };
+                    if let Some(part) = part {
+                        return $part::$camel(part);
+                    }
+                )*
+                panic!(concat!("no part of the registry's ", stringify!($kind), " axis represents the description"))
             }
         }
 
@@ -103,29 +131,80 @@ macro_rules! axis {
     };
 }
 
-/// The axis enums and the dispatch from built parts to a scene type, from the variant registry.
+/// The axis enums, what the factory derives from their parts, and the dispatch from built parts to
+/// a scene type, from the variant registry.
 macro_rules! factory {
     (axes {
-        medium $media:tt boundary $boundaries:tt phase $phases:tt environment $environments:tt
+        medium [$(($Mv:ident, $mv:ident, $mvt:ty))*]
+        boundary [$(($Bv:ident, $bv:ident, $bvt:ty))*]
+        phase $phases:tt
+        environment [$(($Ev:ident, $ev:ident, $evt:ty))*]
     }
      variants [$([($M:ident, $m:ident, $mt:ty) ($B:ident, $b:ident, $bt:ty)
         ($P:ident, $p:ident, $pt:ty) ($E:ident, $e:ident, $et:ty)])*]) => {
         axis!(
             /// The medium: extinction and albedo.
-            MediumPart<'a>, MediumKind, $media
+            MediumPart<'a>, MediumKind, MediumInput<'a>, [$(($Mv, $mv, $mvt))*]
         );
         axis!(
             /// The boundary of the medium's box.
-            BoundaryPart, BoundaryKind, $boundaries
+            BoundaryPart, BoundaryKind, BoundaryInput, [$(($Bv, $bv, $bvt))*]
         );
         axis!(
             /// The phase function.
-            PhasePart, PhaseKind, $phases
+            PhasePart, PhaseKind, PhaseDesc, $phases
         );
         axis!(
             /// The light: the environment.
-            EnvironmentPart<'a>, EnvironmentKind, $environments
+            EnvironmentPart<'a>, EnvironmentKind, &'a EnvironmentDesc, [$(($Ev, $ev, $evt))*]
         );
+
+        impl<'a> TrackedMedium<'a> for MediumPart<'a> {
+            fn density(&self) -> Option<(Grid<'a, 1>, f32)> {
+                match self {
+                    $(MediumPart::$Mv(m) => m.density(),)*
+                }
+            }
+
+            fn track_with(&mut self, grid: Option<MajorantGrid<'a>>) {
+                match self {
+                    $(MediumPart::$Mv(m) => m.track_with(grid),)*
+                }
+            }
+        }
+
+        // The parts' types borrow for `'a`; what they say of themselves holds for every `'a`.
+        impl<'a> MediumKind {
+            /// The extinction is the same everywhere ([`volpt_core::Medium::HOMOGENEOUS`]).
+            pub fn homogeneous(self) -> bool {
+                match self {
+                    $(MediumKind::$Mv => <$mvt as volpt_core::Medium>::HOMOGENEOUS,)*
+                }
+            }
+        }
+
+        impl BoundaryKind {
+            /// Crossing the boundary changes nothing ([`volpt_core::Bsdf::IS_NULL`]).
+            pub fn index_matched(self) -> bool {
+                match self {
+                    $(BoundaryKind::$Bv => <$bvt as volpt_core::Bsdf>::IS_NULL,)*
+                }
+            }
+        }
+
+        impl<'a> SampledEnvironment<'a> for EnvironmentPart<'a> {
+            fn distribution(&self) -> Option<Vec<f32>> {
+                match self {
+                    $(EnvironmentPart::$Ev(e) => e.distribution(),)*
+                }
+            }
+
+            fn sample_from(&mut self, distribution: &'a [f32]) {
+                match self {
+                    $(EnvironmentPart::$Ev(e) => e.sample_from(distribution),)*
+                }
+            }
+        }
 
         /// Hands the scene made of `shared` and `parts` to `visitor`, monomorphised for its variant.
         fn dispatch<V: SceneVisitor>(shared: Shared, parts: Parts<'_>, visitor: V) -> V::Output {
@@ -213,38 +292,12 @@ impl<'a> Parts<'a> {
     pub fn of_cached(desc: &'a SceneDescription, effects: Effects, cache: &FactoryCache) -> Self {
         let mut simplifications = Vec::new();
         let mut fired = |rule| simplifications.push(rule);
-        let (medium, boundary, phase, environment) = match effects {
-            Effects::Specialised => (
-                medium(desc, cache, &mut fired),
-                boundary(desc, &mut fired),
-                phase(&desc.medium.phase, &mut fired),
-                environment(&desc.environment),
-            ),
-            Effects::General => (
-                general_medium(desc),
-                boundary(desc, &mut |_| ()),
-                PhasePart::HenyeyGreenstein(match desc.medium.phase {
-                    PhaseDesc::Isotropic => HenyeyGreenstein { g: 0.0 },
-                    PhaseDesc::HenyeyGreenstein { g } => HenyeyGreenstein { g },
-                }),
-                EnvironmentPart::LatLong(match &desc.environment {
-                    EnvironmentDesc::Constant(rgb) => LatLongEnvironment::new(
-                        rgb,
-                        1,
-                        1,
-                        LatLongRows::CellCentred,
-                        [Vec3::X, Vec3::Y, Vec3::Z],
-                        1.0,
-                    ),
-                    EnvironmentDesc::LatLong(map) => lat_long(map),
-                }),
-            ),
-        };
+        let medium = MediumInput::of(desc, effects, cache, &mut fired);
         Self {
-            medium,
-            boundary,
-            phase,
-            environment,
+            medium: MediumPart::choose(&medium, effects, &mut fired),
+            boundary: BoundaryPart::choose(&BoundaryInput::of(desc), effects, &mut fired),
+            phase: PhasePart::choose(&desc.medium.phase, effects, &mut fired),
+            environment: EnvironmentPart::choose(&&desc.environment, effects, &mut fired),
             simplifications,
         }
     }
@@ -305,14 +358,15 @@ pub fn with_scene_cached<V: SceneVisitor>(
     dispatch(shared, parts.with(&derived), visitor)
 }
 
-/// What the factory computes from the built parts for the integrator: the majorant grid of a grid
-/// medium and the sampling distribution of a lat-long map. Neither changes the variant.
+/// What the factory computes from the built parts for the integrator: the majorant grid of a
+/// medium with a density grid ([`TrackedMedium`]) and the sampling distribution of an environment
+/// that has one ([`SampledEnvironment`]). Neither changes the variant.
 pub struct Derived {
     /// Per-cell majorants and the grid's resolution, if the medium tracks with a grid.
     majorants: Option<Arc<Majorants>>,
     bounds: Aabb,
-    /// The lat-long map's sampling distribution, for next-event estimation.
-    distribution: Vec<f32>,
+    /// The environment's sampling distribution, for next-event estimation.
+    distribution: Option<Vec<f32>>,
 }
 
 impl Derived {
@@ -327,14 +381,9 @@ impl Derived {
         settings: &PathSettings,
         cache: &FactoryCache,
     ) -> Self {
-        let density = match &parts.medium {
-            MediumPart::Homogeneous(_) => None,
-            MediumPart::GridDensity(m) => Some((m.density, m.scale)),
-            MediumPart::GridDensityAlbedo(m) => Some((m.density, m.scale)),
-            MediumPart::GridAnyLayout(m) => Some((m.density, m.scale)),
-            MediumPart::GridTexture(m) => Some((m.density, m.scale)),
-        };
-        let majorants = density
+        let majorants = parts
+            .medium
+            .density()
             .filter(|_| settings.majorant_resolution > 1)
             .map(|(density, scale)| {
                 let res = MajorantGrid::resolution_for(bounds, settings.majorant_resolution);
@@ -346,14 +395,9 @@ impl Derived {
                 let global = m.data.iter().copied().fold(0.0, f32::max);
                 m.data.iter().any(|&v| v < global)
             });
-        let distribution = match &parts.environment {
-            EnvironmentPart::LatLong(map) if settings.estimator == Estimator::NextEvent => {
-                let mut data =
-                    vec![0.0; LatLongEnvironment::distribution_len(map.width, map.height)];
-                map.fill_distribution(&mut data);
-                data
-            }
-            _ => Vec::new(),
+        let distribution = match settings.estimator {
+            Estimator::NextEvent => parts.environment.distribution(),
+            Estimator::PathTracing => None,
         };
         Self {
             majorants,
@@ -375,15 +419,9 @@ impl<'a> Parts<'a> {
             .majorants
             .as_ref()
             .map(|m| MajorantGrid::new(&m.data, m.res, derived.bounds));
-        match &mut self.medium {
-            MediumPart::Homogeneous(_) => {}
-            MediumPart::GridDensity(m) => m.majorants = grid,
-            MediumPart::GridDensityAlbedo(m) => m.majorants = grid,
-            MediumPart::GridAnyLayout(m) => m.majorants = grid,
-            MediumPart::GridTexture(m) => m.majorants = grid,
-        }
-        if let EnvironmentPart::LatLong(map) = &mut self.environment {
-            map.distribution = &derived.distribution;
+        self.medium.track_with(grid);
+        if let Some(distribution) = &derived.distribution {
+            self.environment.sample_from(distribution);
         }
         self
     }
