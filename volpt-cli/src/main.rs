@@ -557,8 +557,18 @@ fn render_command(args: RenderArgs) -> Result<()> {
         Some(output) => preview_for(output)?,
         None => None,
     };
-    let mut scene = args.scene.load(Some(&args.sampling))?;
-    let backend = args.sampling.open()?;
+    // Opening a GPU takes a fifth of a second (the driver's context): it opens while the scene
+    // loads. A scene that does not load is still the error reported.
+    let (scene, backend) = std::thread::scope(|threads| {
+        let opening = threads.spawn(|| args.sampling.open());
+        let scene = args.scene.load(Some(&args.sampling));
+        let backend = opening
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (scene, backend)
+    });
+    let mut scene = scene?;
+    let backend = backend?;
     backend.prepare(&mut scene);
     let spp = scene.spp();
     let variant = scene.variant();
@@ -641,10 +651,15 @@ fn render_command(args: RenderArgs) -> Result<()> {
             &configuration(&backend, &scene)
         )
     );
-    match output {
+    let written = match output {
         Some(output) => write_image(&image, &output, preview.as_deref()),
         None => Ok(()),
-    }
+    };
+    // The process ends here, and the driver releases its GPU contexts as it exits: destroying
+    // them first (the backend's drop) cost 0.11 s of a small render's 0.38 s on an H100
+    // (bench/device/startup.py, 2026-11-26).
+    std::mem::forget(backend);
+    written
 }
 
 /// Writes `image` to `output` (OpenEXR) and its preview, if any, and says so.
