@@ -391,7 +391,11 @@ impl CudaRenderer {
         volumes.check()?;
 
         let pixels = width as u64 * height as u64;
-        let reused = self.buffers.lock().unwrap_or_else(|e| e.into_inner()).take();
+        let reused = self
+            .buffers
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .take();
         let mut buffers = match reused {
             Some(buffers) if buffers.film.len() == 3 * pixels as usize => buffers,
             _ => RenderBuffers::new(stream, pixels)?,

@@ -172,7 +172,11 @@ pub(crate) fn render_shared(
             .collect();
         makers
             .into_iter()
-            .map(|maker| maker.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+            .map(|maker| {
+                maker
+                    .join()
+                    .unwrap_or_else(|p| std::panic::resume_unwind(p))
+            })
             .collect()
     }));
     // Paths of finished batches, and of each device's batch in flight.
