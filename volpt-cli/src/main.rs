@@ -585,7 +585,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
         "rendering"
     );
     let save = checkpoint::save_path(args.checkpoint.as_deref(), args.resume.as_deref());
-    let (image, stats, spp) = match save {
+    let (image, stats, spp, schedule) = match save {
         None => {
             let samples = args.samples.clone().unwrap_or(0..spp);
             let terminal = Terminal::new(true);
@@ -610,9 +610,9 @@ fn render_command(args: RenderArgs) -> Result<()> {
                     file.fingerprint,
                     file.seed
                 );
-                (file.image(), rendered.stats, count)
+                (file.image(), rendered.stats, count, rendered.schedule)
             } else {
-                (film.image(count), rendered.stats, count)
+                (film.image(count), rendered.stats, count, rendered.schedule)
             }
         }
         Some(save) => {
@@ -638,7 +638,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
                 );
                 std::process::exit(130);
             }
-            (film.image(spp), rendered.stats, spp)
+            (film.image(spp), rendered.stats, spp, rendered.schedule)
         }
     };
     println!(
@@ -648,7 +648,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
             spp,
             &stats,
             variant,
-            &configuration(&backend, &scene)
+            &configuration(&backend, &scene, schedule)
         )
     );
     let written = match output {
@@ -747,10 +747,22 @@ fn preview_for(output: &Path) -> Result<Option<PathBuf>> {
 
 /// Which configuration renders: the device, the GPU's strategy and math, and the grid lookup of a
 /// medium with grids (`--math`, `--lookup`; their defaults are the fastest correct ones).
-fn configuration(backend: &volpt::Backend, scene: &volpt::Scene) -> String {
+/// What ran: the device, the strategy (for `auto`, the one it chose: `ran`), the math build and
+/// the grids' lookup.
+fn configuration(
+    backend: &volpt::Backend,
+    scene: &volpt::Scene,
+    ran: Option<volpt::cuda::Schedule>,
+) -> String {
     let mut s = backend.device_name();
-    if let Some(strategy) = backend.strategy() {
-        let _ = write!(s, ", {strategy}");
+    match (backend.strategy(), ran) {
+        (Some(volpt::StrategyChoice::Auto), Some(ran)) => {
+            let _ = write!(s, ", auto: {}", ran.strategy);
+        }
+        (Some(strategy), _) => {
+            let _ = write!(s, ", {strategy}");
+        }
+        (None, _) => {}
     }
     if let Some(math) = backend.math() {
         let _ = write!(s, ", {math} math");
