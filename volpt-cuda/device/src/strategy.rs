@@ -13,7 +13,7 @@
 //!   no live path, advance every live path by one step ([`Advance`]: in place, or followed by
 //!   regrouping the block's paths). A thread's [`PathPool`] starts its paths and records the
 //!   ended ones.
-//! - The multi-kernel strategies ([`wavefront`]): paths queued in device memory, one step per
+//! - The multi-kernel strategies ([`multi_kernel`]): paths queued in device memory, one step per
 //!   launch.
 //!
 //! The persistent and multi-kernel strategies add radiance to the film with `f64` atomics in the
@@ -33,9 +33,7 @@ use volpt_core::medium::Medium;
 use volpt_core::path::{fly, sample_pixel, scatter, step, PathCounters, PathState, Truncation};
 use volpt_core::{Scene, Spectrum, Vec3};
 
-use crate::launch::{
-    path_of, LaunchParams, Regeneration, Slot, Stage, Wavefront, BLOCK_SIZE, SLOT_BYTES,
-};
+use crate::launch::{path_of, LaunchParams, Slot, Stage, Wavefront, BLOCK_SIZE, SLOT_BYTES};
 use crate::nvptx::{
     atomic_add_u64, ballot, block_broadcast_u64, block_exclusive_count, block_sort_u32,
     global_thread_index, grid_threads, lane_id, lanemask_lt, opaque, opaque_u32, red_add_f64,
@@ -205,8 +203,12 @@ struct PathPool<'a, S, P> {
 }
 
 impl<'a, S: Scene, P> PathPool<'a, S, P> {
+    /// # Safety
+    /// `lp.film` must hold the film's `3 * width * height` `f64` sums, `lp.counters` the
+    /// `launch::COUNTERS` totals and `lp.next_path` one `u64`, all alive until the kernel ends:
+    /// the pool's other methods rely on it.
     #[inline(always)]
-    fn new(scene: &'a S, lp: &'a LaunchParams<P>) -> Self {
+    unsafe fn new(scene: &'a S, lp: &'a LaunchParams<P>) -> Self {
         PathPool {
             scene,
             lp,
@@ -369,7 +371,10 @@ trait Refill {
 
     /// Whether any lane of the group is live, given whether this thread's are: the same answer
     /// in every thread of the group, so that the group leaves the loop together.
-    fn any_live(live: bool) -> bool;
+    #[inline(always)]
+    fn any_live(live: bool) -> bool {
+        ballot(live) != 0
+    }
 }
 
 /// Warp level, refilling by threshold: the warp's idle lanes take paths once
@@ -399,16 +404,19 @@ fn warp_refill<S: Scene, P, L: Lanes>(
     if pool.exhausted {
         return;
     }
-    lanes.each(|lane| {
-        let need = ready(pool.lp, lane.active) && !lane.active;
-        // SAFETY: `next_path` is the launch's one path counter.
-        if let Some(index) = unsafe { warp_take_indices(need, pool.next_path) } {
-            if need && index < pool.lp.total_paths {
-                pool.start_in(lane, index);
+    lanes.each(
+        #[inline(always)]
+        |lane| {
+            let need = ready(pool.lp, lane.active) && !lane.active;
+            // SAFETY: `next_path` is the launch's one path counter.
+            if let Some(index) = unsafe { warp_take_indices(need, pool.next_path) } {
+                if need && index < pool.lp.total_paths {
+                    pool.start_in(lane, index);
+                }
+                pool.exhausted = ballot(need && index >= pool.lp.total_paths) != 0;
             }
-            pool.exhausted = ballot(need && index >= pool.lp.total_paths) != 0;
-        }
-    });
+        },
+    );
 }
 
 impl Refill for ThreadRefill {
@@ -416,14 +424,16 @@ impl Refill for ThreadRefill {
 
     #[inline(always)]
     fn refill<S: Scene, P, L: Lanes>(pool: &mut PathPool<'_, S, P>, lanes: &mut L) {
-        warp_refill(pool, lanes, |lp, active| {
-            lp.refill_at <= 1 || ballot(!active).count_ones() >= lp.refill_at || ballot(active) == 0
-        })
-    }
-
-    #[inline(always)]
-    fn any_live(live: bool) -> bool {
-        ballot(live) != 0
+        warp_refill(
+            pool,
+            lanes,
+            #[inline(always)]
+            |lp, active| {
+                lp.refill_at <= 1
+                    || ballot(!active).count_ones() >= lp.refill_at
+                    || ballot(active) == 0
+            },
+        )
     }
 }
 
@@ -432,12 +442,12 @@ impl Refill for WarpRefill {
 
     #[inline(always)]
     fn refill<S: Scene, P, L: Lanes>(pool: &mut PathPool<'_, S, P>, lanes: &mut L) {
-        warp_refill(pool, lanes, |_, active| ballot(active) == 0)
-    }
-
-    #[inline(always)]
-    fn any_live(live: bool) -> bool {
-        ballot(live) != 0
+        warp_refill(
+            pool,
+            lanes,
+            #[inline(always)]
+            |_, active| ballot(active) == 0,
+        )
     }
 }
 
@@ -448,19 +458,22 @@ impl Refill for BlockRefill {
 
     #[inline(always)]
     fn refill<S: Scene, P, L: Lanes>(pool: &mut PathPool<'_, S, P>, lanes: &mut L) {
-        lanes.each(|lane| {
-            let need = opaque(!lane.active && !pool.exhausted);
-            // SAFETY: `next_path` is the launch's one path counter.
-            if let Some(index) = unsafe { block_take_indices(need, pool.next_path) } {
-                if need {
-                    if index < pool.lp.total_paths {
-                        pool.start_in(lane, index);
-                    } else {
-                        pool.exhausted = true;
+        lanes.each(
+            #[inline(always)]
+            |lane| {
+                let need = opaque(!lane.active && !pool.exhausted);
+                // SAFETY: `next_path` is the launch's one path counter.
+                if let Some(index) = unsafe { block_take_indices(need, pool.next_path) } {
+                    if need {
+                        if index < pool.lp.total_paths {
+                            pool.start_in(lane, index);
+                        } else {
+                            pool.exhausted = true;
+                        }
                     }
                 }
-            }
-        });
+            },
+        );
     }
 
     #[inline(always)]
@@ -506,7 +519,10 @@ impl<L: Lanes> Advance<L> for InPlace {
 
     #[inline(always)]
     fn advance<S: Scene, P>(pool: &mut PathPool<'_, S, P>, lanes: &mut L) {
-        lanes.each(|lane| pool.step(lane));
+        lanes.each(
+            #[inline(always)]
+            |lane| pool.step(lane),
+        );
     }
 }
 
@@ -687,7 +703,8 @@ unsafe fn persistent<S: Scene, P, R: Refill, A: Advance<L>, L: Lanes>(
             "a block-collective advance needs a block-level refill"
         )
     };
-    let mut pool = PathPool::new(scene, lp);
+    // SAFETY: the caller's contract.
+    let mut pool = unsafe { PathPool::new(scene, lp) };
     let mut lanes = L::idle(pool.idle_lane());
     loop {
         R::refill(&mut pool, &mut lanes);
@@ -777,30 +794,9 @@ pub unsafe fn sorting_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     unsafe { persistent::<S, P, BlockRefill, SortAlbedoReads, Lane>(scene, lp) }
 }
 
-/// naiveMK (the thesis's first multi-kernel strategy): a batch of one sample of every pixel is
-/// started and traced to its end, one segment per launch, before the next batch starts; see
-/// [`wavefront`].
-///
-/// # Safety
-/// As [`wavefront`].
-#[inline(always)]
-pub unsafe fn naive_mk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
-    // SAFETY: forwarded.
-    unsafe { wavefront(scene, lp, Regeneration::WhenEmpty) }
-}
-
-/// streamingMK (the thesis's multi-kernel streaming, with device-wide compaction): after every
-/// extension new paths fill the room the finished ones left; see [`wavefront`].
-///
-/// # Safety
-/// As [`wavefront`].
-#[inline(always)]
-pub unsafe fn streaming_mk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
-    // SAFETY: forwarded.
-    unsafe { wavefront(scene, lp, Regeneration::Continuous) }
-}
-
-/// The multi-kernel strategies' stages ([`Stage`]): paths live in two queues in device memory;
+/// The multi-kernel strategies, naiveMK and streamingMK (the thesis's; `Regeneration` says how
+/// they differ), one kernel whose launches run the stages of an iteration ([`Stage`]): paths live
+/// in two queues in device memory;
 /// extension advances every path of one queue by a segment and appends the survivors to the
 /// other (device-wide compaction: the warp's survivors take consecutive places with one atomic
 /// on the queue's count), the plan stage ([`Wavefront::plan`]) sizes the next batch of new paths,
@@ -814,15 +810,19 @@ pub unsafe fn streaming_mk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
 /// [`Wavefront`], zeroed before the launch's first iteration; the film and counters as
 /// [`naive_sk`]; blocks of `BLOCK_SIZE` threads.
 #[inline(always)]
-unsafe fn wavefront<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, regeneration: Regeneration) {
+pub unsafe fn multi_kernel<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     let state = lp.wavefront as *mut Wavefront;
     let slot_at = |queue: u32, i: u64| -> *mut Slot {
         let index = queue as u64 * lp.capacity as u64 + i;
         (lp.queues + index * SLOT_BYTES as u64) as *mut Slot
     };
-    let mut pool = PathPool::new(scene, lp);
+    // SAFETY: the caller's contract.
+    let mut pool = unsafe { PathPool::new(scene, lp) };
     let (parity, regenerate) = match Stage::from_code(lp.stage) {
-        Stage::Plan { parity } => {
+        Stage::Plan {
+            parity,
+            regeneration,
+        } => {
             if global_thread_index() == 0 {
                 // SAFETY: one `Wavefront` (the caller's contract), and this the only thread.
                 let state = unsafe { &mut *state };

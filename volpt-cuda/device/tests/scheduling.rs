@@ -204,7 +204,7 @@ fn run_wavefront(
     let mut started = vec![0u32; total as usize];
     let mut iteration = 0;
     while !state.done(total) {
-        for stage in Stage::iteration(iteration) {
+        for stage in Stage::iteration(iteration, regeneration) {
             assert_eq!(Stage::from_code(stage.code()), stage);
             match stage {
                 Stage::Extend { parity } => {
@@ -218,9 +218,13 @@ fn run_wavefront(
                     state.count[o] = queues[o].len() as u64;
                     // The input is consumed; `plan` zeroes its count.
                 }
-                Stage::Plan { parity } => {
+                Stage::Plan {
+                    parity,
+                    regeneration: planned,
+                } => {
+                    assert_eq!(planned, regeneration);
                     let live = state.count[1 - parity as usize];
-                    state.plan(parity, capacity, total, regeneration);
+                    state.plan(parity, capacity, total, planned);
                     if regeneration == Regeneration::WhenEmpty && live > 0 {
                         assert_eq!(
                             state.batch_len, 0,
