@@ -1,7 +1,10 @@
 #!/usr/bin/env python3
 """Per-kernel comparison of two PTX modules (before and after a change), on the CPU.
 
-    ptx_diff.py BEFORE.ptx AFTER.ptx
+    ptx_diff.py BEFORE.ptx AFTER.ptx [SHOW] [OLD=NEW ...]
+
+SHOW: list that many differing kernels per strategy. OLD=NEW: compare BEFORE's kernels of entry
+prefix OLD with AFTER's of prefix NEW (a kernel function renamed or shared).
 
 Per strategy (the entry name's prefix): how many kernels are textually identical, and for those
 that differ the change of their instruction count, virtual registers declared (`.reg` counts, an
@@ -49,7 +52,16 @@ def stats(body):
 
 before, after = kernels(sys.argv[1]), kernels(sys.argv[2])
 print(f"# {sys.argv[1]}: {len(before)} kernels; {sys.argv[2]}: {len(after)} kernels")
-missing = sorted(set(before) ^ set(after))
+show = int(sys.argv[3]) if len(sys.argv) > 3 and "=" not in sys.argv[3] else 0
+for arg in sys.argv[3:]:
+    if "=" in arg:
+        old, new = arg.split("=")
+        for name in [n for n in before if n.startswith(old + "__")]:
+            renamed = new + name[len(old):]
+            if renamed in after:
+                after[name] = after[renamed]
+renamed = {a.split("=")[1] for a in sys.argv[3:] if "=" in a}
+missing = sorted(n for n in set(before) ^ set(after) if n.split("__")[0] not in renamed)
 if missing:
     print(f"only in one module: {missing[:10]} ({len(missing)})")
 by = collections.defaultdict(list)
@@ -72,5 +84,5 @@ for strategy, names in by.items():
                  f"(mean {sum(d_inst) / len(diffs):+.1f} of {sum(b[0] for _, b, _ in diffs) / len(diffs):.0f}), "
                  f"virtual regs {min(d_regs):+}..{max(d_regs):+}, local depot {min(d_depot):+}..{max(d_depot):+} bytes")
     print(line)
-    for n, b, a in diffs[:int(sys.argv[3]) if len(sys.argv) > 3 else 0]:
+    for n, b, a in diffs[:show]:
         print(f"    {n}: inst {b[0]} -> {a[0]}, regs {b[1]} -> {a[1]}, depot {b[2]} -> {a[2]}")
