@@ -488,7 +488,19 @@ trait Advance<L: Lanes> {
     /// exit test keeps the whole block in the loop.
     const BLOCK: bool;
 
-    fn advance<S: Scene, P>(pool: &mut PathPool<'_, S, P>, lanes: &mut L);
+    /// The loop advances before the refill (advance, refill, exit test) rather than after the
+    /// exit test (refill, exit test, advance). Both orders do the same work, since the first
+    /// advance finds every lane idle, but compile to different kernels: the regroupings keep
+    /// the order their kernels were measured in; in the other, streaming-sk took +5% on the
+    /// index-matched cube and -8% on the dielectric one (H100, 2026-11-26,
+    /// `bench/results/2026-11-26-h100-pool/ab.txt`).
+    const FIRST: bool;
+
+    /// What the advance computes once, before the loop (the shared-memory slots' address).
+    type Setup: Copy;
+    fn setup() -> Self::Setup;
+
+    fn advance<S: Scene, P>(setup: Self::Setup, pool: &mut PathPool<'_, S, P>, lanes: &mut L);
 }
 
 /// Each lane steps its own path (no collective).
@@ -516,9 +528,14 @@ struct SortAlbedoReads;
 
 impl<L: Lanes> Advance<L> for InPlace {
     const BLOCK: bool = false;
+    const FIRST: bool = false;
+    type Setup = ();
 
     #[inline(always)]
-    fn advance<S: Scene, P>(pool: &mut PathPool<'_, S, P>, lanes: &mut L) {
+    fn setup() {}
+
+    #[inline(always)]
+    fn advance<S: Scene, P>(_: (), pool: &mut PathPool<'_, S, P>, lanes: &mut L) {
         lanes.each(
             #[inline(always)]
             |lane| pool.step(lane),
@@ -528,24 +545,37 @@ impl<L: Lanes> Advance<L> for InPlace {
 
 impl Advance<Lane> for Compact {
     const BLOCK: bool = true;
+    const FIRST: bool = true;
+    type Setup = BlockSlots;
 
     #[inline(always)]
-    fn advance<S: Scene, P>(pool: &mut PathPool<'_, S, P>, lane: &mut Lane) {
+    fn setup() -> BlockSlots {
+        BlockSlots::new()
+    }
+
+    #[inline(always)]
+    fn advance<S: Scene, P>(block: BlockSlots, pool: &mut PathPool<'_, S, P>, lane: &mut Lane) {
         pool.step(lane);
-        compact(lane);
+        compact(block, lane);
     }
 }
 
 impl Advance<Lane> for SortPaths {
     const BLOCK: bool = true;
+    const FIRST: bool = true;
+    type Setup = BlockSlots;
 
     #[inline(always)]
-    fn advance<S: Scene, P>(pool: &mut PathPool<'_, S, P>, lane: &mut Lane) {
+    fn setup() -> BlockSlots {
+        BlockSlots::new()
+    }
+
+    #[inline(always)]
+    fn advance<S: Scene, P>(block: BlockSlots, pool: &mut PathPool<'_, S, P>, lane: &mut Lane) {
         pool.step(lane);
         // Each thread parks its live path at its own index and takes the path of its place in
         // the Morton order.
-        let slots = stream_slots();
-        let thread = thread_index();
+        let BlockSlots { slots, thread } = block;
         let key = if lane.active {
             morton30(lane.path.ray.origin, &pool.scene.bounds())
         } else {
@@ -569,9 +599,16 @@ impl Advance<Lane> for SortPaths {
 
 impl Advance<Lane> for SortAlbedoReads {
     const BLOCK: bool = true;
+    const FIRST: bool = true;
+    type Setup = BlockSlots;
 
     #[inline(always)]
-    fn advance<S: Scene, P>(pool: &mut PathPool<'_, S, P>, lane: &mut Lane) {
+    fn setup() -> BlockSlots {
+        BlockSlots::new()
+    }
+
+    #[inline(always)]
+    fn advance<S: Scene, P>(block: BlockSlots, pool: &mut PathPool<'_, S, P>, lane: &mut Lane) {
         if S::Medium::CONSTANT_ALBEDO {
             pool.step(lane);
         } else {
@@ -580,7 +617,7 @@ impl Advance<Lane> for SortAlbedoReads {
                 pool.retire_if_ended(lane);
             }
         }
-        compact(lane);
+        compact(block, lane);
     }
 }
 
@@ -606,18 +643,29 @@ core::arch::global_asm!(
     n = const core::mem::size_of::<Slot>() * BLOCK_SIZE as usize,
 );
 
-/// The block's path slots in shared memory, one per thread.
-#[inline(always)]
-fn stream_slots() -> *mut Slot {
-    shared_to_generic(shared_address!("volpt_stream_slots")) as *mut Slot
+/// The block's path slots in shared memory, one per thread, and this thread's index there;
+/// computed once per kernel, before the loop (the address comes from asm, which LLVM does not
+/// hoist out of a loop).
+#[derive(Clone, Copy)]
+struct BlockSlots {
+    slots: *mut Slot,
+    thread: u32,
+}
+
+impl BlockSlots {
+    #[inline(always)]
+    fn new() -> Self {
+        BlockSlots {
+            slots: shared_to_generic(shared_address!("volpt_stream_slots")) as *mut Slot,
+            thread: thread_index(),
+        }
+    }
 }
 
 /// The block's live paths move to its first threads, in thread order: live path `rank` to thread
 /// `rank` (block-collective).
 #[inline(always)]
-fn compact(lane: &mut Lane) {
-    let slots = stream_slots();
-    let thread = thread_index();
+fn compact(BlockSlots { slots, thread }: BlockSlots, lane: &mut Lane) {
     let (rank, live) = block_exclusive_count(opaque(lane.active));
     if lane.active {
         // SAFETY: `rank < BLOCK_SIZE` slots.
@@ -686,7 +734,8 @@ fn step_with_sorted_albedo_reads<S: Scene>(scene: &S, path: &mut PathState, acti
 }
 
 /// The persistent loop: refill the idle lanes, leave once the refill's group has no live path,
-/// advance the live paths by a step; at the end add the thread's path counts to the launch's.
+/// advance the live paths by a step (or advance first: [`Advance::FIRST`]); at the end add the
+/// thread's path counts to the launch's.
 ///
 /// # Safety
 /// `lp.film` must hold `3 * width * height` `f64`s, `lp.counters` `launch::COUNTERS` `u64`s and
@@ -706,12 +755,18 @@ unsafe fn persistent<S: Scene, P, R: Refill, A: Advance<L>, L: Lanes>(
     // SAFETY: the caller's contract.
     let mut pool = unsafe { PathPool::new(scene, lp) };
     let mut lanes = L::idle(pool.idle_lane());
+    let setup = A::setup();
     loop {
+        if A::FIRST {
+            A::advance(setup, &mut pool, &mut lanes);
+        }
         R::refill(&mut pool, &mut lanes);
         if !R::any_live(lanes.any_active()) {
             break;
         }
-        A::advance(&mut pool, &mut lanes);
+        if !A::FIRST {
+            A::advance(setup, &mut pool, &mut lanes);
+        }
     }
     pool.flush();
 }
