@@ -754,8 +754,8 @@ unsafe fn persistent<S: Scene, P, R: Refill, A: Advance<L>, L: Lanes>(
     };
     // SAFETY: the caller's contract.
     let mut pool = unsafe { PathPool::new(scene, lp) };
-    let mut lanes = L::idle(pool.idle_lane());
     let setup = A::setup();
+    let mut lanes = L::idle(pool.idle_lane());
     loop {
         if A::FIRST {
             A::advance(setup, &mut pool, &mut lanes);
