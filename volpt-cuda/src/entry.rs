@@ -9,24 +9,30 @@ use crate::kernels::layout;
 
 /// The entry point that renders scenes of type `S` with `strategy`.
 pub fn entry_name<S: SceneAbi>(strategy: Strategy) -> String {
-    let [m, b, p, e] = S::names();
-    format!("{}__{m}__{b}__{p}__{e}", strategy.entry_prefix())
+    kernel_entry_name::<S>(strategy.entry_prefix())
 }
 
-/// The entry points of every strategy for every variant of the registry: what the workspace's
-/// kernels crate must export, no more and no less.
+/// The entry point of kernel function `prefix` (one of [`Strategy::KERNELS`]) for scene type `S`.
+fn kernel_entry_name<S: SceneAbi>(prefix: &str) -> String {
+    let [m, b, p, e] = S::names();
+    format!("{prefix}__{m}__{b}__{p}__{e}")
+}
+
+/// The entry points of every kernel function for every variant of the registry (strategies that
+/// share a kernel function share its entry points): what the workspace's kernels crate must
+/// export, no more and no less.
 pub fn registry_entries() -> Vec<String> {
     macro_rules! entries {
         (axes $axes:tt variants [$([$(($camel:ident, $snake:ident, $ty:ty))*])*]) => {
-            fn variant_entries(strategy: Strategy) -> Vec<String> {
-                vec![$(entry_name::<volpt_core::VolumeScene<$($ty),*>>(strategy)),*]
+            fn variant_entries(prefix: &str) -> Vec<String> {
+                vec![$(kernel_entry_name::<volpt_core::VolumeScene<$($ty),*>>(prefix)),*]
             }
         };
     }
     volpt_core::variants!('static => entries {});
-    Strategy::ALL
+    Strategy::KERNELS
         .iter()
-        .flat_map(|&strategy| variant_entries(strategy))
+        .flat_map(|prefix| variant_entries(prefix))
         .collect()
 }
 
@@ -75,17 +81,34 @@ mod tests {
     }
 
     #[test]
-    fn the_registry_has_one_entry_per_strategy_and_variant() {
+    fn the_registry_has_one_entry_per_kernel_function_and_variant() {
         let mut entries = registry_entries();
         assert_eq!(
             entries.len(),
-            Strategy::ALL.len() * volpt_core::variant::COUNT
+            Strategy::KERNELS.len() * volpt_core::variant::COUNT
         );
         entries.sort();
         entries.dedup();
         assert_eq!(
             entries.len(),
-            Strategy::ALL.len() * volpt_core::variant::COUNT
+            Strategy::KERNELS.len() * volpt_core::variant::COUNT
+        );
+    }
+
+    /// Every strategy's kernel function is listed once, and every listed one serves a strategy.
+    #[test]
+    fn the_kernel_functions_are_the_strategies_own() {
+        let mut kernels = Strategy::KERNELS.to_vec();
+        kernels.sort();
+        kernels.dedup();
+        assert_eq!(kernels.len(), Strategy::KERNELS.len(), "listed twice");
+        let mut used: Vec<&str> = Strategy::ALL.iter().map(|s| s.entry_prefix()).collect();
+        used.sort();
+        used.dedup();
+        assert_eq!(used, kernels);
+        assert_eq!(
+            Strategy::NaiveMk.entry_prefix(),
+            Strategy::StreamingMk.entry_prefix()
         );
     }
 

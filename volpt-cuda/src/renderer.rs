@@ -425,12 +425,15 @@ impl CudaRenderer {
         let resident_threads = resident_blocks as u64 * BLOCK_SIZE as u64;
 
         // A multi-kernel strategy's queues, sized for the largest tile, and their counters.
-        let wavefront = matches!(strategy.scheduling(), Scheduling::Wavefront(_));
+        let wavefront = match strategy.scheduling() {
+            Scheduling::Wavefront(regeneration) => Some(regeneration),
+            _ => None,
+        };
         let capacity = Tile::grid(width, height, columns, rows)
             .map(|tile| strategy.wavefront_capacity(tile.pixels(), resident_threads))
             .max()
             .unwrap_or(1);
-        let queue_bytes = if wavefront {
+        let queue_bytes = if wavefront.is_some() {
             2 * capacity as usize * SLOT_BYTES
         } else {
             0
@@ -504,7 +507,7 @@ impl CudaRenderer {
                         .launch(config)
                         .doing("launching the kernel")
                 };
-                if wavefront {
+                if let Some(regeneration) = wavefront {
                     stream
                         .memset_zeros(queue_state)
                         .doing("resetting the queue counters")?;
@@ -517,7 +520,7 @@ impl CudaRenderer {
                     let mut iteration = 0;
                     loop {
                         for _ in 0..WAVEFRONT_BATCH {
-                            for stage in Stage::iteration(iteration) {
+                            for stage in Stage::iteration(iteration, regeneration) {
                                 params.stage = stage.code();
                                 let config = match stage {
                                     Stage::Plan { .. } => plan,

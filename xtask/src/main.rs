@@ -164,9 +164,18 @@ fn ptx_build(package: &str, flavour: Flavour, only: Only) -> Result<PathBuf> {
         .arg(&target_dir)
         .args(["--", "--emit=asm"]))?;
     let crate_name = package.replace('-', "_");
-    let built = target_dir.join(format!("nvptx64-nvidia-cuda/nvptx/deps/{crate_name}.s"));
+    let deps = target_dir.join("nvptx64-nvidia-cuda/nvptx/deps");
+    let built = deps.join(format!("{crate_name}.s"));
     let ptx =
         std::fs::read_to_string(&built).with_context(|| format!("reading {}", built.display()))?;
+    // Cargo takes the crate's output to be the linked `<crate>.ptx`, which `--emit=asm` with no
+    // linker never writes: without it every build counts as stale and compiles the kernels again
+    // (minutes), also when nothing changed. The assembly is that PTX; put it where cargo looks.
+    let output = deps.join(format!("{crate_name}.ptx"));
+    let _ = std::fs::remove_file(&output);
+    std::fs::hard_link(&built, &output)
+        .or_else(|_| std::fs::copy(&built, &output).map(|_| ()))
+        .with_context(|| format!("writing {}", output.display()))?;
     let entries = ptx.lines().filter(|l| l.contains(".entry")).count();
     if entries == 0 {
         bail!("{} has no kernel entry points", built.display());

@@ -202,7 +202,8 @@ pub enum Regeneration {
 /// The stages of a multi-kernel strategy's iteration, each one launch. `parity` says which
 /// queue the iteration consumes: extension reads queue `parity` and writes its survivors to queue
 /// `1 - parity`, to which regeneration adds the new paths; the next iteration has the other
-/// parity.
+/// parity. Both multi-kernel strategies run one kernel, whose plan stage is told the strategy's
+/// [`Regeneration`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Stage {
     Extend {
@@ -211,6 +212,7 @@ pub enum Stage {
     /// One thread: [`Wavefront::plan`].
     Plan {
         parity: u32,
+        regeneration: Regeneration,
     },
     Regenerate {
         parity: u32,
@@ -218,11 +220,21 @@ pub enum Stage {
 }
 
 impl Stage {
-    /// The stage as [`LaunchParams::stage`] carries it.
+    /// The stage as [`LaunchParams::stage`] carries it: bit 0 the parity, bits 1-2 the stage,
+    /// bit 3 a plan's [`Regeneration::Continuous`].
     pub fn code(self) -> u32 {
         match self {
             Stage::Extend { parity } => parity & 1,
-            Stage::Plan { parity } => 2 | (parity & 1),
+            Stage::Plan {
+                parity,
+                regeneration,
+            } => {
+                let continuous = match regeneration {
+                    Regeneration::WhenEmpty => 0,
+                    Regeneration::Continuous => 8,
+                };
+                continuous | 2 | (parity & 1)
+            }
             Stage::Regenerate { parity } => 4 | (parity & 1),
         }
     }
@@ -230,19 +242,30 @@ impl Stage {
     #[inline(always)]
     pub fn from_code(code: u32) -> Self {
         let parity = code & 1;
-        match code >> 1 {
+        match (code >> 1) & 3 {
             0 => Stage::Extend { parity },
-            1 => Stage::Plan { parity },
+            1 => Stage::Plan {
+                parity,
+                regeneration: if code & 8 != 0 {
+                    Regeneration::Continuous
+                } else {
+                    Regeneration::WhenEmpty
+                },
+            },
             _ => Stage::Regenerate { parity },
         }
     }
 
-    /// The three launches of iteration `iteration`, in order.
-    pub fn iteration(iteration: u64) -> [Stage; 3] {
+    /// The three launches of iteration `iteration` of a strategy that regenerates as
+    /// `regeneration`, in order.
+    pub fn iteration(iteration: u64, regeneration: Regeneration) -> [Stage; 3] {
         let parity = (iteration & 1) as u32;
         [
             Stage::Extend { parity },
-            Stage::Plan { parity },
+            Stage::Plan {
+                parity,
+                regeneration,
+            },
             Stage::Regenerate { parity },
         ]
     }

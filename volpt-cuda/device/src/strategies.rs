@@ -1,32 +1,41 @@
 //! The scheduling strategies (Novák, Havran & Dachsbacher 2010; the thesis's naiveSK,
 //! regenerationSK, streamingSK, sortingSK, naiveMK and streamingMK), listed once:
 //! [`strategies!`](crate::strategies) generates the host's [`Strategy`] enum and
-//! [`export_kernels!`](crate::export_kernels) one kernel per strategy.
+//! [`export_kernels!`](crate::export_kernels) one kernel per kernel function.
 //!
-//! Each entry is `(CamelCase variant, kernel function in `strategy`, command-line name)`; the
-//! function's name is also the prefix of the kernels' entry points.
+//! `kernels` lists the kernel functions of `strategy`; each function's name is the prefix of its
+//! kernels' entry points. Each strategy is `(CamelCase variant, its kernel function, command-line
+//! name)`: strategies that differ only in what the host tells the kernel share one function (the
+//! multi-kernel strategies: `launch::Stage` carries their `Regeneration`), which halves their
+//! share of the kernels' build time and size.
 
-/// Calls `$callback!` with `$args` and the strategy list.
+/// Calls `$callback!` with `$args`, the kernel functions and the strategy list.
 #[macro_export]
 macro_rules! strategies {
     ($callback:path { $($args:tt)* }) => {
-        $callback! { $($args)* strategies [
-            (NaiveSk, naive_sk, "naive-sk")
-            (RegenerationSk, regeneration_sk, "regeneration-sk")
-            (RegenerationWarpSk, regeneration_warp_sk, "regeneration-warp-sk")
-            (RegenerationBlockSk, regeneration_block_sk, "regeneration-block-sk")
-            (Regeneration2pSk, regeneration_2p_sk, "regeneration-2p-sk")
-            (StreamingSk, streaming_sk, "streaming-sk")
-            (StreamingSortedSk, streaming_sorted_sk, "streaming-sorted-sk")
-            (SortingSk, sorting_sk, "sorting-sk")
-            (NaiveMk, naive_mk, "naive-mk")
-            (StreamingMk, streaming_mk, "streaming-mk")
-        ] }
+        $callback! { $($args)*
+            kernels [
+                naive_sk regeneration_sk regeneration_warp_sk regeneration_block_sk
+                regeneration_2p_sk streaming_sk streaming_sorted_sk sorting_sk multi_kernel
+            ]
+            strategies [
+                (NaiveSk, naive_sk, "naive-sk")
+                (RegenerationSk, regeneration_sk, "regeneration-sk")
+                (RegenerationWarpSk, regeneration_warp_sk, "regeneration-warp-sk")
+                (RegenerationBlockSk, regeneration_block_sk, "regeneration-block-sk")
+                (Regeneration2pSk, regeneration_2p_sk, "regeneration-2p-sk")
+                (StreamingSk, streaming_sk, "streaming-sk")
+                (StreamingSortedSk, streaming_sorted_sk, "streaming-sorted-sk")
+                (SortingSk, sorting_sk, "sorting-sk")
+                (NaiveMk, multi_kernel, "naive-mk")
+                (StreamingMk, multi_kernel, "streaming-mk")
+            ]
+        }
     };
 }
 
 /// The kernels of every strategy for one scene type `VolumeScene<M, B, P, E>`, exported as
-/// `<strategy>__<m>__<b>__<p>__<e>`: the names must be the parts' `Component::NAME`s, which is how
+/// `<kernel function>__<m>__<b>__<p>__<e>`: the names must be the parts' `Component::NAME`s, which is how
 /// the host finds the entry point of a scene type.
 ///
 /// ```text
@@ -39,7 +48,7 @@ macro_rules! export_kernels {
         $crate::strategies! { $crate::export_kernels { @each ($m: $mt, $b: $bt, $p: $pt, $e: $et) } }
     };
     (@each ($m:ident: $mt:ty, $b:ident: $bt:ty, $p:ident: $pt:ty, $e:ident: $et:ty)
-     strategies [$(($camel:ident, $s:ident, $cli:literal))*]) => {$(
+     kernels [$($s:ident)*] strategies $strategies:tt) => {$(
         const _: () = {
             /// The launch parameters come by value: they live in the kernel's constant bank, where
             /// every instruction can read them, instead of ~40 registers held across the path loop.
@@ -67,7 +76,7 @@ macro_rules! export_kernels {
 }
 
 macro_rules! define_strategy {
-    (strategies [$(($camel:ident, $s:ident, $cli:literal))*]) => {
+    (kernels [$($kernel:ident)*] strategies [$(($camel:ident, $s:ident, $cli:literal))*]) => {
         /// A GPU scheduling strategy: who traces which path, and how results reach the film.
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
         #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
@@ -78,6 +87,10 @@ macro_rules! define_strategy {
         impl Strategy {
             pub const ALL: &'static [Strategy] = &[$(Strategy::$camel),*];
 
+            /// The entry prefixes of the kernel functions, each once: a scene type has one kernel
+            /// per prefix.
+            pub const KERNELS: &'static [&'static str] = &[$(stringify!($kernel)),*];
+
             /// The name users type: `--strategy naive-sk`.
             pub fn name(self) -> &'static str {
                 match self {
@@ -85,7 +98,7 @@ macro_rules! define_strategy {
                 }
             }
 
-            /// The prefix of this strategy's kernel entry points.
+            /// The prefix of this strategy's kernel entry points (one of [`Self::KERNELS`]).
             pub fn entry_prefix(self) -> &'static str {
                 match self {
                     $(Strategy::$camel => stringify!($s),)*

@@ -1,25 +1,39 @@
 //! The strategies' kernel bodies: who traces which path, and how results reach the film.
 //!
-//! Both trace the same paths as the CPU: path `(pixel, sample)` is `PathState::from_camera` with the
-//! launch's seed, run by the shared `path::step`. They differ only in scheduling (the thesis' first
-//! two strategies, after Novák, Havran & Dachsbacher 2010):
+//! Every strategy traces the CPU's paths: path index `k` of a launch is sample `k / pixels` of the
+//! tile's pixel `k % pixels` ([`path_of`]), started by `PathState::from_camera` with the launch's
+//! seed and advanced by the shared `path::step`. They differ only in scheduling (the thesis's
+//! strategies, after Novák, Havran & Dachsbacher 2010):
 //!
-//! - [`naive_sk`] (naiveSK): one thread per pixel traces that pixel's samples in order and sums them in
-//!   `f64`, exactly as the CPU does, so the image is bit-identical to the CPU's. A warp waits for its
-//!   longest path, and there are only `width * height` threads.
-//! - [`regeneration_sk`] (regenerationSK): a persistent grid sized to fill the GPU; a thread advances its
-//!   path one step at a time, and as soon as the path ends it records it and takes the next path index
-//!   from a global counter (one atomic per warp and refill), so lanes do not idle behind long paths.
-//!   Radiance reaches the film through `f64` atomic additions, whose order varies: the image agrees
-//!   with the CPU's up to the rounding of the sums.
+//! - [`naive_sk`]: one thread per pixel traces that pixel's samples in order and sums them in `f64`
+//!   with the CPU's own loop, so its image is the CPU's bit for bit.
+//! - The persistent strategies, each one [`persistent`] loop: a grid sized to fill the GPU, whose
+//!   threads keep one or two path slots ([`Lane`]s) and repeat: refill idle lanes from the launch's
+//!   path counter ([`Refill`]: at thread, warp or block level), stop once the refill's group has
+//!   no live path, advance every live path by one step ([`Advance`]: in place, or followed by
+//!   regrouping the block's paths). A thread's [`PathPool`] starts its paths and records the
+//!   ended ones.
+//! - The multi-kernel strategies ([`multi_kernel`]): paths queued in device memory, one step per
+//!   launch.
+//!
+//! The persistent and multi-kernel strategies add radiance to the film with `f64` atomics in the
+//! order paths end: their images agree with the CPU's up to the rounding of those sums.
+//!
+//! # Collectives
+//!
+//! A warp-collective operation (vote, shuffle) must be reached by every lane of the warp, a
+//! block-collective one (barrier) by every thread of the block, at the same instruction; each
+//! function says which it is. Collectives therefore sit outside branches on per-lane values, and
+//! the loop's exit test is uniform over the group of the refill. Where a per-lane flag that a
+//! branch just set feeds a collective, it passes through [`opaque`]: LLVM otherwise threads the
+//! value it knows on one edge (a path that just ended is inactive) into a copy of the collective
+//! code, and lanes vote or wait at different instructions.
 
 use volpt_core::medium::Medium;
 use volpt_core::path::{fly, sample_pixel, scatter, step, PathCounters, PathState, Truncation};
 use volpt_core::{Scene, Spectrum, Vec3};
 
-use crate::launch::{
-    path_of, LaunchParams, Regeneration, Slot, Stage, Wavefront, BLOCK_SIZE, SLOT_BYTES,
-};
+use crate::launch::{path_of, LaunchParams, Slot, Stage, Wavefront, BLOCK_SIZE, SLOT_BYTES};
 use crate::nvptx::{
     atomic_add_u64, ballot, block_broadcast_u64, block_exclusive_count, block_sort_u32,
     global_thread_index, grid_threads, lane_id, lanemask_lt, opaque, opaque_u32, red_add_f64,
@@ -111,44 +125,6 @@ impl ThreadCounters {
     }
 }
 
-/// Records a finished path: its counts, and its radiance added to its pixel's `f64` sums.
-///
-/// # Safety
-/// `film` must hold the `3 * pixels` sums and `pixel` be inside it; `totals` must be the launch's
-/// `launch::COUNTERS` totals.
-#[inline(always)]
-unsafe fn finish_path(
-    path: &PathState,
-    pixel: u32,
-    film: *mut f64,
-    counters: &mut ThreadCounters,
-    totals: *mut u64,
-) {
-    // SAFETY: the caller's contract.
-    unsafe { counters.record(path, totals) };
-    for c in 0..3 {
-        let value = path.radiance[c];
-        if value != 0.0 {
-            // SAFETY: the caller's contract.
-            unsafe { red_add_f64(film.add(3 * pixel as usize + c), value as f64) };
-        }
-    }
-}
-
-/// Path index `index` of the launch ([`path_of`]) over its tile's `pixels` pixels: its first
-/// state, from the camera, and its film pixel. The callers count `pixels` once, before their
-/// loops, as they did before this was shared: counted here, the multiplication moved into every
-/// refill and the kernels' branches were laid out anew.
-#[inline(always)]
-fn start_path<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, pixels: u64, index: u64) -> Slot {
-    let (tile_pixel, sample) = path_of(index, pixels, lp.first_sample);
-    let (px, py, pixel) = lp.tile.film_pixel(tile_pixel, scene.camera().width);
-    Slot {
-        path: PathState::from_camera(scene, px, py, sample, lp.seed),
-        pixel,
-    }
-}
-
 /// naiveSK: thread `i` renders the tile's pixel `i`, adding this launch's samples to its `f64` sum with the
 /// CPU's own per-pixel loop, so the sums are the CPU's bit for bit.
 ///
@@ -210,225 +186,500 @@ pub unsafe fn block_take_indices(need: bool, next: *mut u64) -> Option<u64> {
     Some(base + rank as u64)
 }
 
-/// Where regeneration waits before an idle lane takes a new path (the thesis's synchronisation
-/// levels of regenerationSK).
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Refill {
-    /// Idle lanes refill once `LaunchParams::refill_at` of them are idle (the host's default: 8),
-    /// or when no lane of the warp is busy; the warp's idle lanes share one atomic.
-    Thread,
-    /// The warp refills only when all its lanes are idle: one atomic per 32 paths, and a warp's
-    /// lanes start (and tend to end) together.
-    Warp,
+/// A thread's side of a launch: where its paths start (path indices from the launch's counter,
+/// the tile's pixels) and where an ended path goes (its pixel's `f64` sums, the path counts).
+struct PathPool<'a, S, P> {
+    scene: &'a S,
+    lp: &'a LaunchParams<P>,
+    /// The tile's pixel count, computed once per launch rather than at every refill.
+    pixels: u64,
+    film: *mut f64,
+    next_path: *mut u64,
+    totals: *mut u64,
+    counters: ThreadCounters,
+    /// Every path index of the launch has been handed out: a refill starts no path any more. The
+    /// [`Refill`] policy sets it, and says whether it is uniform over its group.
+    exhausted: bool,
 }
 
-impl Refill {
-    /// Whether the warp refills its idle lanes now, for a lane whose path is `active` (or none
-    /// is left to take: `exhausted`). Warp-collective: the threshold is the same for every lane,
-    /// so every vote is warp-uniform.
+impl<'a, S: Scene, P> PathPool<'a, S, P> {
+    /// # Safety
+    /// `lp.film` must hold the film's `3 * width * height` `f64` sums, `lp.counters` the
+    /// `launch::COUNTERS` totals and `lp.next_path` one `u64`, all alive until the kernel ends:
+    /// the pool's other methods rely on it.
     #[inline(always)]
-    fn ready<P>(self, lp: &LaunchParams<P>, active: bool, exhausted: bool) -> bool {
-        match self {
-            Refill::Thread => {
-                lp.refill_at <= 1
-                    || ballot(!active && !exhausted).count_ones() >= lp.refill_at
-                    || ballot(active) == 0
-            }
-            Refill::Warp => ballot(active) == 0,
+    unsafe fn new(scene: &'a S, lp: &'a LaunchParams<P>) -> Self {
+        PathPool {
+            scene,
+            lp,
+            pixels: lp.tile.pixels(),
+            film: lp.film as *mut f64,
+            next_path: lp.next_path as *mut u64,
+            totals: lp.counters as *mut u64,
+            counters: ThreadCounters::default(),
+            exhausted: false,
         }
+    }
+
+    /// A lane without a path: its path is a placeholder until a refill starts one.
+    #[inline(always)]
+    fn idle_lane(&self) -> Lane {
+        Lane {
+            path: PathState::from_camera(self.scene, 0, 0, 0, self.lp.seed),
+            pixel: 0,
+            active: false,
+        }
+    }
+
+    /// Path `index` of the launch ([`path_of`]): its first state, from the camera, and its film
+    /// pixel.
+    #[inline(always)]
+    fn start(&self, index: u64) -> Slot {
+        let (tile_pixel, sample) = path_of(index, self.pixels, self.lp.first_sample);
+        let (px, py, pixel) = self
+            .lp
+            .tile
+            .film_pixel(tile_pixel, self.scene.camera().width);
+        Slot {
+            path: PathState::from_camera(self.scene, px, py, sample, self.lp.seed),
+            pixel,
+        }
+    }
+
+    /// Starts path `index` in `lane`, which becomes live.
+    #[inline(always)]
+    fn start_in(&self, lane: &mut Lane, index: u64) {
+        let Slot { path, pixel } = self.start(index);
+        lane.path = path;
+        lane.pixel = pixel;
+        lane.active = true;
+    }
+
+    /// Records a finished path: its counts, and its radiance added to its pixel's `f64` sums.
+    ///
+    /// # Safety
+    /// `pixel` must be a pixel of the launch's film (every [`Self::start`]ed path's is).
+    #[inline(always)]
+    unsafe fn record(&mut self, path: &PathState, pixel: u32) {
+        // SAFETY: `totals` holds the launch's `launch::COUNTERS` totals.
+        unsafe { self.counters.record(path, self.totals) };
+        for c in 0..3 {
+            let value = path.radiance[c];
+            if value != 0.0 {
+                // SAFETY: the film holds `3 * pixels` sums and `pixel` is inside it.
+                unsafe { red_add_f64(self.film.add(3 * pixel as usize + c), value as f64) };
+            }
+        }
+    }
+
+    /// Records the path of a live `lane` if it has ended, and idles the lane.
+    #[inline(always)]
+    fn retire_if_ended(&mut self, lane: &mut Lane) {
+        if !lane.path.alive {
+            // SAFETY: a live lane's pixel is its started path's.
+            unsafe { self.record(&lane.path, lane.pixel) };
+            lane.active = false;
+        }
+    }
+
+    /// One step of `lane`'s path if it is live; an ended path is recorded and the lane idles.
+    #[inline(always)]
+    fn step(&mut self, lane: &mut Lane) {
+        if lane.active {
+            step(self.scene, &mut lane.path);
+            self.retire_if_ended(lane);
+        }
+    }
+
+    /// Adds the thread's path counts to the launch's totals (warp-collective: every lane calls
+    /// it, at the kernel's end).
+    #[inline(always)]
+    fn flush(self) {
+        // SAFETY: `lp.counters` holds `launch::COUNTERS` totals.
+        unsafe { self.counters.flush(self.lp) };
     }
 }
 
-/// regenerationSK: persistent threads step their paths and refill finished lanes from a global
-/// path counter. Path index `k` is sample `k / pixels` of pixel `k % pixels`, so the paths in flight
-/// at any time are spread over the image and the film's atomics rarely collide.
-///
-/// # Safety
-/// As [`naive_sk`]; and `lp.next_path` must be one zeroed `u64`, and the block size a multiple of 32.
-#[inline(always)]
-pub unsafe fn regeneration_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
-    // SAFETY: forwarded.
-    unsafe { regeneration(scene, lp, Refill::Thread) }
+/// One path slot of a thread: a path and its film pixel, traced while `active`. An idle lane's
+/// path is a placeholder or the path it last finished, and is never stepped.
+#[derive(Clone, Copy)]
+struct Lane {
+    path: PathState,
+    pixel: u32,
+    active: bool,
 }
 
-/// regenerationSK at warp level: see [`Refill::Warp`].
-///
-/// # Safety
-/// As [`regeneration_sk`].
-#[inline(always)]
-pub unsafe fn regeneration_warp_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
-    // SAFETY: forwarded.
-    unsafe { regeneration(scene, lp, Refill::Warp) }
+/// The lanes a thread keeps: one [`Lane`], or an array of them that one copy of the step's code
+/// walks in turn.
+trait Lanes: Copy {
+    fn idle(lane: Lane) -> Self;
+    /// Calls `f` on every lane, in order.
+    fn each(&mut self, f: impl FnMut(&mut Lane));
+    /// Whether any of this thread's lanes is live (no vote).
+    fn any_active(&self) -> bool;
 }
 
-/// # Safety
-/// As [`regeneration_sk`].
+impl Lanes for Lane {
+    #[inline(always)]
+    fn idle(lane: Lane) -> Self {
+        lane
+    }
+
+    #[inline(always)]
+    fn each(&mut self, mut f: impl FnMut(&mut Lane)) {
+        f(self)
+    }
+
+    #[inline(always)]
+    fn any_active(&self) -> bool {
+        self.active
+    }
+}
+
+/// `K` lanes walked by a loop: the array is indexed at run time and so kept in local memory (the
+/// one kind of kernel that keeps more than the counters' 64 bytes there,
+/// `volpt-cuda/tests/ptx_entries.rs`). Unrolled, the step's code would be inlined `K` times.
+impl<const K: usize> Lanes for [Lane; K] {
+    #[inline(always)]
+    fn idle(lane: Lane) -> Self {
+        [lane; K]
+    }
+
+    #[inline(always)]
+    fn each(&mut self, mut f: impl FnMut(&mut Lane)) {
+        for lane in self.iter_mut() {
+            f(lane)
+        }
+    }
+
+    #[inline(always)]
+    fn any_active(&self) -> bool {
+        self.iter().any(|lane| lane.active)
+    }
+}
+
+/// When idle lanes take new paths from the launch's counter, and over which group of threads
+/// the persistent loop decides to go on (the thesis's synchronisation levels of regenerationSK).
+trait Refill {
+    /// The group is the block: [`Self::refill`] and [`Self::any_live`] are block-collective.
+    /// Otherwise it is the warp, and they are warp-collective.
+    const BLOCK: bool;
+
+    /// Gives idle lanes the next path indices, in lane order, and sets `pool.exhausted` once the
+    /// indices run out. Every thread of the group calls it at the same point with all its lanes.
+    fn refill<S: Scene, P, L: Lanes>(pool: &mut PathPool<'_, S, P>, lanes: &mut L);
+
+    /// Whether any lane of the group is live, given whether this thread's are: the same answer
+    /// in every thread of the group, so that the group leaves the loop together.
+    #[inline(always)]
+    fn any_live(live: bool) -> bool {
+        ballot(live) != 0
+    }
+}
+
+/// Warp level, refilling by threshold: the warp's idle lanes take paths once
+/// `LaunchParams::refill_at` of them are idle (the host's default: 8; 1: at once), or when no lane
+/// of the warp is busy; they share one atomic.
+struct ThreadRefill;
+
+/// Warp level, refilling whole warps: the warp's lanes take paths only when all of them are idle
+/// (one atomic per 32 paths), so they start, and tend to end, together.
+struct WarpRefill;
+
+/// Block level: after every step the block counts its idle lanes (a block-wide scan), takes that
+/// many path indices with one atomic and hands them out in thread order.
+struct BlockRefill;
+
+/// The refill of the warp-level policies, which differ in when the warp is `ready` (a vote,
+/// warp-uniform). `pool.exhausted` is warp-uniform: once one lane of the warp receives an index
+/// past the launch's paths every later index is past them too, and from then on the warp only
+/// steps its paths to their ends, without the refill's votes (that tail sets the pace of the
+/// launch's last, longest paths, docs/strategies.md).
 #[inline(always)]
-unsafe fn regeneration<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, refill: Refill) {
-    let pixels = lp.tile.pixels();
-    let film = lp.film as *mut f64;
-    let next_path = lp.next_path as *mut u64;
-    let mut counters = ThreadCounters::default();
-    let totals = lp.counters as *mut u64;
-    // A placeholder until the first refill; `active` says whether `path` is a live path.
-    let mut path = PathState::from_camera(scene, 0, 0, 0, lp.seed);
-    let mut pixel = 0u32;
-    let mut active = false;
-    // Warp-uniform: the launch's paths are all handed out. From then on the warp only steps its
-    // paths to their ends, without the refill's votes: that tail sets the pace of the launch's
-    // last, longest paths (docs/strategies.md).
-    let mut exhausted = false;
-    loop {
-        if !exhausted {
-            // Refill: the lanes without a path take consecutive indices with one atomic per warp.
-            let need = refill.ready(lp, active, false) && !active;
-            // SAFETY: `next_path` is one `u64` (the caller's contract).
-            if let Some(index) = unsafe { warp_take_indices(need, next_path) } {
-                if need && index < lp.total_paths {
-                    Slot { path, pixel } = start_path(scene, lp, pixels, index);
-                    active = true;
+fn warp_refill<S: Scene, P, L: Lanes>(
+    pool: &mut PathPool<'_, S, P>,
+    lanes: &mut L,
+    ready: impl Fn(&LaunchParams<P>, bool) -> bool,
+) {
+    if pool.exhausted {
+        return;
+    }
+    lanes.each(
+        #[inline(always)]
+        |lane| {
+            let need = ready(pool.lp, lane.active) && !lane.active;
+            // SAFETY: `next_path` is the launch's one path counter.
+            if let Some(index) = unsafe { warp_take_indices(need, pool.next_path) } {
+                if need && index < pool.lp.total_paths {
+                    pool.start_in(lane, index);
                 }
-                exhausted = ballot(need && index >= lp.total_paths) != 0;
+                pool.exhausted = ballot(need && index >= pool.lp.total_paths) != 0;
             }
-        }
-        if ballot(active) == 0 {
-            break;
-        }
-        if active {
-            step(scene, &mut path);
-            if !path.alive {
-                // SAFETY: `pixel` is inside the film.
-                unsafe { finish_path(&path, pixel, film, &mut counters, totals) };
-                active = false;
-            }
-        }
+        },
+    );
+}
+
+impl Refill for ThreadRefill {
+    const BLOCK: bool = false;
+
+    #[inline(always)]
+    fn refill<S: Scene, P, L: Lanes>(pool: &mut PathPool<'_, S, P>, lanes: &mut L) {
+        warp_refill(
+            pool,
+            lanes,
+            #[inline(always)]
+            |lp, active| {
+                lp.refill_at <= 1
+                    || ballot(!active).count_ones() >= lp.refill_at
+                    || ballot(active) == 0
+            },
+        )
     }
-    // SAFETY: `lp.counters` holds `COUNTERS` totals.
-    unsafe { counters.flush(lp) };
 }
 
-/// regenerationSK with two paths per thread (the thesis's instruction-level-parallelism study):
-/// each thread keeps two paths and steps both in every iteration, so that the latency of one
-/// path's memory reads and long arithmetic can overlap the other's, at the price of twice the
-/// path state in registers (lower occupancy). Each of the two path slots refills as
-/// [`Refill::Thread`] does.
-///
-/// The paths live in an array walked by a loop, so that one copy of the step's code serves both;
-/// the array is indexed at run time and so kept in local memory (the one kernel that keeps more
-/// than the counters' 64 bytes there, `volpt-cuda/tests/ptx_entries.rs`). Two named paths stay in
-/// registers but inline the step twice: on an H100 (2026-11-24,
-/// `bench/results/2026-11-24-h100-strategies-all/bench-2p-named-slots.txt`) that kernel was
-/// 1.2-3.5x slower than this one on five of seven scenes and 1.1-1.6x faster on two (ad, the
-/// index-matched cube), and slower than regeneration-sk on all seven, like this one.
-///
-/// # Safety
-/// As [`regeneration_sk`].
-#[inline(always)]
-pub unsafe fn regeneration_2p_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
-    // SAFETY: forwarded.
-    unsafe { regeneration_paths::<S, P, 2>(scene, lp) }
+impl Refill for WarpRefill {
+    const BLOCK: bool = false;
+
+    #[inline(always)]
+    fn refill<S: Scene, P, L: Lanes>(pool: &mut PathPool<'_, S, P>, lanes: &mut L) {
+        warp_refill(
+            pool,
+            lanes,
+            #[inline(always)]
+            |_, active| ballot(active) == 0,
+        )
+    }
 }
 
-/// # Safety
-/// As [`regeneration_sk`].
-#[inline(always)]
-unsafe fn regeneration_paths<S: Scene, P, const K: usize>(scene: &S, lp: &LaunchParams<P>) {
-    let pixels = lp.tile.pixels();
-    let film = lp.film as *mut f64;
-    let next_path = lp.next_path as *mut u64;
-    let mut counters = ThreadCounters::default();
-    let totals = lp.counters as *mut u64;
-    let mut paths = [PathState::from_camera(scene, 0, 0, 0, lp.seed); K];
-    let mut pixel = [0u32; K];
-    let mut active = [false; K];
-    let mut exhausted = false;
-    loop {
-        for k in 0..K {
-            // Every lane votes for every slot, so the votes stay warp-uniform.
-            let need = Refill::Thread.ready(lp, active[k], exhausted) && !active[k] && !exhausted;
-            // SAFETY: `next_path` is one `u64` (the caller's contract).
-            if let Some(index) = unsafe { warp_take_indices(need, next_path) } {
-                if need {
-                    if index < lp.total_paths {
-                        Slot {
-                            path: paths[k],
-                            pixel: pixel[k],
-                        } = start_path(scene, lp, pixels, index);
-                        active[k] = true;
-                    } else {
-                        exhausted = true;
+/// `pool.exhausted` is per thread here: set in the threads that received an index past the
+/// launch's paths, which take none after that.
+impl Refill for BlockRefill {
+    const BLOCK: bool = true;
+
+    #[inline(always)]
+    fn refill<S: Scene, P, L: Lanes>(pool: &mut PathPool<'_, S, P>, lanes: &mut L) {
+        lanes.each(
+            #[inline(always)]
+            |lane| {
+                let need = opaque(!lane.active && !pool.exhausted);
+                // SAFETY: `next_path` is the launch's one path counter.
+                if let Some(index) = unsafe { block_take_indices(need, pool.next_path) } {
+                    if need {
+                        if index < pool.lp.total_paths {
+                            pool.start_in(lane, index);
+                        } else {
+                            pool.exhausted = true;
+                        }
                     }
                 }
-            }
-        }
-        if ballot(active.iter().any(|&a| a)) == 0 {
-            break;
-        }
-        for k in 0..K {
-            if active[k] {
-                step(scene, &mut paths[k]);
-                if !paths[k].alive {
-                    // SAFETY: `pixel[k]` is inside the film.
-                    unsafe { finish_path(&paths[k], pixel[k], film, &mut counters, totals) };
-                    active[k] = false;
-                }
-            }
-        }
+            },
+        );
     }
-    // SAFETY: `lp.counters` holds `COUNTERS` totals.
-    unsafe { counters.flush(lp) };
+
+    #[inline(always)]
+    fn any_live(live: bool) -> bool {
+        sync_threads_or(opaque(live))
+    }
 }
 
-/// regenerationSK at block level: after every step the block counts its idle lanes (a block-wide
-/// scan), takes that many path indices with one atomic, and hands them out in thread order.
-///
-/// # Safety
-/// As [`regeneration_sk`]; every thread of the block runs it.
-#[inline(always)]
-pub unsafe fn regeneration_block_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
-    let pixels = lp.tile.pixels();
-    let film = lp.film as *mut f64;
-    let next_path = lp.next_path as *mut u64;
-    let mut counters = ThreadCounters::default();
-    let totals = lp.counters as *mut u64;
-    let mut path = PathState::from_camera(scene, 0, 0, 0, lp.seed);
-    let mut pixel = 0u32;
-    let mut active = false;
-    let mut exhausted = false;
-    loop {
-        let need = opaque(!active && !exhausted);
-        // SAFETY: `next_path` is one `u64` (the caller's contract).
-        if let Some(index) = unsafe { block_take_indices(need, next_path) } {
-            if need {
-                if index < lp.total_paths {
-                    Slot { path, pixel } = start_path(scene, lp, pixels, index);
-                    active = true;
-                } else {
-                    exhausted = true;
-                }
-            }
-        }
-        if !sync_threads_or(opaque(active)) {
-            break;
-        }
-        if active {
-            step(scene, &mut path);
-            if !path.alive {
-                // SAFETY: `pixel` is inside the film.
-                unsafe { finish_path(&path, pixel, film, &mut counters, totals) };
-                active = false;
-            }
-        }
-    }
-    // SAFETY: `lp.counters` holds `COUNTERS` totals.
-    unsafe { counters.flush(lp) };
+/// How one iteration of the persistent loop advances a thread's lanes `L`.
+trait Advance<L: Lanes> {
+    /// [`Self::advance`] is block-collective: it runs only under a block-level [`Refill`], whose
+    /// exit test keeps the whole block in the loop.
+    const BLOCK: bool;
+
+    /// The loop advances before the refill (advance, refill, exit test) rather than after the
+    /// exit test (refill, exit test, advance). Both orders do the same work, since the first
+    /// advance finds every lane idle, but compile to different kernels: the regroupings keep
+    /// the order their kernels were measured in; in the other, streaming-sk took +5% on the
+    /// index-matched cube and -8% on the dielectric one (H100, 2026-11-26,
+    /// `bench/results/2026-11-26-h100-pool/ab.txt`).
+    const FIRST: bool;
+
+    /// What the advance computes once, before the loop (the shared-memory slots' address).
+    type Setup: Copy;
+    fn setup() -> Self::Setup;
+
+    fn advance<S: Scene, P>(setup: Self::Setup, pool: &mut PathPool<'_, S, P>, lanes: &mut L);
 }
 
-// One slot per thread of the block, where streaming parks its paths to compact or sort them.
+/// Each lane steps its own path (no collective).
+struct InPlace;
+
+/// streamingSK's compaction: after the step the block's live paths move to its first threads, in
+/// thread order (a block-wide exclusive scan gives each its slot in shared memory), so that the
+/// idle lanes are whole warps at the block's end, which refill together.
+struct Compact;
+
+/// streamingSK with Morton sorting (the thesis's sorting variant of its algorithm 5): after the
+/// step the block's live paths move to its first threads in the Morton order of their positions
+/// ([`crate::order::morton30`]; a block-wide radix sort in which ended paths have the largest
+/// key), so that the lanes of a warp track through neighbouring cells and read neighbouring voxels.
+struct SortPaths;
+
+/// sortingSK: each step stops at its collision ([`volpt_core::path::fly`]), the block sorts its
+/// collision points by Morton code, each lane reads the albedo at the point of its place in that
+/// order (neighbouring lanes, neighbouring voxels) and hands it back to the path's lane, which then
+/// scatters ([`volpt_core::path::scatter`]); then the block compacts as [`Compact`]. The paths are
+/// those of the CPU: the albedo draws no random number (unlike the thesis's sortingSK, which
+/// applied roulette before the deferred albedo). A medium of constant albedo has no reads to
+/// order, and the step runs whole.
+struct SortAlbedoReads;
+
+impl<L: Lanes> Advance<L> for InPlace {
+    const BLOCK: bool = false;
+    const FIRST: bool = false;
+    type Setup = ();
+
+    #[inline(always)]
+    fn setup() {}
+
+    #[inline(always)]
+    fn advance<S: Scene, P>(_: (), pool: &mut PathPool<'_, S, P>, lanes: &mut L) {
+        lanes.each(
+            #[inline(always)]
+            |lane| pool.step(lane),
+        );
+    }
+}
+
+impl Advance<Lane> for Compact {
+    const BLOCK: bool = true;
+    const FIRST: bool = true;
+    type Setup = BlockSlots;
+
+    #[inline(always)]
+    fn setup() -> BlockSlots {
+        BlockSlots::new()
+    }
+
+    #[inline(always)]
+    fn advance<S: Scene, P>(block: BlockSlots, pool: &mut PathPool<'_, S, P>, lane: &mut Lane) {
+        pool.step(lane);
+        compact(block, lane);
+    }
+}
+
+impl Advance<Lane> for SortPaths {
+    const BLOCK: bool = true;
+    const FIRST: bool = true;
+    type Setup = BlockSlots;
+
+    #[inline(always)]
+    fn setup() -> BlockSlots {
+        BlockSlots::new()
+    }
+
+    #[inline(always)]
+    fn advance<S: Scene, P>(block: BlockSlots, pool: &mut PathPool<'_, S, P>, lane: &mut Lane) {
+        pool.step(lane);
+        // Each thread parks its live path at its own index and takes the path of its place in
+        // the Morton order.
+        let BlockSlots { slots, thread } = block;
+        let key = if lane.active {
+            morton30(lane.path.ray.origin, &pool.scene.bounds())
+        } else {
+            INACTIVE_KEY
+        };
+        let (sorted, source) = block_sort_u32(opaque_u32(key));
+        if lane.active {
+            // SAFETY: one slot per thread of the block.
+            unsafe { slots.add(thread as usize).write(lane.slot()) };
+        }
+        sync_threads();
+        lane.active = sorted != INACTIVE_KEY;
+        if lane.active {
+            // SAFETY: written before the barrier by thread `source`, which was live.
+            lane.set_slot(unsafe { slots.add(source as usize).read() });
+        }
+        // The slots are read before the next regrouping writes them: the barriers of the next
+        // refill's block-wide scan order them.
+    }
+}
+
+impl Advance<Lane> for SortAlbedoReads {
+    const BLOCK: bool = true;
+    const FIRST: bool = true;
+    type Setup = BlockSlots;
+
+    #[inline(always)]
+    fn setup() -> BlockSlots {
+        BlockSlots::new()
+    }
+
+    #[inline(always)]
+    fn advance<S: Scene, P>(block: BlockSlots, pool: &mut PathPool<'_, S, P>, lane: &mut Lane) {
+        if S::Medium::CONSTANT_ALBEDO {
+            pool.step(lane);
+        } else {
+            step_with_sorted_albedo_reads(pool.scene, &mut lane.path, opaque(lane.active));
+            if lane.active {
+                pool.retire_if_ended(lane);
+            }
+        }
+        compact(block, lane);
+    }
+}
+
+impl Lane {
+    #[inline(always)]
+    fn slot(&self) -> Slot {
+        Slot {
+            path: self.path,
+            pixel: self.pixel,
+        }
+    }
+
+    #[inline(always)]
+    fn set_slot(&mut self, slot: Slot) {
+        self.path = slot.path;
+        self.pixel = slot.pixel;
+    }
+}
+
+// One slot per thread of the block, where the regroupings park its paths.
 core::arch::global_asm!(
     ".shared .align 16 .b8 volpt_stream_slots[{n}];",
     n = const core::mem::size_of::<Slot>() * BLOCK_SIZE as usize,
 );
+
+/// The block's path slots in shared memory, one per thread, and this thread's index there;
+/// computed once per kernel, before the loop (the address comes from asm, which LLVM does not
+/// hoist out of a loop).
+#[derive(Clone, Copy)]
+struct BlockSlots {
+    slots: *mut Slot,
+    thread: u32,
+}
+
+impl BlockSlots {
+    #[inline(always)]
+    fn new() -> Self {
+        BlockSlots {
+            slots: shared_to_generic(shared_address!("volpt_stream_slots")) as *mut Slot,
+            thread: thread_index(),
+        }
+    }
+}
+
+/// The block's live paths move to its first threads, in thread order: live path `rank` to thread
+/// `rank` (block-collective).
+#[inline(always)]
+fn compact(BlockSlots { slots, thread }: BlockSlots, lane: &mut Lane) {
+    let (rank, live) = block_exclusive_count(opaque(lane.active));
+    if lane.active {
+        // SAFETY: `rank < BLOCK_SIZE` slots.
+        unsafe { slots.add(rank as usize).write(lane.slot()) };
+    }
+    sync_threads();
+    lane.active = thread < live;
+    if lane.active {
+        // SAFETY: written before the barrier by the thread of that rank.
+        lane.set_slot(unsafe { slots.add(thread as usize).read() });
+    }
+    // The slots are read before the next regrouping writes them: the barriers of the next
+    // refill's block-wide scan order them.
+}
 
 // sorting-sk's collision points and their albedos, one per thread of the block.
 core::arch::global_asm!(
@@ -436,62 +687,6 @@ core::arch::global_asm!(
     ".shared .align 4 .b8 volpt_sort_albedos[{n}];",
     n = const 12 * BLOCK_SIZE as usize,
 );
-
-/// How streaming regroups a block's paths after every step.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Regroup {
-    /// Live paths to the first threads, in thread order (a block-wide exclusive scan).
-    Compact,
-    /// Live paths to the first threads, in the Morton order of their positions (a block-wide
-    /// radix sort whose ended paths have the largest key).
-    SortPaths,
-    /// As `Compact`, and before that each collision's albedo is read by the lane of its place in
-    /// the Morton order of the block's collision points (the thesis's sortingSK).
-    SortAlbedoReads,
-}
-
-/// streamingSK (the thesis's algorithm 5, with compaction in the block): persistent blocks; after
-/// every step the block compacts its live paths to its first threads (a block-wide exclusive scan
-/// gives each live path its slot in shared memory) and the idle tail takes new paths with one
-/// atomic per block. Live paths stay dense in the first warps, so the idle lanes are whole warps at
-/// the end of the block, which refill together.
-///
-/// # Safety
-/// As [`regeneration_sk`]; every thread of the block runs it.
-#[inline(always)]
-pub unsafe fn streaming_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
-    // SAFETY: forwarded.
-    unsafe { streaming(scene, lp, Regroup::Compact) }
-}
-
-/// streamingSK with Morton sorting (the thesis's sorting variant of algorithm 5): as
-/// [`streaming_sk`], but the live paths are ordered by the Morton codes of their positions
-/// ([`crate::order::morton30`]; ended paths last), so that the lanes of a warp track through
-/// neighbouring cells and read neighbouring voxels.
-///
-/// # Safety
-/// As [`regeneration_sk`]; every thread of the block runs it.
-#[inline(always)]
-pub unsafe fn streaming_sorted_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
-    // SAFETY: forwarded.
-    unsafe { streaming(scene, lp, Regroup::SortPaths) }
-}
-
-/// sortingSK: as [`streaming_sk`], but each step stops at its collision
-/// ([`volpt_core::path::fly`]), the block sorts its collision points by Morton code, each lane
-/// reads the albedo at the point of its place in that order (neighbouring lanes, neighbouring
-/// voxels) and hands it back to the path's lane, which then scatters
-/// ([`volpt_core::path::scatter`]). The paths are those of the CPU: the albedo draws no random
-/// number (unlike the thesis's sortingSK, which applied roulette before the deferred albedo). A
-/// medium of constant albedo has no reads to order, and the step runs whole.
-///
-/// # Safety
-/// As [`regeneration_sk`]; every thread of the block runs it.
-#[inline(always)]
-pub unsafe fn sorting_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
-    // SAFETY: forwarded.
-    unsafe { streaming(scene, lp, Regroup::SortAlbedoReads) }
-}
 
 /// One step of the block's live paths with the albedo of their collisions read in Morton order
 /// (block-collective).
@@ -538,121 +733,125 @@ fn step_with_sorted_albedo_reads<S: Scene>(scene: &S, path: &mut PathState, acti
     // compaction that follows order them.
 }
 
+/// The persistent loop: refill the idle lanes, leave once the refill's group has no live path,
+/// advance the live paths by a step (or advance first: [`Advance::FIRST`]); at the end add the
+/// thread's path counts to the launch's.
+///
 /// # Safety
-/// As [`regeneration_sk`]; every thread of the block runs it.
+/// `lp.film` must hold `3 * width * height` `f64`s, `lp.counters` `launch::COUNTERS` `u64`s and
+/// `lp.next_path` one zeroed `u64`; the block size a multiple of 32 (of `BLOCK_SIZE` under a
+/// block-level refill), and every thread of the block runs the kernel.
 #[inline(always)]
-unsafe fn streaming<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, regroup: Regroup) {
-    let pixels = lp.tile.pixels();
-    let film = lp.film as *mut f64;
-    let next_path = lp.next_path as *mut u64;
-    let slots = shared_to_generic(shared_address!("volpt_stream_slots")) as *mut Slot;
-    let thread = thread_index();
-    let mut counters = ThreadCounters::default();
-    let totals = lp.counters as *mut u64;
-    let mut slot = Slot {
-        path: PathState::from_camera(scene, 0, 0, 0, lp.seed),
-        pixel: 0,
+unsafe fn persistent<S: Scene, P, R: Refill, A: Advance<L>, L: Lanes>(
+    scene: &S,
+    lp: &LaunchParams<P>,
+) {
+    const {
+        assert!(
+            R::BLOCK || !A::BLOCK,
+            "a block-collective advance needs a block-level refill"
+        )
     };
-    let mut active = false;
-    let mut exhausted = false;
-    let sort_albedo_reads = regroup == Regroup::SortAlbedoReads && !S::Medium::CONSTANT_ALBEDO;
+    // SAFETY: the caller's contract.
+    let mut pool = unsafe { PathPool::new(scene, lp) };
+    let setup = A::setup();
+    let mut lanes = L::idle(pool.idle_lane());
     loop {
-        // A path that ends is recorded inside the step's branch, as streaming-sk did before
-        // sorting-sk shared this loop (one check after both branches changed its kernels' code).
-        if sort_albedo_reads {
-            step_with_sorted_albedo_reads(scene, &mut slot.path, opaque(active));
-            if active && !slot.path.alive {
-                // SAFETY: `pixel` is inside the film.
-                unsafe { finish_path(&slot.path, slot.pixel, film, &mut counters, totals) };
-                active = false;
-            }
-        } else if active {
-            step(scene, &mut slot.path);
-            if !slot.path.alive {
-                // SAFETY: `pixel` is inside the film.
-                unsafe { finish_path(&slot.path, slot.pixel, film, &mut counters, totals) };
-                active = false;
-            }
+        if A::FIRST {
+            A::advance(setup, &mut pool, &mut lanes);
         }
-        if regroup == Regroup::SortPaths {
-            // Sorting: each thread parks its path at its own index and takes the path of its
-            // place in the Morton order; ended paths sort last.
-            let key = if active {
-                morton30(slot.path.ray.origin, &scene.bounds())
-            } else {
-                INACTIVE_KEY
-            };
-            let (sorted, source) = block_sort_u32(opaque_u32(key));
-            if active {
-                // SAFETY: one slot per thread of the block.
-                unsafe { slots.add(thread as usize).write(slot) };
-            }
-            sync_threads();
-            active = sorted != INACTIVE_KEY;
-            if active {
-                // SAFETY: written before the barrier by thread `source`, which was live.
-                slot = unsafe { slots.add(source as usize).read() };
-            }
-        } else {
-            // Compaction: live path `rank` moves to thread `rank`.
-            let (rank, live) = block_exclusive_count(opaque(active));
-            if active {
-                // SAFETY: `rank < BLOCK_SIZE` slots.
-                unsafe { slots.add(rank as usize).write(slot) };
-            }
-            sync_threads();
-            active = thread < live;
-            if active {
-                // SAFETY: written before the barrier by the thread of that rank.
-                slot = unsafe { slots.add(thread as usize).read() };
-            }
-        }
-        // The slots are read before the next regrouping writes them: the barrier in
-        // `block_exclusive_count` below orders them.
-        let need = opaque(!active && !exhausted);
-        // SAFETY: `next_path` is one `u64` (the caller's contract).
-        if let Some(index) = unsafe { block_take_indices(need, next_path) } {
-            if need {
-                if index < lp.total_paths {
-                    slot = start_path(scene, lp, pixels, index);
-                    active = true;
-                } else {
-                    exhausted = true;
-                }
-            }
-        }
-        if !sync_threads_or(opaque(active)) {
+        R::refill(&mut pool, &mut lanes);
+        if !R::any_live(lanes.any_active()) {
             break;
         }
+        if !A::FIRST {
+            A::advance(setup, &mut pool, &mut lanes);
+        }
     }
-    // SAFETY: `lp.counters` holds `COUNTERS` totals.
-    unsafe { counters.flush(lp) };
+    pool.flush();
 }
 
-/// naiveMK (the thesis's first multi-kernel strategy): a batch of one sample of every pixel is
-/// started and traced to its end, one segment per launch, before the next batch starts; see
-/// [`wavefront`].
+/// regenerationSK: a thread advances its path one step at a time, and as soon as the path ends
+/// records it and takes the next path index ([`ThreadRefill`]), so that lanes do not idle behind
+/// long paths. Path index `k` is sample `k / pixels` of pixel `k % pixels`, so the paths in flight
+/// at any time are spread over the image and the film's atomics rarely collide.
 ///
 /// # Safety
-/// As [`wavefront`].
+/// As [`persistent`].
 #[inline(always)]
-pub unsafe fn naive_mk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
+pub unsafe fn regeneration_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     // SAFETY: forwarded.
-    unsafe { wavefront(scene, lp, Regeneration::WhenEmpty) }
+    unsafe { persistent::<S, P, ThreadRefill, InPlace, Lane>(scene, lp) }
 }
 
-/// streamingMK (the thesis's multi-kernel streaming, with device-wide compaction): after every
-/// extension new paths fill the room the finished ones left; see [`wavefront`].
+/// regenerationSK at warp level: see [`WarpRefill`].
 ///
 /// # Safety
-/// As [`wavefront`].
+/// As [`persistent`].
 #[inline(always)]
-pub unsafe fn streaming_mk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
+pub unsafe fn regeneration_warp_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     // SAFETY: forwarded.
-    unsafe { wavefront(scene, lp, Regeneration::Continuous) }
+    unsafe { persistent::<S, P, WarpRefill, InPlace, Lane>(scene, lp) }
 }
 
-/// The multi-kernel strategies' stages ([`Stage`]): paths live in two queues in device memory;
+/// regenerationSK at block level: see [`BlockRefill`].
+///
+/// # Safety
+/// As [`persistent`].
+#[inline(always)]
+pub unsafe fn regeneration_block_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
+    // SAFETY: forwarded.
+    unsafe { persistent::<S, P, BlockRefill, InPlace, Lane>(scene, lp) }
+}
+
+/// regenerationSK with two paths per thread (the thesis's instruction-level-parallelism study):
+/// each thread keeps two lanes and steps both in every iteration, so that the latency of one
+/// path's memory reads and long arithmetic can overlap the other's, at the price of twice the
+/// path state (in local memory: see the `Lanes` impl of arrays). Named lanes in registers, with the
+/// step inlined twice, measured slower on five of seven scenes on an H100
+/// (`bench/results/2026-11-24-h100-strategies-all/bench-2p-named-slots.txt`).
+///
+/// # Safety
+/// As [`persistent`].
+#[inline(always)]
+pub unsafe fn regeneration_2p_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
+    // SAFETY: forwarded.
+    unsafe { persistent::<S, P, ThreadRefill, InPlace, [Lane; 2]>(scene, lp) }
+}
+
+/// streamingSK (the thesis's algorithm 5, with compaction in the block): see [`Compact`].
+///
+/// # Safety
+/// As [`persistent`].
+#[inline(always)]
+pub unsafe fn streaming_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
+    // SAFETY: forwarded.
+    unsafe { persistent::<S, P, BlockRefill, Compact, Lane>(scene, lp) }
+}
+
+/// streamingSK with Morton sorting: see [`SortPaths`].
+///
+/// # Safety
+/// As [`persistent`].
+#[inline(always)]
+pub unsafe fn streaming_sorted_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
+    // SAFETY: forwarded.
+    unsafe { persistent::<S, P, BlockRefill, SortPaths, Lane>(scene, lp) }
+}
+
+/// sortingSK: see [`SortAlbedoReads`].
+///
+/// # Safety
+/// As [`persistent`].
+#[inline(always)]
+pub unsafe fn sorting_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
+    // SAFETY: forwarded.
+    unsafe { persistent::<S, P, BlockRefill, SortAlbedoReads, Lane>(scene, lp) }
+}
+
+/// The multi-kernel strategies, naiveMK and streamingMK (the thesis's; `Regeneration` says how
+/// they differ), one kernel whose launches run the stages of an iteration ([`Stage`]): paths live
+/// in two queues in device memory;
 /// extension advances every path of one queue by a segment and appends the survivors to the
 /// other (device-wide compaction: the warp's survivors take consecutive places with one atomic
 /// on the queue's count), the plan stage ([`Wavefront::plan`]) sizes the next batch of new paths,
@@ -666,17 +865,19 @@ pub unsafe fn streaming_mk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
 /// [`Wavefront`], zeroed before the launch's first iteration; the film and counters as
 /// [`naive_sk`]; blocks of `BLOCK_SIZE` threads.
 #[inline(always)]
-unsafe fn wavefront<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, regeneration: Regeneration) {
+pub unsafe fn multi_kernel<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     let state = lp.wavefront as *mut Wavefront;
     let slot_at = |queue: u32, i: u64| -> *mut Slot {
         let index = queue as u64 * lp.capacity as u64 + i;
         (lp.queues + index * SLOT_BYTES as u64) as *mut Slot
     };
-    let film = lp.film as *mut f64;
-    let totals = lp.counters as *mut u64;
-    let mut counters = ThreadCounters::default();
+    // SAFETY: the caller's contract.
+    let mut pool = unsafe { PathPool::new(scene, lp) };
     let (parity, regenerate) = match Stage::from_code(lp.stage) {
-        Stage::Plan { parity } => {
+        Stage::Plan {
+            parity,
+            regeneration,
+        } => {
             if global_thread_index() == 0 {
                 // SAFETY: one `Wavefront` (the caller's contract), and this the only thread.
                 let state = unsafe { &mut *state };
@@ -701,7 +902,6 @@ unsafe fn wavefront<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, regeneration: 
     let output = 1 - parity;
     // SAFETY: as above; the survivors' count of the output queue.
     let output_count = unsafe { &raw mut (*state).count[output as usize] };
-    let pixels = lp.tile.pixels();
     // The warp's lanes take consecutive items; `base` is the same in every lane of the warp, so
     // the loop and the append's vote stay warp-uniform.
     let stride = grid_threads() as u64;
@@ -711,7 +911,7 @@ unsafe fn wavefront<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, regeneration: 
         let mut survivor = None;
         if i < work {
             let mut slot = if regenerate {
-                start_path(scene, lp, pixels, batch_first + i)
+                pool.start(batch_first + i)
             } else {
                 // SAFETY: `i` is below the queue's count, at most its capacity.
                 unsafe { slot_at(parity, i).read() }
@@ -720,8 +920,8 @@ unsafe fn wavefront<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, regeneration: 
             if slot.path.alive {
                 survivor = Some(slot);
             } else {
-                // SAFETY: `pixel` is inside the film.
-                unsafe { finish_path(&slot.path, slot.pixel, film, &mut counters, totals) };
+                // SAFETY: the path was started by this launch.
+                unsafe { pool.record(&slot.path, slot.pixel) };
             }
         }
         let survives = opaque(survivor.is_some());
@@ -734,6 +934,5 @@ unsafe fn wavefront<S: Scene, P>(scene: &S, lp: &LaunchParams<P>, regeneration: 
         }
         base += stride;
     }
-    // SAFETY: `lp.counters` holds `COUNTERS` totals.
-    unsafe { counters.flush(lp) };
+    pool.flush();
 }
