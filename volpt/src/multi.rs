@@ -157,9 +157,11 @@ pub(crate) fn render_shared(
     // caller, and written once, since a new allocation's pages are mapped by the first write to
     // each (for 800x800 on the device machine that cost 25 ms, more than reading a film back).
     // Films added to the render's film are zeroed by the thread that added them and come back
-    // here; a batch finds one unless more than these are pending.
+    // here; a batch finds one unless more than these are pending. Two per device, as many as
+    // fit in 1 GiB if fewer (at least one): the others are made when a batch needs them.
+    let premade = (2 * u64::from(n)).min(((1 << 30) / (pixels * 24).max(1)).max(1));
     let spare: Mutex<Vec<Film>> = Mutex::new(std::thread::scope(|threads| {
-        let makers: Vec<_> = (0..queue.window.min(2 * u64::from(n)))
+        let makers: Vec<_> = (0..premade)
             .map(|_| {
                 threads.spawn(|| {
                     let mut film = Film::new(width, height).with_accumulation(film.accumulation);
