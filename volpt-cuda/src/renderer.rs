@@ -268,15 +268,31 @@ impl CudaRenderer {
     /// # Safety
     /// As [`CudaRenderer::render_samples_keeping`].
     pub unsafe fn keep_grids<S: SceneAbi>(&self, scene: &S, grids: u64) -> Result<(), CudaError> {
-        // SAFETY: the grids are `scene`'s, borrowed for this whole call; `volumes` is dropped
-        // (synchronising) before it returns, and what it keeps falls under the caller's contract.
-        let mut volumes = unsafe {
-            VolumePlacer::new(self.stream.clone(), self.volumes)?
-                .keeping(self.resident.clone(), grids)
-        };
-        let _ = scene.to_params(&mut volumes);
+        // SAFETY: the caller's contract; what is not kept is freed (synchronising) on return.
+        unsafe { self.place(scene, Some(grids)) }.map(drop)
+    }
+
+    /// `scene`'s launch parameters: its grids where the volume policy puts them (taken from and
+    /// left in the kept grids of the scene numbered `keep`, if any), everything else by value.
+    /// The parameters are valid while the placer lives.
+    ///
+    /// # Safety
+    /// With `keep`, as [`CudaRenderer::render_samples_keeping`].
+    unsafe fn place<S: SceneAbi>(
+        &self,
+        scene: &S,
+        keep: Option<u64>,
+    ) -> Result<(VolumePlacer, S::Params), CudaError> {
+        // SAFETY: the grids are `scene`'s, borrowed by the caller for as long as it holds the
+        // placer.
+        let mut volumes = unsafe { VolumePlacer::new(self.stream.clone(), self.volumes) }?;
+        if let Some(grids) = keep {
+            // SAFETY: the caller's contract.
+            volumes = unsafe { volumes.keeping(self.resident.clone(), grids) };
+        }
+        let params = scene.to_params(&mut volumes);
         volumes.check()?;
-        Ok(())
+        Ok((volumes, params))
     }
 
     pub(crate) fn stream(&self) -> &Arc<CudaStream> {
@@ -379,16 +395,9 @@ impl CudaRenderer {
         let kernel = self.kernel(&name, schedule.max_registers)?;
         let stream = &self.stream;
 
-        // The scene: grids where the volume policy puts them, everything else by value.
         // SAFETY: the grids are `scene`'s, borrowed for this whole call; `volumes` is dropped
-        // before it returns.
-        let mut volumes = unsafe { VolumePlacer::new(stream.clone(), self.volumes) }?;
-        if let Some(grids) = keep {
-            // SAFETY: `render_samples_keeping`'s contract.
-            volumes = unsafe { volumes.keeping(self.resident.clone(), grids) };
-        }
-        let scene_params = scene.to_params(&mut volumes);
-        volumes.check()?;
+        // before it returns; with `keep`, `render_samples_keeping`'s contract.
+        let (volumes, scene_params) = unsafe { self.place(scene, keep) }?;
 
         let pixels = width as u64 * height as u64;
         let reused = self
