@@ -24,7 +24,7 @@ use std::sync::{mpsc, Condvar, Mutex};
 use std::time::Instant;
 
 use volpt_core::PathCounters;
-use volpt_film::{Film, RenderStats};
+use volpt_film::{Accumulation, Film, RenderStats};
 
 use crate::{Error, Observer};
 
@@ -55,7 +55,24 @@ fn batch_size(remaining: u32, devices: u32) -> u32 {
 /// How many batches may be handed out past the oldest one not yet added to the film: two per
 /// device and two more, or as many films as fit in 1 GiB, whichever is more.
 fn window(devices: u32, film_bytes: u64) -> u64 {
-    (2 * u64::from(devices) + 2).max((1 << 30) / film_bytes.max(1))
+    (2 * u64::from(devices) + 2).max(films_in_a_gib(film_bytes))
+}
+
+/// How many films of `film_bytes` fit in 1 GiB, the memory batch films may take before a bound
+/// of their count applies.
+fn films_in_a_gib(film_bytes: u64) -> u64 {
+    (1 << 30) / film_bytes.max(1)
+}
+
+/// A zeroed film for a batch, written once: a new allocation's pages are mapped by the first
+/// write to each, which on the device machine cost 25 ms for 800x800, more than reading a film
+/// back into memory written before.
+fn batch_film(width: u32, height: u32, accumulation: Accumulation) -> Film {
+    let mut film = Film::new(width, height).with_accumulation(accumulation);
+    // Opaque to the optimiser, which knows that a new film's memory is zeroed and would drop the
+    // writes.
+    std::hint::black_box(film.flat_sums_mut()).fill(0.0);
+    film
 }
 
 /// The shared queue of batches.
@@ -140,6 +157,7 @@ pub(crate) fn render_shared(
     let (width, height) = (film.width, film.height);
     let pixels = u64::from(width) * u64::from(height);
     let total = pixels * u64::from(samples.end - samples.start);
+    let film_bytes = pixels * size_of::<[f64; 3]>() as u64;
     let queue = Queue {
         state: Mutex::new(QueueState {
             next: samples.start,
@@ -151,26 +169,18 @@ pub(crate) fn render_shared(
         advanced: Condvar::new(),
         devices: n,
         smallest: smallest(samples.end - samples.start, n),
-        window: window(n, pixels * 24),
+        window: window(n, film_bytes),
     };
     // Films for batches: made before the clock, as one device's render gets its film from the
-    // caller, and written once, since a new allocation's pages are mapped by the first write to
-    // each (for 800x800 on the device machine that cost 25 ms, more than reading a film back).
-    // Films added to the render's film are zeroed by the thread that added them and come back
-    // here; a batch finds one unless more than these are pending. Two per device, as many as
-    // fit in 1 GiB if fewer (at least one): the others are made when a batch needs them.
-    let premade = (2 * u64::from(n)).min(((1 << 30) / (pixels * 24).max(1)).max(1));
+    // caller ([`batch_film`]). Films added to the render's film are zeroed by the thread that
+    // added them and come back here; a batch finds one unless more than these are pending. Two
+    // per device, as many as fit in 1 GiB if fewer (at least one): the others are made when a
+    // batch needs them.
+    let accumulation = film.accumulation;
+    let premade = (2 * u64::from(n)).min(films_in_a_gib(film_bytes).max(1));
     let spare: Mutex<Vec<Film>> = Mutex::new(std::thread::scope(|threads| {
         let makers: Vec<_> = (0..premade)
-            .map(|_| {
-                threads.spawn(|| {
-                    let mut film = Film::new(width, height).with_accumulation(film.accumulation);
-                    // Opaque to the optimiser, which knows that a new film's memory is zeroed
-                    // and would drop the writes.
-                    std::hint::black_box(film.flat_sums_mut()).fill(0.0);
-                    film
-                })
-            })
+            .map(|_| threads.spawn(|| batch_film(width, height, accumulation)))
             .collect();
         makers
             .into_iter()
@@ -202,7 +212,6 @@ pub(crate) fn render_shared(
             let send = send.clone();
             let (queue, finished, in_flight, report, spare) =
                 (&queue, &finished, &in_flight, &report, &spare);
-            let accumulation = film.accumulation;
             scope.spawn(move || {
                 let mut cap = observer.check_every().map(|_| 1u32);
                 let mut first = true;
@@ -223,9 +232,8 @@ pub(crate) fn render_shared(
                         report();
                     };
                     let reused = spare.lock().unwrap_or_else(|e| e.into_inner()).pop();
-                    let mut batch_film = reused.unwrap_or_else(|| {
-                        Film::new(width, height).with_accumulation(accumulation)
-                    });
+                    let mut batch_film =
+                        reused.unwrap_or_else(|| batch_film(width, height, accumulation));
                     let batch_started = Instant::now();
                     match device(&mut batch_film, batch.clone(), &progress) {
                         Ok(stats) => {
