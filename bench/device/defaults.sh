@@ -14,7 +14,7 @@
 # 4. accuracy against time: `volpt converge --setting lookup=trilinear,stochastic,texture`, fast
 #    math, TIME seconds per setting against a REFSPP reference;
 # 5. start-up: a 16x16, 1-spp render's process time, warm (kernel in the driver's JIT cache),
-#    and its parts from `RUST_LOG=volpt_cuda=debug` (context, kernel cut, JIT/module load).
+#    and its parts, each printed line stamped (startup.py).
 # 6. the defaults as shipped: the summary line of a render without flags, `--math exact` alone
 #    against the CPU (bit for bit, naive-sk), and `volpt bench` without flags, with `--strategy
 #    auto` and with fixed strategies (all with the default math and lookup).
@@ -166,21 +166,10 @@ PY
     }
     part 5 && {
     echo "## 5. start-up (scenes/example/cube.xml, 16x16, 1 spp, --backend cuda, no other flag)"
-    tiny=(scenes/example/cube.xml --resolution 16x16 --spp 1 --backend cuda -o "$WORK/tiny.exr")
-    "$VOLPT" render "${tiny[@]}" >/dev/null 2>&1 # fills the driver's JIT cache
-    for i in 1 2 3 4 5; do
-        s=$(date +%s.%N)
-        "$VOLPT" render "${tiny[@]}" >/dev/null 2>&1
-        e=$(date +%s.%N)
-        echo "warm run $i: $(python3 -c "print(f'{$e - $s:.3f}')") s"
-    done
-    echo "-- the parts (RUST_LOG=volpt_cuda=debug,volpt=debug; timestamps are UTC):"
-    s=$(date -u +%H:%M:%S.%N)
-    RUST_LOG=volpt_cuda=debug,volpt=debug "$VOLPT" render "${tiny[@]}" 2>&1 | sed -E 's/\x1b\[[0-9;]*m//g' | cut -c1-220
-    echo "started $s, ended $(date -u +%H:%M:%S.%N)"
+    OUT=$WORK python3 startup.py "$VOLPT" 5
     s=$(date +%s.%N); "$VOLPT" --version >/dev/null 2>&1; e=$(date +%s.%N)
     echo "volpt --version: $(python3 -c "print(f'{$e - $s:.3f}')") s"
-    s=$(date +%s.%N); "$VOLPT" render "${tiny[@]:0:5}" -o "$WORK/tiny-cpu.exr" >/dev/null 2>&1; e=$(date +%s.%N)
+    s=$(date +%s.%N); "$VOLPT" render scenes/example/cube.xml --resolution 16x16 --spp 1 -o "$WORK/tiny-cpu.exr" >/dev/null 2>&1; e=$(date +%s.%N)
     echo "the same render on the CPU: $(python3 -c "print(f'{$e - $s:.3f}')") s"
     }
     part 6 && {

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""Where a small GPU render's process time goes: runs `volpt render` on a tiny scene several times
-and stamps every line it prints (stdout and stderr, with RUST_LOG=volpt=debug,volpt_cuda=debug) with
-the time since the process started, and the process's exit.
+"""Where a small GPU render's process time goes: runs `volpt render` on a tiny scene once untimed
+(the driver's JIT cache then holds its kernel), then several times, and stamps every line the last
+run prints (stdout and stderr, with RUST_LOG=volpt=debug,volpt_cuda=debug) with the time since the
+process started, and the process's exit.
 
     python3 startup.py bin/volpt [RUNS]      # from a device bundle: scenes/example/cube.xml
 """
@@ -16,6 +17,7 @@ out = os.environ.get("OUT", "/tmp")
 args = [volpt, "render", "scenes/example/cube.xml", "--resolution", "16x16", "--spp", "1",
         "--backend", "cuda", "-o", os.path.join(out, "tiny.exr")]
 env = dict(os.environ, RUST_LOG="volpt=debug,volpt_cuda=debug,volpt_scene=debug", NO_COLOR="1")
+subprocess.run(args, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 totals = []
 for run in range(runs):
     start = time.perf_counter()
