@@ -16,6 +16,8 @@ import collections
 import re
 import sys
 
+from ptx_cut import entries
+
 
 def kernels(path):
     text = open(path).read()
@@ -27,20 +29,7 @@ def kernels(path):
                         (r"(switch_\$_table_\$_\w+?)\d+\b", r"\1")]:
         text = re.sub(pattern, by, text)
     lines = text.split("\n")
-    out, i = {}, 0
-    while i < len(lines):
-        m = re.search(r"\.entry (\w+)", lines[i])
-        if not m:
-            i += 1
-            continue
-        j = i
-        while lines[j] != "{":
-            j += 1
-        while lines[j] != "}":
-            j += 1
-        out[m.group(1)] = lines[i:j + 1]
-        i = j + 1
-    return out
+    return {name: lines[first:end + 1] for name, first, end in entries(lines)}
 
 
 def stats(body):
