@@ -91,6 +91,19 @@ impl Film {
         self.sums.as_flattened_mut()
     }
 
+    /// Adds `other`'s sums to this film's, pixel by pixel (a film of other samples of the same
+    /// image: the sum of both).
+    pub fn add(&mut self, other: &Film) {
+        assert_eq!(
+            (self.width, self.height),
+            (other.width, other.height),
+            "films of one image"
+        );
+        for (sum, add) in self.flat_sums_mut().iter_mut().zip(other.flat_sums()) {
+            *sum += add;
+        }
+    }
+
     /// The same film, adding samples in `accumulation`.
     pub fn with_accumulation(self, accumulation: Accumulation) -> Self {
         Self {

@@ -181,11 +181,7 @@ pub fn merge_films(
     let mut films = films.into_iter().map(|(_, f)| f);
     let mut merged = films.next().expect("checked: at least one film");
     for film in films {
-        for (sum, add) in merged.film.sums.iter_mut().zip(&film.film.sums) {
-            for c in 0..3 {
-                sum[c] += add[c];
-            }
-        }
+        merged.film.add(&film.film);
     }
     merged.ranges = ranges;
     Ok(Merged {

@@ -296,11 +296,7 @@ pub(crate) fn render_shared(
                     let before = next_index;
                     while let Some((batch, mut batch_film)) = pending.remove(&next_index) {
                         debug_assert_eq!(batch.start, done, "batches are numbered in sample order");
-                        for (sum, add) in
-                            film.flat_sums_mut().iter_mut().zip(batch_film.flat_sums())
-                        {
-                            *sum += add;
-                        }
+                        film.add(&batch_film);
                         done = batch.end;
                         next_index += 1;
                         batch_film.flat_sums_mut().fill(0.0);
