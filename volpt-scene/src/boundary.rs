@@ -39,6 +39,9 @@ pub enum BsdfDesc {
 /// any alpha above a few is already as rough as a surface gets.
 pub const MAX_ALPHA: f32 = 1e4;
 
+/// The Mitsuba BSDF plugins volpt reads, in words.
+pub(crate) const MITSUBA_KINDS: &str = "null, dielectric or roughdielectric";
+
 /// Mitsuba's defaults: BK7 glass inside, air outside.
 const DEFAULT_INT_IOR: &str = "bk7";
 const DEFAULT_EXT_IOR: &str = "air";
@@ -68,9 +71,7 @@ impl BsdfDesc {
                 }
             }
             _ => {
-                return Err(p.unsupported(
-                    "volpt's boundary bsdf must be null, dielectric or roughdielectric",
-                ))
+                return Err(p.unsupported(format!("volpt's boundary bsdf must be {MITSUBA_KINDS}")))
             }
         };
         p.finish()?;

@@ -9,6 +9,7 @@ use super::obj::obj_vertices;
 use super::plugin::{invalid, Ctx, Plugin};
 use super::transform::{apply_point, transform, IDENTITY_F64};
 use super::xml::Element;
+use crate::boundary::MITSUBA_KINDS;
 use crate::description::{BoundaryDesc, BsdfDesc, MediumDesc};
 use crate::error::SceneError;
 
@@ -107,8 +108,10 @@ pub(crate) fn boundary(
         p.finish()?;
         return Err(super::plugin::missing(
             el,
-            "a <bsdf>: volpt needs the boundary's surface to be null, dielectric or \
-             roughdielectric (Mitsuba would make it diffuse)",
+            &format!(
+                "a <bsdf>: volpt needs the boundary's surface to be {MITSUBA_KINDS} (Mitsuba \
+                 would make it diffuse)"
+            ),
         ));
     };
     let surface = BsdfDesc::from_mitsuba(surface.target, ctx)?;
