@@ -174,6 +174,15 @@ impl EnvironmentDesc {
         })
     }
 
+    /// The values the description's serialisation leaves out (a map's texels), which what
+    /// fingerprints a scene hashes on their own (the facade's `fingerprint::content`).
+    pub fn unserialised_values(&self) -> &[f32] {
+        match self {
+            EnvironmentDesc::Constant(_) => &[],
+            EnvironmentDesc::LatLong(map) => &map.rgb,
+        }
+    }
+
     /// One description of each kind; together they select every registry environment part
     /// (tests cover the registry with them).
     pub fn examples() -> Vec<Self> {
