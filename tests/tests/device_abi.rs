@@ -31,7 +31,8 @@ fn grid(channels: u32, bounds: Bounds, convention: GridConvention) -> GridDesc {
     }
 }
 
-/// A description of every combination of the axes the factory reads.
+/// A description of every combination of the axes the factory reads: the media below, and every
+/// example of the other axes.
 fn descriptions() -> Vec<SceneDescription> {
     // Grids a little inside and outside the box, so that the grid's own mapping matters.
     let grid_bounds = Bounds {
@@ -80,43 +81,15 @@ fn descriptions() -> Vec<SceneDescription> {
             GridLookup::Stochastic,
         ),
     ];
-    let boundaries = [
-        BsdfDesc::Null,
-        BsdfDesc::Dielectric {
-            int_ior: 1.33,
-            ext_ior: 1.0,
-        },
-        BsdfDesc::RoughDielectric {
-            alpha: 0.3,
-            int_ior: 1.5,
-            ext_ior: 1.1,
-        },
-    ];
-    let phases = [PhaseDesc::Isotropic, PhaseDesc::HenyeyGreenstein { g: 0.6 }];
-    let (w, h) = (8, 4);
-    let rgb = (0..3 * w * h)
-        .map(|i| 0.1 + (i % 11) as f32 * 0.2)
-        .collect();
-    let environments = [
-        EnvironmentDesc::Constant([1.0, 0.8, 0.6]),
-        EnvironmentDesc::LatLong(LatLongDesc {
-            width: w,
-            height: h,
-            rgb,
-            to_world: [
-                [0.0, 0.0, 1.0, 0.0],
-                [0.0, 1.0, 0.0, 0.0],
-                [-1.0, 0.0, 0.0, 0.0],
-                [0.0, 0.0, 0.0, 1.0],
-            ],
-            scale: 1.5,
-            rows: LatLongRows::PoleToPole,
-        }),
-    ];
+    // The other axes' examples, from their files in volpt-scene: a new kind's example there is
+    // covered here.
+    let boundaries = BsdfDesc::examples();
+    let phases = PhaseDesc::examples();
+    let environments = EnvironmentDesc::examples();
     let mut descs = Vec::new();
     for (density, albedo, lookup) in &media {
-        for bsdf in boundaries {
-            for phase in phases {
+        for &bsdf in &boundaries {
+            for &phase in &phases {
                 for environment in &environments {
                     let medium = MediumDesc {
                         density: density.clone(),

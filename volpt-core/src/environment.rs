@@ -27,6 +27,28 @@ pub trait Environment {
     fn pdf(&self, dir: Vec3) -> f32;
 }
 
+/// What next-event estimation asks of an environment on the host: the distribution it samples
+/// directions from, computed once per scene by the host and borrowed for `'a` (a map's). The
+/// defaults fit an environment that samples without one (a constant). The device never calls
+/// these: it receives the distribution through the part's parameters ([`Component`]).
+pub trait SampledEnvironment<'a> {
+    /// How many values the distribution has; 0 where the environment samples without one.
+    fn distribution_size(&self) -> usize {
+        0
+    }
+
+    /// Writes the distribution into `out` ([`SampledEnvironment::distribution_size`] values).
+    fn write_distribution(&self, out: &mut [f32]) {
+        let _ = out;
+    }
+
+    /// Samples from `distribution` (what [`SampledEnvironment::write_distribution`] wrote) from
+    /// now on.
+    fn sample_from(&mut self, distribution: &'a [f32]) {
+        let _ = distribution;
+    }
+}
+
 #[derive(Clone, Copy, Debug)]
 pub struct ConstantEnvironment(pub Spectrum);
 
@@ -50,6 +72,8 @@ impl Environment for ConstantEnvironment {
         INV_4PI
     }
 }
+
+impl SampledEnvironment<'_> for ConstantEnvironment {}
 
 /// Where the rows of a latitude-longitude map sit between the poles. Columns are the same in every
 /// Mitsuba generation (pixel centres at `u = (i + 0.5) / width`, wrapping around); rows are not.
@@ -270,6 +294,20 @@ impl Environment for LatLongEnvironment<'_> {
         let j = ((v * h as f32) as usize).min(h - 1);
         let f = rows[j * (w + 1) + i + 1] - rows[j * (w + 1) + i];
         self.density(f, marginal[h], sin_cos_2pi(0.5 * v).0)
+    }
+}
+
+impl<'a> SampledEnvironment<'a> for LatLongEnvironment<'a> {
+    fn distribution_size(&self) -> usize {
+        Self::distribution_len(self.width, self.height)
+    }
+
+    fn write_distribution(&self, out: &mut [f32]) {
+        self.fill_distribution(out);
+    }
+
+    fn sample_from(&mut self, distribution: &'a [f32]) {
+        self.distribution = distribution;
     }
 }
 

@@ -31,7 +31,9 @@ pub mod variant;
 pub use abi::{Component, SceneAbi};
 pub use bsdf::{Bsdf, BsdfSample, NullBoundary, RoughDielectric, SmoothDielectric};
 pub use camera::PerspectiveCamera;
-pub use environment::{ConstantEnvironment, Environment, LatLongEnvironment, LatLongRows};
+pub use environment::{
+    ConstantEnvironment, Environment, LatLongEnvironment, LatLongRows, SampledEnvironment,
+};
 pub use geometry::{Aabb, Ray};
 pub use grid::{
     sparse_table_len, AnyLayout, DenseTrilinear, Grid, GridLayout, GridLookup, GridMapping,

@@ -2,9 +2,15 @@
 //!
 //! Nothing here knows about a file format or about a backend. Units are Mitsuba's: world space is
 //! whatever the scene file says, extinction coefficients are per world unit, colours are linear RGB.
-//! Every type serialises (serde), so that a render's fingerprint can take in all of it.
+//! Every type serialises (serde), so that a render's fingerprint can take in all of it. The
+//! phase, the boundary's surface and the environment are described in their axes' files
+//! ([`crate::phase`], [`crate::boundary`], [`crate::environment`]) and named here.
 
 use serde::Serialize;
+
+pub use crate::boundary::BsdfDesc;
+pub use crate::environment::{EnvironmentDesc, LatLongDesc, LatLongRows};
+pub use crate::phase::PhaseDesc;
 
 /// An axis-aligned box in world space.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -81,20 +87,6 @@ pub struct BoundaryDesc {
     pub bsdf: BsdfDesc,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub enum BsdfDesc {
-    /// Index-matched boundary: light crosses it unchanged.
-    Null,
-    /// Smooth dielectric interface.
-    Dielectric { int_ior: f32, ext_ior: f32 },
-    /// GGX (Trowbridge-Reitz) rough dielectric interface with isotropic roughness `alpha`.
-    RoughDielectric {
-        alpha: f32,
-        int_ior: f32,
-        ext_ior: f32,
-    },
-}
-
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct MediumDesc {
     /// Density; the extinction coefficient is `scale * density`.
@@ -151,12 +143,6 @@ pub enum AlbedoDesc {
     Grid(GridDesc),
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub enum PhaseDesc {
-    Isotropic,
-    HenyeyGreenstein { g: f32 },
-}
-
 /// Where the grid's samples sit inside its bounding box.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub enum GridConvention {
@@ -197,41 +183,4 @@ impl GridDesc {
     pub fn max_value(&self) -> f32 {
         self.samples().iter().copied().fold(0.0, f32::max)
     }
-}
-
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub enum EnvironmentDesc {
-    /// Constant radiance from every direction.
-    Constant([f32; 3]),
-    /// A latitude-longitude environment map (Mitsuba's `envmap`).
-    LatLong(LatLongDesc),
-}
-
-/// A latitude-longitude environment map. The look direction `d`, taken to the map's frame by the
-/// inverse of `to_world`, is found at `u = atan2(d.x, -d.z) / 2 pi` (wrapping around) and
-/// `v = acos(d.y) / pi`: the top row is the +y pole and the centre column looks along -z.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct LatLongDesc {
-    pub width: u32,
-    pub height: u32,
-    /// Linear RGB radiance, `3 * width * height` values, row-major from the top-left pixel. Not
-    /// serialised, as a grid's values ([`GridDesc::data`]).
-    #[serde(skip)]
-    pub rgb: Vec<f32>,
-    /// Map-to-world transform; its linear part is a rotation (possibly a mirroring), and its
-    /// translation does not matter for light from infinitely far away.
-    pub to_world: Matrix4,
-    /// Multiplies every texel.
-    pub scale: f32,
-    pub rows: LatLongRows,
-}
-
-/// Where a latitude-longitude map's rows sit between the poles; columns sit at
-/// `u = (i + 0.5) / width` in every Mitsuba generation.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-pub enum LatLongRows {
-    /// Mitsuba 0.5/0.6: row `j` at `v = (j + 0.5) / height`.
-    CellCentred,
-    /// Mitsuba 3: row `j` at `v = j / (height - 1)`, the first and last rows on the poles.
-    PoleToPole,
 }

@@ -1,6 +1,12 @@
 //! volpt's scenes: the plain-data description a renderer consumes, and the loaders that build it.
 //!
 //! - [`description`]: the scene as plain data ([`SceneDescription`]).
+//! - [`phase`], [`boundary`], [`environment`]: one axis of the scene each, everything about its
+//!   descriptions: what they say, how each format spells them, their checks, their export, how
+//!   `volpt info` prints them, and how each registry part of the axis is built from them.
+//! - [`from_description`]: the rule from a description to a registry part ([`FromDescription`]),
+//!   and [`simplification`]: where a part is simpler than the description names.
+//! - [`param`]: the numbers of a description a scene takes between renders.
 //! - [`builder`]: [`SceneBuilder`]s (one per source) and the [`SceneAssembler`] that applies the
 //!   command line's [`Config`] to what they build.
 //! - [`toml_scene`]: volpt's own TOML scene files: one grid file, a transfer function, defaults.
@@ -20,10 +26,13 @@
 //! - [`normalise`]: rescaling a grid's values onto `[0, target]` (raw counts to densities).
 //! - [`numerics`]: whether `f32` positions resolve a scene's free flights (checked on assembly).
 
+pub mod boundary;
 pub mod builder;
 mod contain;
 pub mod description;
+pub mod environment;
 pub mod error;
+pub mod from_description;
 pub mod generate;
 pub mod limits;
 pub mod metaimage;
@@ -31,7 +40,10 @@ pub mod mitsuba;
 pub mod normalise;
 pub mod numerics;
 mod output;
+pub mod param;
+pub mod phase;
 pub mod raw;
+pub mod simplification;
 pub mod sparse;
 pub mod toml_scene;
 pub mod transfer;
@@ -42,12 +54,16 @@ pub mod vtk;
 
 use std::path::Path;
 
+pub use boundary::BoundaryInput;
 pub use builder::{builder_for, Config, SceneAssembler, SceneBuilder};
 pub use description::*;
 pub use error::{GridProblem, SceneError, VolProblem};
+pub use from_description::FromDescription;
 pub use metaimage::{read_metaimage, write_metaimage, MetaImageOptions};
 pub use normalise::normalise;
+pub use param::NumberParam;
 pub use raw::{read_raw, read_raw_into, write_raw, ByteOrder, RawLayout, ScalarType};
+pub use simplification::Simplification;
 pub use transfer::TransferFunction;
 pub use vdb::{read_vdb, Sparsity, VdbOptions};
 pub use vol::{read_vol, write_vol, VolGrid};

@@ -13,9 +13,12 @@ use serde::Deserialize;
 
 use crate::description::*;
 use crate::error::SceneError;
-use crate::mitsuba::ior::named_ior;
 use crate::raw::{read_raw, ByteOrder, RawLayout, ScalarType};
 use crate::{normalise, read_metaimage, read_vol, read_vtk, TransferFunction};
+
+pub use crate::boundary::{BoundarySpec, BsdfKind, Ior};
+pub use crate::environment::EnvironmentSpec;
+pub use crate::phase::PhaseSpec;
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -87,17 +90,6 @@ pub enum VolumeFormat {
     Vdb,
 }
 
-/// The boundary's surface (`boundary.bsdf`), named as Mitsuba's plugins.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum BsdfKind {
-    Null,
-    Dielectric,
-    /// The thesis's boundary, the default.
-    #[default]
-    RoughDielectric,
-}
-
 /// The image axis the field of view spans (`camera.fov_axis`), as Mitsuba names it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -129,55 +121,12 @@ pub enum OneOrThree {
 }
 
 impl OneOrThree {
-    fn rgb(self) -> [f32; 3] {
+    pub(crate) fn rgb(self) -> [f32; 3] {
         match self {
             OneOrThree::One(v) => [v; 3],
             OneOrThree::Three(rgb) => rgb,
         }
     }
-}
-
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PhaseSpec {
-    /// Henyey-Greenstein asymmetry; absent means isotropic.
-    pub g: Option<f32>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct BoundarySpec {
-    /// `null` (index-matched), `dielectric` or `roughdielectric` (GGX).
-    #[serde(default)]
-    pub bsdf: BsdfKind,
-    #[serde(default = "thesis_alpha")]
-    pub alpha: f32,
-    /// A number or a Mitsuba IOR name (`water`, `air`, ...).
-    #[serde(default = "thesis_int_ior")]
-    pub int_ior: Ior,
-    #[serde(default = "thesis_ext_ior")]
-    pub ext_ior: Ior,
-    /// The boundary box; by default the volume's.
-    pub bounds: Option<[[f32; 3]; 2]>,
-}
-
-impl Default for BoundarySpec {
-    fn default() -> Self {
-        Self {
-            bsdf: BsdfKind::default(),
-            alpha: thesis_alpha(),
-            int_ior: thesis_int_ior(),
-            ext_ior: thesis_ext_ior(),
-            bounds: None,
-        }
-    }
-}
-
-#[derive(Clone, Debug, Deserialize)]
-#[serde(untagged)]
-pub enum Ior {
-    Value(f32),
-    Named(String),
 }
 
 #[derive(Debug, Deserialize)]
@@ -259,33 +208,8 @@ impl Default for IntegratorSpec {
     }
 }
 
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct EnvironmentSpec {
-    /// Constant radiance, grey or RGB.
-    #[serde(default = "unit_radiance")]
-    pub radiance: OneOrThree,
-}
-
-impl Default for EnvironmentSpec {
-    fn default() -> Self {
-        Self {
-            radiance: unit_radiance(),
-        }
-    }
-}
-
 fn one() -> f32 {
     1.0
-}
-fn thesis_alpha() -> f32 {
-    0.1
-}
-fn thesis_int_ior() -> Ior {
-    Ior::Value(1.05)
-}
-fn thesis_ext_ior() -> Ior {
-    Ior::Value(1.01)
 }
 fn thesis_origin() -> [f32; 3] {
     [0.0, 0.0, 100.0]
@@ -305,10 +229,6 @@ fn thesis_spp() -> u32 {
 fn unlimited() -> i64 {
     -1
 }
-fn unit_radiance() -> OneOrThree {
-    OneOrThree::One(1.0)
-}
-
 /// Reads and parses a TOML scene file (without loading the files it names).
 pub fn parse(path: &Path) -> Result<SceneFile, SceneError> {
     parse_with_text(path).map(|(file, _)| file)
@@ -350,7 +270,7 @@ fn field_at(text: &str, offset: usize) -> Option<String> {
 }
 
 /// The file being loaded, for error messages: value errors point at the line of their key.
-struct Cx<'a> {
+pub(crate) struct Cx<'a> {
     path: &'a Path,
     text: &'a str,
 }
@@ -375,7 +295,12 @@ impl Cx<'_> {
         in_table.map_or(start + 1, |i| start + 2 + i)
     }
 
-    fn invalid(&self, field: &str, expected: &str, found: impl std::fmt::Display) -> SceneError {
+    pub(crate) fn invalid(
+        &self,
+        field: &str,
+        expected: &str,
+        found: impl std::fmt::Display,
+    ) -> SceneError {
         SceneError::InvalidValue {
             path: self.path.to_owned(),
             line: self.line_of(field),
@@ -508,38 +433,10 @@ fn assemble(
             AlbedoDesc::Constant(rgb)
         }
     };
-    let phase = match file.phase.g {
-        None => PhaseDesc::Isotropic,
-        Some(g) if g > -1.0 && g < 1.0 => PhaseDesc::HenyeyGreenstein { g },
-        Some(g) => return Err(cx.invalid("phase.g", "a value in (-1, 1)", g)),
-    };
+    let phase = file.phase.phase(cx)?;
 
-    let b = &file.boundary;
-    let ior = |ior: &Ior, field: &str| match ior {
-        Ior::Value(v) if v.is_finite() && *v > 0.0 => Ok(*v),
-        Ior::Value(v) => Err(cx.invalid(field, "a positive index of refraction", v)),
-        Ior::Named(name) => {
-            named_ior(name).ok_or_else(|| cx.invalid(field, "a number or a Mitsuba IOR name", name))
-        }
-    };
-    let bsdf = match b.bsdf {
-        BsdfKind::Null => BsdfDesc::Null,
-        BsdfKind::Dielectric => BsdfDesc::Dielectric {
-            int_ior: ior(&b.int_ior, "boundary.int_ior")?,
-            ext_ior: ior(&b.ext_ior, "boundary.ext_ior")?,
-        },
-        BsdfKind::RoughDielectric => {
-            if !(b.alpha.is_finite() && b.alpha > 0.0) {
-                return Err(cx.invalid("boundary.alpha", "a positive roughness", b.alpha));
-            }
-            BsdfDesc::RoughDielectric {
-                alpha: b.alpha,
-                int_ior: ior(&b.int_ior, "boundary.int_ior")?,
-                ext_ior: ior(&b.ext_ior, "boundary.ext_ior")?,
-            }
-        }
-    };
-    let bounds = match b.bounds {
+    let bsdf = file.boundary.bsdf(cx)?;
+    let bounds = match file.boundary.bounds {
         Some(box_) => checked_box(cx, "boundary.bounds", box_)?,
         None => grid.bounds,
     };
@@ -577,15 +474,7 @@ fn assemble(
         d if d >= 0 && d <= u32::MAX as i64 => Ok(Some(d as u32)),
         d => Err(cx.invalid(field, "-1 (unlimited) or a depth >= 0", d)),
     };
-    // As the XML loader requires of a constant emitter's radiance.
-    let radiance = file.environment.radiance.rgb();
-    if !radiance.iter().all(|v| v.is_finite() && *v >= 0.0) {
-        return Err(cx.invalid(
-            "environment.radiance",
-            "a finite radiance >= 0 (one number or three)",
-            format!("{radiance:?}"),
-        ));
-    }
+    let environment = file.environment.environment(cx)?;
     Ok(SceneDescription {
         camera: CameraDesc {
             to_world,
@@ -610,7 +499,7 @@ fn assemble(
             lookup: Default::default(),
             storage: Default::default(),
         },
-        environment: EnvironmentDesc::Constant(radiance),
+        environment,
     })
 }
 

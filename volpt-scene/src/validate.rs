@@ -14,10 +14,7 @@ use crate::limits::{bytes_of, check_memory, MAX_OPTICAL_DEPTH};
 /// rounded up.
 pub const FILM_BYTES_PER_PIXEL: u64 = 40;
 
-/// The roughest GGX boundary volpt renders. Mitsuba sets no upper bound, and neither does GGX, but
-/// its terms hold `alpha^2` and `alpha^4` in f32: 1e4 keeps them finite with room to spare, and
-/// any alpha above a few is already as rough as a surface gets.
-pub const MAX_ALPHA: f32 = 1e4;
+pub use crate::boundary::MAX_ALPHA;
 
 /// What checking every value of a scene's data (its grids and environment map) found. The data
 /// does not change once a scene is assembled, so a scene whose camera, film or parameters change
@@ -53,12 +50,8 @@ fn check(
     source: &str,
     checked: Option<CheckedData>,
 ) -> Result<CheckedData, SceneError> {
-    let invalid = |field: &str, expected: &str, found: String| SceneError::InvalidScene {
-        source_name: source.to_owned(),
-        field: field.to_owned(),
-        expected: expected.to_owned(),
-        found,
-    };
+    let invalid =
+        |field: &str, expected: &str, found: String| invalid(source, field, expected, found);
     let path = std::path::Path::new(source);
 
     let FilmDesc { width, height } = desc.film;
@@ -97,32 +90,7 @@ fn check(
 
     let bounds = desc.boundary.bounds;
     check_bounds(bounds).map_err(|found| invalid("boundary box", BOX, found))?;
-    match desc.boundary.bsdf {
-        BsdfDesc::Null => {}
-        BsdfDesc::Dielectric { int_ior, ext_ior } => check_iors(int_ior, ext_ior, &invalid)?,
-        BsdfDesc::RoughDielectric {
-            alpha,
-            int_ior,
-            ext_ior,
-        } => {
-            check_iors(int_ior, ext_ior, &invalid)?;
-            if !(alpha > 0.0 && alpha <= MAX_ALPHA) {
-                return Err(invalid(
-                    "boundary alpha",
-                    &format!("a roughness in (0, {MAX_ALPHA:e}]"),
-                    alpha.to_string(),
-                ));
-            }
-            if alpha > 1.0 {
-                // Mitsuba accepts it too: GGX is defined for any alpha, the surface is just
-                // rougher than any real one.
-                tracing::warn!(
-                    "{source}: boundary alpha {alpha} is above 1, rougher than any real surface; \
-                     rendered as GGX with that alpha, as Mitsuba does"
-                );
-            }
-        }
-    }
+    desc.boundary.bsdf.check(source)?;
 
     let medium = &desc.medium;
     if !(medium.scale.is_finite() && medium.scale >= 0.0) {
@@ -180,11 +148,7 @@ fn check(
             format!("{:?}", medium.lookup),
         ));
     }
-    if let PhaseDesc::HenyeyGreenstein { g } = medium.phase {
-        if !(g > -1.0 && g < 1.0) {
-            return Err(invalid("phase g", "a number in (-1, 1)", g.to_string()));
-        }
-    }
+    medium.phase.check(source)?;
     // Delta tracking takes about majorant x distance tentative collisions per crossing.
     let majorant = f64::from(medium.scale) * f64::from(max_density);
     let diagonal = (0..3)
@@ -206,46 +170,21 @@ fn check(
         ));
     }
 
-    match &desc.environment {
-        EnvironmentDesc::Constant(rgb) => {
-            if !rgb.iter().all(|v| v.is_finite() && *v >= 0.0) {
-                return Err(invalid(
-                    "environment radiance",
-                    "three finite numbers >= 0",
-                    format!("{rgb:?}"),
-                ));
-            }
-        }
-        EnvironmentDesc::LatLong(map) => {
-            let texels = bytes_of(u64::from(map.width), u64::from(map.height));
-            if texels.and_then(|t| bytes_of(t, 3)) != Some(map.rgb.len() as u64) {
-                return Err(invalid(
-                    "environment map",
-                    "3 x width x height values",
-                    format!("{} for {} x {}", map.rgb.len(), map.width, map.height),
-                ));
-            }
-            let unchecked = if checked.is_none() { &map.rgb[..] } else { &[] };
-            if let Some(v) = unchecked.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
-                return Err(invalid(
-                    "environment map",
-                    "finite radiances >= 0",
-                    v.to_string(),
-                ));
-            }
-            if !(map.scale.is_finite() && map.scale >= 0.0 && finite_matrix(&map.to_world)) {
-                return Err(invalid(
-                    "environment map scale and to_world",
-                    "finite numbers, the scale >= 0",
-                    format!("scale {}, to_world {:?}", map.scale, map.to_world),
-                ));
-            }
-        }
-    }
+    desc.environment.check(source, checked.is_none())?;
     Ok(CheckedData {
         largest_density,
         largest_albedo,
     })
+}
+
+/// The error of a scene whose `field` is not what it must be; `source` names the scene.
+pub(crate) fn invalid(source: &str, field: &str, expected: &str, found: String) -> SceneError {
+    SceneError::InvalidScene {
+        source_name: source.to_owned(),
+        field: field.to_owned(),
+        expected: expected.to_owned(),
+        found,
+    }
 }
 
 /// What a box must be.
@@ -261,24 +200,8 @@ pub(crate) fn check_bounds(b: Bounds) -> Result<(), String> {
     }
 }
 
-fn finite_matrix(m: &Matrix4) -> bool {
+pub(crate) fn finite_matrix(m: &Matrix4) -> bool {
     m.iter().flatten().all(|v| v.is_finite())
-}
-
-fn check_iors(
-    int_ior: f32,
-    ext_ior: f32,
-    invalid: &impl Fn(&str, &str, String) -> SceneError,
-) -> Result<(), SceneError> {
-    if int_ior.is_finite() && ext_ior.is_finite() && int_ior > 0.0 && ext_ior > 0.0 {
-        Ok(())
-    } else {
-        Err(invalid(
-            "boundary int_ior and ext_ior",
-            "finite indices of refraction > 0",
-            format!("{int_ior} and {ext_ior}"),
-        ))
-    }
 }
 
 /// Checks a grid's shape, box and values (finite, in `[0, max]`); returns its largest value.

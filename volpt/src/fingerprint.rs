@@ -15,7 +15,7 @@ use serde::Serialize;
 use volpt_core::PathSettings;
 use volpt_film::checkpoint::Fnv;
 use volpt_render::Effects;
-use volpt_scene::{AlbedoDesc, DensityDesc, EnvironmentDesc, SceneDescription};
+use volpt_scene::{AlbedoDesc, DensityDesc, SceneDescription};
 
 /// The fingerprint of rendering `desc` with `settings` and `effects`; `content` is [`content`]`(desc)`.
 pub fn fingerprint(
@@ -61,10 +61,7 @@ pub fn content(desc: &SceneDescription) -> u64 {
             AlbedoDesc::Grid(g) => Some(&g.data[..]),
             AlbedoDesc::Constant(_) => None,
         },
-        match &desc.environment {
-            EnvironmentDesc::LatLong(map) => Some(&map.rgb[..]),
-            EnvironmentDesc::Constant(_) => None,
-        },
+        Some(desc.environment.unserialised_values()),
     ];
     let mut hash = Fnv::default();
     for values in data {

@@ -8,10 +8,7 @@ use volpt_render::factory::{
     default_majorants, tracking_cost, Derived, Effects, EnvironmentKind, MajorantChoice,
     MajorantRule, Parts,
 };
-use volpt_scene::{
-    AlbedoDesc, BsdfDesc, DensityDesc, EnvironmentDesc, GridDesc, GridLookup, PhaseDesc,
-    SampleLayout, SceneDescription,
-};
+use volpt_scene::{AlbedoDesc, DensityDesc, GridDesc, GridLookup, SampleLayout, SceneDescription};
 
 /// A scene described field by field, in `volpt info`'s order: `scene`, `variant`, `film`,
 /// `camera`, `integrator`, `bounds`, `boundary`, `density`, `majorant`, `tracking`, `estimator`,
@@ -95,18 +92,7 @@ pub fn describe(
         ),
     );
     field("bounds", format!("{:?} .. {:?}", b.min, b.max));
-    let boundary = match desc.boundary.bsdf {
-        BsdfDesc::Null => "index-matched (null)".to_owned(),
-        BsdfDesc::Dielectric { int_ior, ext_ior } => {
-            format!("smooth dielectric, int IOR {int_ior}, ext IOR {ext_ior}")
-        }
-        BsdfDesc::RoughDielectric {
-            alpha,
-            int_ior,
-            ext_ior,
-        } => format!("GGX rough dielectric, alpha {alpha}, int IOR {int_ior}, ext IOR {ext_ior}"),
-    };
-    field("boundary", boundary);
+    field("boundary", desc.boundary.bsdf.to_string());
     let grid = |g: &GridDesc| {
         let (lo, hi) = g
             .samples()
@@ -172,19 +158,8 @@ pub fn describe(
             crate::backend::DEFAULT_GPU_MATH
         ),
     );
-    let phase = match m.phase {
-        PhaseDesc::Isotropic => "isotropic".to_owned(),
-        PhaseDesc::HenyeyGreenstein { g } => format!("Henyey-Greenstein, g {g}"),
-    };
-    field("phase", phase);
-    let light = match &desc.environment {
-        EnvironmentDesc::Constant(rgb) => format!("constant environment, radiance {rgb:?}"),
-        EnvironmentDesc::LatLong(map) => format!(
-            "lat-long environment map {}x{}, scale {}, rows {:?}",
-            map.width, map.height, map.scale, map.rows
-        ),
-    };
-    field("light", light);
+    field("phase", m.phase.to_string());
+    field("light", desc.environment.to_string());
     Info { fields }
 }
 

@@ -13,8 +13,8 @@ use volpt_render::{Effects, Variant};
 use volpt_scene::toml_scene::look_at;
 use volpt_scene::validate::CheckedData;
 use volpt_scene::{
-    AlbedoDesc, DensityDesc, GridDesc, GridLookup, GridStorage, PhaseDesc, SampleLayout,
-    SceneAssembler, SceneBuilder, SceneDescription,
+    AlbedoDesc, DensityDesc, GridDesc, GridLookup, GridStorage, NumberParam, PhaseDesc,
+    SampleLayout, SceneAssembler, SceneBuilder, SceneDescription,
 };
 
 use crate::settings::RenderSettings;
@@ -99,8 +99,34 @@ pub enum ParamValue {
     Vec3([f32; 3]),
 }
 
-/// The parameters a scene takes between renders: key and what it is.
-pub const PARAMS: &[(&str, &str)] = &[
+/// The parameters a scene takes between renders: key and what it is. The scene's own, then the
+/// phase's ([`PhaseDesc::PARAMS`]).
+pub const PARAMS: &[(&str, &str)] = &with_numbers::<{ SCENE_PARAMS.len() + PhaseDesc::PARAMS.len() }>(
+    SCENE_PARAMS,
+    PhaseDesc::PARAMS,
+);
+
+/// `keys`, then the key and description of each of `numbers`, `N` in all.
+const fn with_numbers<const N: usize>(
+    keys: &[(&'static str, &'static str)],
+    numbers: &[NumberParam],
+) -> [(&'static str, &'static str); N] {
+    let mut all = [("", ""); N];
+    let mut i = 0;
+    while i < keys.len() {
+        all[i] = keys[i];
+        i += 1;
+    }
+    let mut j = 0;
+    while j < numbers.len() {
+        all[i + j] = (numbers[j].key, numbers[j].about);
+        j += 1;
+    }
+    all
+}
+
+/// The parameters the scene holds apart from its parts' descriptions.
+const SCENE_PARAMS: &[(&str, &str)] = &[
     ("spp", "samples per pixel, an integer of at least 1"),
     (
         "seed",
@@ -135,10 +161,6 @@ pub const PARAMS: &[(&str, &str)] = &[
     (
         "medium.albedo",
         "the constant single-scattering albedo, RGB in [0, 1] (not a grid's)",
-    ),
-    (
-        "phase.g",
-        "Henyey-Greenstein's mean cosine in (-1, 1); 0 is isotropic",
     ),
 ];
 
@@ -326,11 +348,10 @@ impl Scene {
                 AlbedoDesc::Constant(rgb) => ParamValue::Rgb(*rgb),
                 AlbedoDesc::Grid(_) => return Err(not_here(key, "a constant albedo", "a grid")),
             },
-            "phase.g" => ParamValue::Float(match d.medium.phase {
-                PhaseDesc::Isotropic => 0.0,
-                PhaseDesc::HenyeyGreenstein { g } => g,
-            }),
-            _ => return Err(unknown(key)),
+            _ => match d.medium.phase.param(key) {
+                Some(value) => ParamValue::Float(value),
+                None => return Err(unknown(key)),
+            },
         })
     }
 
@@ -424,13 +445,13 @@ impl Scene {
                 }
                 AlbedoDesc::Grid(_) => return Err(not_here(key, "a constant albedo", "a grid")),
             },
-            "phase.g" => {
-                let g = float(&|g| g > -1.0 && g < 1.0, "a number in (-1, 1)")?;
-                // g = 0 stays a Henyey-Greenstein phase: the factory picks the isotropic part for
-                // it, and `volpt info` says so.
-                d.medium.phase = PhaseDesc::HenyeyGreenstein { g };
+            _ => {
+                let Some(number) = PhaseDesc::PARAMS.iter().find(|p| p.key == key) else {
+                    return Err(unknown(key));
+                };
+                let value = float(&number.accepts, number.expected)?;
+                d.medium.phase.set_param(key, value);
             }
-            _ => return Err(unknown(key)),
         }
         Ok(())
     }

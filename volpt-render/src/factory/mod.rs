@@ -6,15 +6,15 @@
 //! constant or lat-long environment. The axes and their values are the variant registry's
 //! ([`volpt_core::variant`]): from it this module generates one enum per axis ([`MediumPart`], ...,
 //! holding the built part), the choice of each axis's part (the first in registry order whose
-//! [`Part`] rule represents the description) and the one exhaustive `match` that turns four built
-//! parts into a scene type. Nothing here names a part: a registry line and the part's [`Part`] rule
-//! are all a new part needs. A backend receives the scene through [`SceneVisitor`], so one generic
-//! function serves every variant.
+//! rule represents the description: [`Part`] for a medium, [`FromDescription`] in `volpt-scene`'s
+//! axis files for the other axes) and the one exhaustive `match` that turns four built parts into
+//! a scene type. Nothing here names a part: a registry line and the part's rule are all a new part
+//! needs. A backend receives the scene through [`SceneVisitor`], so one generic function serves
+//! every variant.
 //!
 //! - this file: the axis enums, the choice and the dispatch, [`Parts`] and what is derived from
 //!   them;
-//! - [`parts`]: each part's rule from the description to the part, by axis, with the
-//!   [`Simplification`] rules;
+//! - [`parts`]: each medium's rule from the description to the part;
 //! - [`cache`]: what the factory reads from a scene's grids, kept between builds of one scene
 //!   ([`FactoryCache`]);
 //! - [`camera`](camera()) and [`path_settings`]: the camera and integrator settings a file asks for;
@@ -31,10 +31,13 @@ pub use camera::camera;
 pub use majorant_choice::{
     default_majorants, tracking_cost, MajorantChoice, MajorantRule, TrackingCost,
 };
-pub use parts::{Part, ReadsRule, Simplification};
+pub use parts::{Part, ReadsRule};
 pub use settings::{default_estimator, path_settings};
+pub use volpt_scene::{FromDescription, Simplification};
 
-use parts::{aabb, BoundaryInput, MediumInput, SampledEnvironment, TrackedMedium};
+use parts::{aabb, MediumInput, TrackedMedium};
+use volpt_core::SampledEnvironment;
+use volpt_scene::BoundaryInput;
 
 use std::fmt;
 
@@ -47,17 +50,15 @@ use volpt_core::grid::{
 
 use volpt_core::majorant::MajorantGrid;
 use volpt_core::math::tan;
-use volpt_core::microfacet::Ggx;
 use volpt_core::path::Estimator;
 use volpt_core::{
-    Aabb, ConstantAlbedo, ConstantEnvironment, GridAlbedo, GridMedium, HenyeyGreenstein,
-    HomogeneousMedium, Isotropic, LatLongEnvironment, LatLongRows, NullBoundary, PathSettings,
-    PerspectiveCamera, RoughDielectric, Scene, SmoothDielectric, Spectrum, Vec2, Vec3, VolumeScene,
+    Aabb, ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium, PathSettings,
+    PerspectiveCamera, Scene, Spectrum, Vec2, Vec3, VolumeScene,
 };
 use volpt_scene::description::{
     AlbedoDesc, Bounds, BsdfDesc, CameraDesc, DensityDesc, EnvironmentDesc, FilmDesc, FovAxis,
-    GridConvention, GridDesc, GridLookup as GridLookupDesc, GridStorage, LatLongDesc, MediumDesc,
-    PhaseDesc, SampleLayout, SceneDescription,
+    GridConvention, GridDesc, GridLookup as GridLookupDesc, GridStorage, MediumDesc, PhaseDesc,
+    SampleLayout, SceneDescription,
 };
 
 /// What a backend can render: the CPU needs a [`Scene`] it can share between threads, a GPU backend
@@ -74,10 +75,10 @@ pub trait SceneVisitor {
 
 /// One axis: the enum of its built parts, the enum of its kinds (the part without its data), and
 /// the choice of its part for a description: the first part of the registry's order whose
-/// [`Part`] rule accepts. Axes whose parts borrow grids or maps from the description take its
-/// lifetime `'a`.
+/// `$rule` (a trait of [`Part`]'s shape) accepts. Axes whose parts borrow grids or maps from the
+/// description take its lifetime `'a`.
 macro_rules! axis {
-    ($(#[$doc:meta])* $part:ident $(<$lt:lifetime>)?, $kind:ident, $input:ty,
+    ($(#[$doc:meta])* $part:ident $(<$lt:lifetime>)?, $kind:ident, $input:ty, $rule:ident,
      [$(($camel:ident, $snake:ident, $ty:ty))*]) => {
         $(#[$doc])*
         pub enum $part $(<$lt>)? {
@@ -109,8 +110,8 @@ macro_rules! axis {
             ) -> Self {
                 $(
                     let part = match effects {
-                        Effects::Specialised => <$ty as Part<'a>>::specialised(input, fired),
-                        Effects::General => <$ty as Part<'a>>::general(input),
+                        Effects::Specialised => <$ty as $rule<'a>>::specialised(input, fired),
+                        Effects::General => <$ty as $rule<'a>>::general(input),
                     };
                     if let Some(part) = part {
                         return $part::$camel(part);
@@ -144,19 +145,20 @@ macro_rules! factory {
         ($P:ident, $p:ident, $pt:ty) ($E:ident, $e:ident, $et:ty)])*]) => {
         axis!(
             /// The medium: extinction and albedo.
-            MediumPart<'a>, MediumKind, MediumInput<'a>, [$(($Mv, $mv, $mvt))*]
+            MediumPart<'a>, MediumKind, MediumInput<'a>, Part, [$(($Mv, $mv, $mvt))*]
         );
         axis!(
             /// The boundary of the medium's box.
-            BoundaryPart, BoundaryKind, BoundaryInput, [$(($Bv, $bv, $bvt))*]
+            BoundaryPart, BoundaryKind, BoundaryInput, FromDescription, [$(($Bv, $bv, $bvt))*]
         );
         axis!(
             /// The phase function.
-            PhasePart, PhaseKind, PhaseDesc, $phases
+            PhasePart, PhaseKind, PhaseDesc, FromDescription, $phases
         );
         axis!(
             /// The light: the environment.
-            EnvironmentPart<'a>, EnvironmentKind, &'a EnvironmentDesc, [$(($Ev, $ev, $evt))*]
+            EnvironmentPart<'a>, EnvironmentKind, &'a EnvironmentDesc, FromDescription,
+            [$(($Ev, $ev, $evt))*]
         );
 
         impl<'a> TrackedMedium<'a> for MediumPart<'a> {
@@ -193,9 +195,15 @@ macro_rules! factory {
         }
 
         impl<'a> SampledEnvironment<'a> for EnvironmentPart<'a> {
-            fn distribution(&self) -> Option<Vec<f32>> {
+            fn distribution_size(&self) -> usize {
                 match self {
-                    $(EnvironmentPart::$Ev(e) => e.distribution(),)*
+                    $(EnvironmentPart::$Ev(e) => e.distribution_size(),)*
+                }
+            }
+
+            fn write_distribution(&self, out: &mut [f32]) {
+                match self {
+                    $(EnvironmentPart::$Ev(e) => e.write_distribution(out),)*
                 }
             }
 
@@ -396,7 +404,7 @@ impl Derived {
                 m.data.iter().any(|&v| v < global)
             });
         let distribution = match settings.estimator {
-            Estimator::NextEvent => parts.environment.distribution(),
+            Estimator::NextEvent => distribution(&parts.environment),
             Estimator::PathTracing => None,
         };
         Self {
@@ -410,6 +418,16 @@ impl Derived {
     pub fn majorant_resolution(&self) -> Option<[u32; 3]> {
         self.majorants.as_ref().map(|m| m.res)
     }
+}
+
+/// The distribution next-event estimation samples `environment` from, if it has one.
+fn distribution<'a>(environment: &impl SampledEnvironment<'a>) -> Option<Vec<f32>> {
+    let size = environment.distribution_size();
+    (size > 0).then(|| {
+        let mut values = vec![0.0; size];
+        environment.write_distribution(&mut values);
+        values
+    })
 }
 
 impl<'a> Parts<'a> {

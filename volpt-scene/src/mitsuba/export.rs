@@ -19,11 +19,10 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use crate::description::{
-    AlbedoDesc, Bounds, BsdfDesc, DensityDesc, EnvironmentDesc, FovAxis, GridConvention, GridDesc,
-    LatLongRows, Matrix4, PhaseDesc, SceneDescription,
+    AlbedoDesc, Bounds, DensityDesc, FovAxis, GridConvention, GridDesc, Matrix4, SceneDescription,
 };
 use crate::error::SceneError;
-use crate::output::{create_dir, write_rgb_exr};
+use crate::output::create_dir;
 use crate::vol::{write_vol, VolGrid};
 
 /// `rr_depth` for "no Russian roulette", which Mitsuba 3 cannot spell as -1.
@@ -96,59 +95,11 @@ pub fn write_mitsuba3(
         AlbedoDesc::Constant(rgb) => rgb_element("albedo", rgb),
         AlbedoDesc::Grid(g) => grid(g, "albedo", "albedo")?,
     };
-    let phase = match medium.phase {
-        PhaseDesc::Isotropic => "<phase type=\"isotropic\"/>".to_owned(),
-        PhaseDesc::HenyeyGreenstein { g } => {
-            format!("<phase type=\"hg\">\n                <float name=\"g\" value=\"{g}\"/>\n            </phase>")
-        }
-    };
-    let bsdf = match desc.boundary.bsdf {
-        BsdfDesc::Null => "<bsdf type=\"null\"/>".to_owned(),
-        BsdfDesc::Dielectric { int_ior, ext_ior } => format!(
-            "<bsdf type=\"dielectric\">\n            <float name=\"int_ior\" value=\"{int_ior}\"/>\n            \
-             <float name=\"ext_ior\" value=\"{ext_ior}\"/>\n        </bsdf>"
-        ),
-        BsdfDesc::RoughDielectric {
-            alpha,
-            int_ior,
-            ext_ior,
-        } => format!(
-            "<bsdf type=\"roughdielectric\">\n            <string name=\"distribution\" value=\"ggx\"/>\n            \
-             <float name=\"alpha\" value=\"{alpha}\"/>\n            <float name=\"int_ior\" value=\"{int_ior}\"/>\n            \
-             <float name=\"ext_ior\" value=\"{ext_ior}\"/>\n        </bsdf>"
-        ),
-    };
-    let emitter = match &desc.environment {
-        EnvironmentDesc::Constant(rgb) => format!(
-            "<emitter type=\"constant\">\n        {}\n    </emitter>",
-            rgb_element("radiance", rgb)
-        ),
-        EnvironmentDesc::LatLong(map) => {
-            if map.rows != LatLongRows::PoleToPole {
-                return Err(SceneError::Export {
-                    path: xml_path,
-                    reason:
-                        "the environment map has Mitsuba 0.6's cell-centred rows, which Mitsuba 3 \
-                             would read half a row apart; load the scene in Mitsuba 3 spelling"
-                            .into(),
-                });
-            }
-            let file = format!("{name}-envmap.exr");
-            let path = dir.join(&file);
-            let width = map.width as usize;
-            write_rgb_exr(&path, width, map.height as usize, |x, y| {
-                let i = 3 * (y * width + x);
-                (map.rgb[i], map.rgb[i + 1], map.rgb[i + 2])
-            })?;
-            written.push(path);
-            format!(
-                "<emitter type=\"envmap\">\n        <string name=\"filename\" value=\"{file}\"/>\n        \
-                 <float name=\"scale\" value=\"{}\"/>\n        {}\n    </emitter>",
-                map.scale,
-                matrix_transform(&map.to_world, "        ")
-            )
-        }
-    };
+    let phase = medium.phase.to_mitsuba3();
+    let bsdf = desc.boundary.bsdf.to_mitsuba3();
+    let emitter = desc
+        .environment
+        .to_mitsuba3(dir, name, &xml_path, &mut written)?;
     let depth = |d: Option<u32>, none: i64| d.map_or(none, i64::from);
     let fov_axis = match desc.camera.fov_axis {
         FovAxis::X => "x",
@@ -259,7 +210,7 @@ fn box_transform(from: &Bounds, to: &Bounds) -> Matrix4 {
 
 /// `<transform name="to_world">` holding `m`, for an element whose children are indented by
 /// `indent`.
-fn matrix_transform(m: &Matrix4, indent: &str) -> String {
+pub(crate) fn matrix_transform(m: &Matrix4, indent: &str) -> String {
     let values: Vec<String> = m.iter().flatten().map(|v| v.to_string()).collect();
     format!(
         "<transform name=\"to_world\">\n{indent}    <matrix value=\"{}\"/>\n{indent}</transform>",
@@ -267,7 +218,7 @@ fn matrix_transform(m: &Matrix4, indent: &str) -> String {
     )
 }
 
-fn rgb_element(name: &str, rgb: &[f32; 3]) -> String {
+pub(crate) fn rgb_element(name: &str, rgb: &[f32; 3]) -> String {
     format!(
         "<rgb name=\"{name}\" value=\"{}, {}, {}\"/>",
         rgb[0], rgb[1], rgb[2]

@@ -6,7 +6,6 @@
 //! parameter is absent, Mitsuba 3's defaults apply (extinction 1, albedo 0.75); Mitsuba 0.6 has
 //! material-preset defaults volpt does not carry, so there it must be given.
 
-use super::phase::phase;
 use super::plugin::{quoted, Arg, Ctx, Plugin};
 use super::preprocess::Dialect;
 use super::volume::{constant_error, volume, Role, VolumeValue};
@@ -52,7 +51,7 @@ pub(crate) fn medium(el: &Element, ctx: &Ctx<'_>) -> Result<MediumDesc, SceneErr
         }
     };
     let phase = match p.object("phase")? {
-        Some(arg) => phase(arg.target, ctx)?,
+        Some(arg) => PhaseDesc::from_mitsuba(arg.target, ctx)?,
         None => PhaseDesc::Isotropic,
     };
     let (density, albedo) = if kind == "homogeneous" {

@@ -11,22 +11,20 @@
 //! plugin family, assembled here.
 
 mod boxes;
-mod bsdf;
-mod emitter;
-mod export;
+pub(crate) mod emitter;
+pub(crate) mod export;
 mod integrator;
 pub(crate) mod ior;
 mod medium;
 mod obj;
-mod phase;
-mod plugin;
-mod preprocess;
+pub(crate) mod plugin;
+pub(crate) mod preprocess;
 mod sensor;
 mod shape;
-mod spectrum;
-mod transform;
+pub(crate) mod spectrum;
+pub(crate) mod transform;
 mod volume;
-mod xml;
+pub(crate) mod xml;
 
 use std::path::Path;
 

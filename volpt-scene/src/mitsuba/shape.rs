@@ -4,13 +4,13 @@
 //! `toWorld`) or as an `obj` mesh; either is accepted when the result is exactly such a box.
 
 use super::boxes::{box_from_corners, transformed_box};
-use super::bsdf::bsdf;
 use super::medium::medium;
 use super::obj::obj_vertices;
 use super::plugin::{invalid, Ctx, Plugin};
 use super::transform::{apply_point, transform, IDENTITY_F64};
 use super::xml::Element;
-use crate::description::{BoundaryDesc, MediumDesc};
+use crate::boundary::MITSUBA_KINDS;
+use crate::description::{BoundaryDesc, BsdfDesc, MediumDesc};
 use crate::error::SceneError;
 
 const NOT_A_BOX: &str = "volpt's boundary must be an axis-aligned box: a cube whose toWorld only \
@@ -108,11 +108,13 @@ pub(crate) fn boundary(
         p.finish()?;
         return Err(super::plugin::missing(
             el,
-            "a <bsdf>: volpt needs the boundary's surface to be null, dielectric or \
-             roughdielectric (Mitsuba would make it diffuse)",
+            &format!(
+                "a <bsdf>: volpt needs the boundary's surface to be {MITSUBA_KINDS} (Mitsuba \
+                 would make it diffuse)"
+            ),
         ));
     };
-    let surface = bsdf(surface.target, ctx)?;
+    let surface = BsdfDesc::from_mitsuba(surface.target, ctx)?;
     let medium = medium(interior.target, ctx)?;
     p.finish()?;
     Ok((
