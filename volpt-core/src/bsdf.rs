@@ -130,7 +130,7 @@ impl Bsdf for RoughDielectric {
         };
         let h = wi + wo * eta;
         let len2 = h.length_squared();
-        if !(len2 > 0.0) {
+        if len2 <= 0.0 {
             return zero;
         }
         let m = h * (1.0 / crate::math::sqrt(len2));
