@@ -369,7 +369,7 @@ fn load(scene: &Path, params: &[(&str, String)], size: u32) -> SceneDescription 
 }
 
 /// What a scene is compared on: the majorant grid where its medium is a grid, NEE where its
-/// boundary is index-matched (elsewhere both are the plain algorithm by construction).
+/// boundary is index-matched or rough (elsewhere both are the plain algorithm by construction).
 struct Comparison {
     grid: bool,
     nee: bool,
@@ -412,11 +412,25 @@ fn grid_and_nee_match_global_pt_on_generated_scenes() {
             nee: false,
         },
     );
-    // NEE needs an index-matched boundary: envmap-cube's sky and sun through a null boundary.
+    // envmap-cube's sky and sun as the scene has them, around a rough dielectric (NEE where paths
+    // meet the boundary), and through a null boundary (NEE at every scattering event).
     let mut envmap = load(&scenes.join("envmap-cube/scene.xml"), &[], 12);
-    envmap.boundary.bsdf = BsdfDesc::Null;
+    assert!(matches!(
+        envmap.boundary.bsdf,
+        BsdfDesc::RoughDielectric { .. }
+    ));
     compare_on(
         "envmap-cube",
+        &envmap,
+        40000,
+        Comparison {
+            grid: false,
+            nee: true,
+        },
+    );
+    envmap.boundary.bsdf = BsdfDesc::Null;
+    compare_on(
+        "envmap-cube (index-matched)",
         &envmap,
         40000,
         Comparison {

@@ -137,7 +137,7 @@ struct SceneArgs {
     #[arg(long, value_name = "CELLS", value_parser = clap::value_parser!(u32).range(1..=1024))]
     majorant_resolution: Option<u32>,
     /// How paths gather the environment's light (default: nee for a lat-long map behind an
-    /// index-matched boundary, pt elsewhere; nee needs an index-matched boundary).
+    /// index-matched or around a rough boundary, pt elsewhere; a smooth dielectric rules nee out).
     #[arg(long, value_enum)]
     estimator: Option<EstimatorArg>,
     /// How the medium's grids are reconstructed between samples (default: stochastic on a GPU
@@ -188,7 +188,8 @@ impl From<Tracking> for volpt::Tracking {
 enum EstimatorArg {
     /// Path tracing: light only where a path escapes.
     Pt,
-    /// Next-event estimation of the environment at scattering events, with MIS.
+    /// Next-event estimation of the environment at scattering events (index-matched boundary) or
+    /// at the boundary (rough dielectric), with MIS.
     Nee,
 }
 

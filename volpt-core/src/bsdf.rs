@@ -25,14 +25,37 @@ pub struct BsdfSample {
     pub eta: f32,
 }
 
+/// The BSDF in one direction, for next-event estimation through the boundary and the MIS weight of
+/// [`Bsdf::sample`]'s directions.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BsdfEval {
+    /// `f(d -> wo) |cos(wo)|`, with the same radiance scaling `1 / eta^2` on refraction as
+    /// [`BsdfSample::weight`], so that `value = weight * pdf` for a direction `sample` returns.
+    pub value: f32,
+    /// Solid-angle density with which [`Bsdf::sample`] returns `wo` (lobe choice included).
+    pub pdf: f32,
+}
+
 pub trait Bsdf {
     /// An index-matched boundary: crossing it changes nothing and is not an interaction, so the path
     /// step skips the BSDF and its random numbers entirely.
     const IS_NULL: bool = false;
 
+    /// A BSDF without delta lobes: it has a density in every direction, so next-event estimation
+    /// can look at the environment through it ([`Bsdf::eval`]).
+    const IS_ROUGH: bool = false;
+
     /// Samples the interaction of a ray travelling along `d` with the boundary of outward normal `n`,
     /// or `None` when the sample carries no energy.
     fn sample(&self, n: Vec3, d: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample>;
+
+    /// The BSDF and the density of [`Bsdf::sample`] for the new direction `wo` of a ray travelling
+    /// along `d` to the boundary of outward normal `n`; zero for a BSDF that is not
+    /// [`Bsdf::IS_ROUGH`] (its lobes are deltas, which no other direction than its own meets).
+    #[inline]
+    fn eval(&self, _n: Vec3, _d: Vec3, _wo: Vec3) -> BsdfEval {
+        BsdfEval::default()
+    }
 }
 
 /// Index-matched (Mitsuba's `null`) boundary.
@@ -75,12 +98,65 @@ pub struct RoughDielectric {
 }
 
 impl Bsdf for RoughDielectric {
+    const IS_ROUGH: bool = true;
+
     #[inline]
     fn sample(&self, n: Vec3, d: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         let ggx = self.distribution;
         scatter_off_microfacet(n, d, self.eta, u_lobe, |wi| {
             (ggx.sample_visible_normal(wi, u), Some(ggx))
         })
+    }
+
+    /// Walter et al. 2007 (eqs. 20-21, with the half-vectors of eqs. 13 and 16), written as the
+    /// density of [`Self::sample`] times its weight: `m` is the microfacet that turns `wi` into
+    /// `wo`, chosen with the visible-normal density `D_wi(m)` and its lobe with probability `F` (or
+    /// `1 - F`); the change of variables from `m` to `wo` is `1 / (4 |wo . m|)` on reflection and
+    /// `eta^2 |wo . m| / (wi . m + eta wo . m)^2` on refraction; the weight is `G1(wo, m) / eta^2`.
+    #[inline]
+    fn eval(&self, n: Vec3, d: Vec3, wo: Vec3) -> BsdfEval {
+        let zero = BsdfEval::default();
+        let outside = d.dot(n) < 0.0;
+        let frame = Frame::from_z(if outside { n } else { -n });
+        let (wi, wo) = (frame.to_local(-d), frame.to_local(wo));
+        if wi.z <= 0.0 || wo.z == 0.0 {
+            return zero;
+        }
+        let reflected = wo.z > 0.0;
+        let eta = match (reflected, outside) {
+            (true, _) => 1.0,
+            (false, true) => self.eta,
+            (false, false) => 1.0 / self.eta,
+        };
+        let h = wi + wo * eta;
+        let len2 = h.length_squared();
+        if len2 <= 0.0 {
+            return zero;
+        }
+        let m = h * (1.0 / crate::math::sqrt(len2));
+        let m = if m.z < 0.0 { -m } else { m };
+        let (cos_im, cos_om) = (wi.dot(m), wo.dot(m));
+        // The microfacet must face `wi`, and `wo` leave it on the side of its lobe.
+        if cos_im <= 0.0 || (cos_om > 0.0) != reflected {
+            return zero;
+        }
+        let ggx = self.distribution;
+        let (reflectance, _) =
+            fresnel_dielectric_cos(cos_im, if outside { self.eta } else { 1.0 / self.eta });
+        let visible = ggx.pdf_visible_normal(wi, m);
+        let pdf = if reflected {
+            visible * reflectance / (4.0 * cos_om)
+        } else {
+            let denom = cos_im + eta * cos_om;
+            visible * (1.0 - reflectance) * eta * eta * -cos_om / (denom * denom)
+        };
+        if !(pdf.is_finite() && pdf > 0.0) {
+            return zero;
+        }
+        BsdfEval {
+            value: pdf * ggx.g1(wo, m) / (eta * eta),
+            pdf,
+        }
     }
 }
 

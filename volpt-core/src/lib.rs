@@ -29,7 +29,7 @@ pub mod tracking;
 pub mod variant;
 
 pub use abi::{Component, SceneAbi};
-pub use bsdf::{Bsdf, BsdfSample, NullBoundary, RoughDielectric, SmoothDielectric};
+pub use bsdf::{Bsdf, BsdfEval, BsdfSample, NullBoundary, RoughDielectric, SmoothDielectric};
 pub use camera::PerspectiveCamera;
 pub use environment::{
     ConstantEnvironment, Environment, LatLongEnvironment, LatLongRows, SampledEnvironment,

@@ -17,7 +17,8 @@
 //! an unbiased estimator of the volume rendering equation (Kajiya 1986; Veach 1997 ch. 4); every
 //! sample is importance sampled exactly except the microfacet masking, so weights stay near 1. With
 //! [`Estimator::NextEvent`] and an index-matched boundary, each scattering event also looks at the
-//! environment directly ([`next_event`]). Depth and roulette follow Mitsuba's
+//! environment directly ([`next_event_estimate`]); with a rough dielectric boundary, each interaction
+//! with the boundary does ([`boundary_next_event_estimate`]). Depth and roulette follow Mitsuba's
 //! `volpath`: `depth` counts scattering events and dielectric interactions, a path may see the light
 //! after at most `max_depth - 1` of them, and from `rr_depth` on it survives with probability
 //! `min(max(throughput) * eta^2, 0.95)`, or by the thesis's `min(1, max(throughput))`
@@ -89,10 +90,12 @@ pub enum Roulette {
 pub enum Estimator {
     /// Only where a path escapes: the phase function alone picks the directions.
     PathTracing,
-    /// Also at every scattering event, towards a direction sampled from the environment, with the
-    /// transmittance to the box estimated by ratio tracking; both strategies weighted by multiple
-    /// importance sampling. Only behind an index-matched boundary (a dielectric bends or reflects
-    /// the shadow ray): elsewhere it is path tracing.
+    /// Also towards a direction sampled from the environment, both strategies weighted by multiple
+    /// importance sampling: behind an index-matched boundary at every scattering event, with the
+    /// transmittance to the box estimated by ratio tracking; with a rough dielectric boundary at
+    /// every interaction with it (the shadow ray leaves the convex box at once; from inside the
+    /// medium it would meet the boundary, which bends it). Behind a smooth dielectric it is path
+    /// tracing.
     NextEvent,
 }
 
@@ -176,6 +179,13 @@ impl PathState {
     #[inline]
     fn uses_next_event<S: Scene>(scene: &S) -> bool {
         S::Bsdf::IS_NULL && scene.settings().estimator == Estimator::NextEvent
+    }
+
+    /// Whether this path samples the environment at its interactions with the boundary (a rough
+    /// dielectric; [`boundary_next_event_estimate`]).
+    #[inline]
+    fn uses_boundary_next_event<S: Scene>(scene: &S) -> bool {
+        S::Bsdf::IS_ROUGH && scene.settings().estimator == Estimator::NextEvent
     }
 
     /// Ends the path at a safety bound; it contributes zero.
@@ -273,7 +283,9 @@ fn advance<S: Scene, const DEFER_SCATTER: bool>(scene: &S, path: &mut PathState)
             Some(hit) => interact_with_boundary(scene, path, hit),
             None => {
                 let mut light = path.throughput * scene.background(path.ray.dir);
-                if PathState::uses_next_event(scene) && path.mis_pdf > 0.0 {
+                let weighted =
+                    PathState::uses_next_event(scene) || PathState::uses_boundary_next_event(scene);
+                if weighted && path.mis_pdf > 0.0 {
                     let light_pdf = scene.environment().pdf(path.ray.dir);
                     light *= power_heuristic(path.mis_pdf, light_pdf);
                 }
@@ -381,6 +393,32 @@ fn next_event_estimate<S: Scene>(scene: &S, path: &mut PathState, p: Vec3) -> bo
     true
 }
 
+/// Next-event estimation at a rough boundary hit at `hit` (Veach 1997, ch. 9; Mitsuba 3's `volpath`
+/// does the same at every non-delta BSDF): a look direction `w` sampled from the environment with
+/// density `p_env` adds `throughput * f(w) |cos(w)| * L_env(w) * w_env / p_env`, with
+/// `w_env = p_env^2 / (p_env^2 + p_bsdf(w)^2)`; [`interact_with_boundary`] keeps `p_bsdf` of the
+/// sampled direction so that, when it escapes, its light takes the complementary weight. Only a
+/// direction out of the box reaches the environment: the box is convex and alone, so nothing lies
+/// in its way and the transmittance is 1 (reflection for a path that arrives from outside,
+/// refraction out for one from inside); a direction into the box meets the medium and the boundary
+/// again, which a straight shadow ray cannot pass, so it adds nothing and the BSDF's sample of it
+/// keeps its full weight (`mis_pdf` 0).
+#[inline(always)]
+fn boundary_next_event_estimate<S: Scene>(scene: &S, path: &mut PathState, hit: &BoxHit) {
+    let Some(light) = scene.environment().sample(path.rng.next_2d()) else {
+        return;
+    };
+    if light.dir.dot(hit.normal) <= 0.0 {
+        return;
+    }
+    let bsdf = scene.boundary().eval(hit.normal, path.ray.dir, light.dir);
+    if bsdf.value <= 0.0 {
+        return;
+    }
+    let weight = power_heuristic(light.pdf, bsdf.pdf) * bsdf.value / light.pdf;
+    path.radiance += path.throughput * light.radiance * weight;
+}
+
 /// Veach's power heuristic with exponent 2: the weight of a strategy of density `a` against one of
 /// density `b`.
 #[inline]
@@ -404,10 +442,27 @@ fn interact_with_boundary<S: Scene>(scene: &S, path: &mut PathState, hit: BoxHit
     if !path.begin_interaction(settings) {
         return;
     }
+    let next_event = PathState::uses_boundary_next_event(scene);
+    if next_event {
+        boundary_next_event_estimate(scene, path, &hit);
+    }
     let u_lobe = path.rng.next_f32();
     let u = path.rng.next_2d();
     match scene.boundary().sample(hit.normal, path.ray.dir, u_lobe, u) {
         Some(sample) => {
+            if next_event {
+                // A direction out of the box escapes at once (the box is convex), where its light
+                // takes the MIS weight against the environment's density. The BSDF's own density
+                // of it, kept positive: 0 in `mis_pdf` would mean "unweighted" (a direction whose
+                // density rounds to 0 leaves its light to the environment's sample, which weights
+                // it by 1 and the BSDF's value of it, 0 too).
+                path.mis_pdf = if sample.wo.dot(hit.normal) > 0.0 {
+                    let bsdf = scene.boundary().eval(hit.normal, path.ray.dir, sample.wo);
+                    bsdf.pdf.max(f32::MIN_POSITIVE)
+                } else {
+                    0.0
+                };
+            }
             path.throughput *= sample.weight;
             if sample.transmitted {
                 path.inside = !path.inside;

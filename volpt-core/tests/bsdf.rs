@@ -12,7 +12,9 @@ use std::f64::consts::PI;
 use common::*;
 use glam::DVec3;
 use volpt_core::microfacet::Ggx;
-use volpt_core::{Bsdf, BsdfSample, NullBoundary, RoughDielectric, SmoothDielectric, Vec2, Vec3};
+use volpt_core::{
+    Bsdf, BsdfEval, BsdfSample, NullBoundary, RoughDielectric, SmoothDielectric, Vec2, Vec3,
+};
 
 const ETA: f32 = 1.5;
 
@@ -403,6 +405,127 @@ fn rough_dielectric_matches_walter_bsdf() {
         }
     }
     assert!(power_checked);
+}
+
+/// `RoughDielectric::eval`, which next-event estimation through the boundary uses: its value is
+/// Walter et al.'s `f |cos theta_o|` written independently above (at directions over both
+/// hemispheres), and its density is the sampler's (the fraction of samples landing in each bin of
+/// the sphere against the density integrated over the bin). A `SmoothDielectric` and the
+/// index-matched boundary have no density anywhere.
+#[test]
+fn rough_dielectric_eval_is_walter_bsdf_and_the_samplers_density() {
+    const N: usize = 200_000;
+    const C_BINS: usize = 16;
+    const PHI_BINS: usize = 12;
+    let n = normal();
+    let n64 = to_f64(n);
+    let frame = test_frame(n);
+    let frame64 = (to_f64(frame.0), to_f64(frame.1), to_f64(frame.2));
+    let c_edges = uniform_edges(-1.0, 1.0, C_BINS);
+    let phi_edges = uniform_edges(0.0, 2.0 * PI, PHI_BINS);
+    let direction = |c: f64, phi: f64| {
+        let s = (1.0 - c * c).max(0.0).sqrt();
+        frame64.0 * (s * phi.cos()) + frame64.1 * (s * phi.sin()) + frame64.2 * c
+    };
+    let to_f32 = |v: DVec3| Vec3::new(v.x as f32, v.y as f32, v.z as f32);
+    let mut rng = TestRng::new(29);
+    let cases = 3 * 2 * 2;
+    for alpha in [0.1f32, 0.3, 0.7] {
+        let bsdf = RoughDielectric {
+            eta: ETA,
+            distribution: Ggx { alpha },
+        };
+        for outside in [true, false] {
+            for theta in [30.0, 70.0] {
+                let label = format!("alpha {alpha}, outside {outside}, {theta} deg");
+                let d = arriving(n, theta, 0.4, outside);
+                let inc = Incidence {
+                    ns: if outside { n64 } else { -n64 },
+                    wi: -to_f64(d),
+                    eta: relative_eta(outside),
+                };
+                // The value, direction by direction.
+                let mut nonzero = 0;
+                for _ in 0..4000 {
+                    let (c, phi) = (2.0 * rng.f64() - 1.0, 2.0 * PI * rng.f64());
+                    let wo = direction(c, phi);
+                    let expected = walter_f_cos(&inc, wo, alpha as f64, true);
+                    let got = bsdf.eval(n, d, to_f32(wo));
+                    assert!(
+                        got.value >= 0.0 && got.pdf >= 0.0 && got.pdf.is_finite(),
+                        "{label}: {got:?}"
+                    );
+                    // f32 against f64: relative 1e-3, and 1e-5 absolute (the mean of f |cos| over
+                    // the sphere is ~0.1) for the far tails near total internal reflection, where
+                    // `1 - F` cancels in f32 (sampling uses the very same F).
+                    assert!(
+                        (got.value as f64 - expected).abs() <= 1e-3 * expected + 1e-5,
+                        "{label}, wo {wo}: value {} vs Walter {expected}",
+                        got.value
+                    );
+                    nonzero += (expected > 0.0) as u32;
+                }
+                assert!(
+                    nonzero > 1000,
+                    "{label}: only {nonzero} directions with f > 0"
+                );
+                // The density: sampled fractions per bin against the integrated pdf. The
+                // integral is 0 where no bin is reached, so a z-test with the binomial error of
+                // the expected fraction (floored at one sample) and a quadrature tolerance.
+                if alpha == 0.1 {
+                    // Too narrow a lobe for the bins' quadrature; its pdf is the same formula.
+                    continue;
+                }
+                let bins = C_BINS * PHI_BINS;
+                let mut counts = vec![0.0f64; bins];
+                for _ in 0..N {
+                    if let Some(s) = bsdf.sample(n, d, rng.f32(), rng.vec2()) {
+                        let (c, phi) = to_spherical(frame, s.wo);
+                        counts[bin_index(&c_edges, c) * PHI_BINS + bin_index(&phi_edges, phi)] +=
+                            1.0;
+                    }
+                }
+                let mut total = 0.0;
+                for i in 0..C_BINS {
+                    for j in 0..PHI_BINS {
+                        let pdf = |c: f64, phi: f64| {
+                            bsdf.eval(n, d, to_f32(direction(c, phi))).pdf as f64
+                        };
+                        let p = integrate_2d(
+                            &pdf,
+                            (c_edges[i], c_edges[i + 1]),
+                            (phi_edges[j], phi_edges[j + 1]),
+                            1e-7,
+                        );
+                        total += p;
+                        let observed = counts[i * PHI_BINS + j] / N as f64;
+                        let se = (p.max(1.0 / N as f64) * (1.0 - p).max(0.0) / N as f64).sqrt();
+                        assert!(
+                            (observed - p).abs() <= Z_MAX * se + 1e-3 * p + 1e-6,
+                            "{label}, bin ({i}, {j}) of {cases} cases: sampled {observed} vs \
+                             integrated pdf {p} (se {se})"
+                        );
+                    }
+                }
+                // The density integrates to the fraction of samples not rejected (a reflection
+                // below the surface or a refraction that does not cross).
+                let accepted = counts.iter().sum::<f64>() / N as f64;
+                let se = (accepted * (1.0 - accepted) / N as f64).sqrt();
+                eprintln!("{label}: pdf integrates to {total}, {accepted} of the samples accepted");
+                assert!(
+                    total > 0.5 && (total - accepted).abs() <= Z_MAX * se + 1e-3,
+                    "{label}: pdf integrates to {total}, {accepted} of the samples accepted"
+                );
+            }
+        }
+    }
+    let d = arriving(n, 30.0, 0.4, true);
+    let wo = -d;
+    assert_eq!(
+        SmoothDielectric { eta: ETA }.eval(n, d, wo),
+        BsdfEval::default()
+    );
+    assert_eq!(NullBoundary.eval(n, d, wo), BsdfEval::default());
 }
 
 #[test]

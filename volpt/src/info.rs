@@ -233,16 +233,32 @@ fn majorant_rule(choice: &MajorantChoice) -> String {
 
 /// The estimator the paths use, and why.
 fn estimator(parts: &Parts<'_>, settings: &PathSettings) -> &'static str {
-    let index_matched = parts.boundary.kind().index_matched();
-    match (settings.estimator, index_matched) {
-        (_, false) => {
-            "path tracing: the dielectric boundary reflects and refracts, so no straight shadow ray \
-             reaches the environment (next-event estimation needs an index-matched boundary)"
+    let boundary = parts.boundary.kind();
+    match (
+        settings.estimator,
+        boundary.index_matched(),
+        boundary.rough(),
+    ) {
+        (_, false, false) => {
+            "path tracing: the smooth dielectric boundary reflects and refracts, so no straight \
+             shadow ray reaches the environment (next-event estimation needs an index-matched or a \
+             rough boundary)"
         }
-        (Estimator::NextEvent, true) => {
+        (Estimator::NextEvent, false, true) => {
+            "next-event estimation of the environment where paths meet the rough boundary (MIS \
+             with the BSDF; behind it no straight shadow ray reaches the environment)"
+        }
+        (Estimator::PathTracing, false, true) => {
+            if parts.environment.kind() == EnvironmentKind::Constant {
+                "path tracing (--estimator nee samples the environment at the rough boundary)"
+            } else {
+                "path tracing (--estimator nee samples the map at the rough boundary)"
+            }
+        }
+        (Estimator::NextEvent, true, _) => {
             "next-event estimation of the environment (ratio tracking, MIS with the phase function)"
         }
-        (Estimator::PathTracing, true) => {
+        (Estimator::PathTracing, true, _) => {
             if parts.environment.kind() == EnvironmentKind::Constant {
                 "path tracing (next-event estimation of a constant environment costs more than its \
                  lower variance saves; --estimator nee)"

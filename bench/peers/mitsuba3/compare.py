@@ -215,8 +215,8 @@ def run_scene(args, mit, path):
     res["peer"]["time_s"], res["volpt"]["time_s"] = tp, tv
     res["speedup"] = tp / tv if tv > 0 else None
     # Efficiency 1 / (MSE x time): the speed-up at equal error, where the two estimators' variances
-    # per sample differ (Mitsuba 3 samples the emitter at every scattering event, volpt by default
-    # only under a lat-long map; docs/heterogeneous.md).
+    # per sample differ (Mitsuba 3 samples the emitter at every scattering event and rough surface,
+    # volpt by default only under a lat-long map; docs/heterogeneous.md).
     mse_v, mse_p = mse_of_one_render(imgs[0][0], imgs[1][0]), mse_of_one_render(imgs[2][0], imgs[3][0])
     res["volpt"]["mse"], res["peer"]["mse"] = mse_v, mse_p
     res["efficiency_ratio"] = (mse_p * tp) / (mse_v * tv) if mse_v > 0 and tv > 0 else None

@@ -192,6 +192,14 @@ macro_rules! factory {
                     $(BoundaryKind::$Bv => <$bvt as volpt_core::Bsdf>::IS_NULL,)*
                 }
             }
+
+            /// The boundary's BSDF has no delta lobe, so paths can sample the environment where they
+            /// meet it ([`volpt_core::Bsdf::IS_ROUGH`]).
+            pub fn rough(self) -> bool {
+                match self {
+                    $(BoundaryKind::$Bv => <$bvt as volpt_core::Bsdf>::IS_ROUGH,)*
+                }
+            }
         }
 
         impl<'a> SampledEnvironment<'a> for EnvironmentPart<'a> {
