@@ -18,6 +18,12 @@ pub struct LightSample {
 }
 
 pub trait Environment {
+    /// The same radiance from every direction. A path that leaves a rough boundary by its BSDF's
+    /// sample sees such a light as well as a light sample would, so paths do not sample it where
+    /// they meet the boundary: that next-event estimation is compiled out of its kernels, whose
+    /// registers it would otherwise take at every boundary interaction.
+    const IS_CONSTANT: bool = false;
+
     /// Radiance seen when looking along `dir` (arriving along `-dir`).
     fn radiance(&self, dir: Vec3) -> Spectrum;
     /// A look direction with density roughly proportional to the radiance, or `None` when there is
@@ -53,6 +59,8 @@ pub trait SampledEnvironment<'a> {
 pub struct ConstantEnvironment(pub Spectrum);
 
 impl Environment for ConstantEnvironment {
+    const IS_CONSTANT: bool = true;
+
     #[inline]
     fn radiance(&self, _dir: Vec3) -> Spectrum {
         self.0

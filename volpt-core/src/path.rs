@@ -17,8 +17,8 @@
 //! an unbiased estimator of the volume rendering equation (Kajiya 1986; Veach 1997 ch. 4); every
 //! sample is importance sampled exactly except the microfacet masking, so weights stay near 1. With
 //! [`Estimator::NextEvent`] and an index-matched boundary, each scattering event also looks at the
-//! environment directly ([`next_event_estimate`]); with a rough dielectric boundary, each interaction
-//! with the boundary does ([`boundary_next_event_estimate`]). Depth and roulette follow Mitsuba's
+//! environment directly ([`next_event_estimate`]); with a rough dielectric boundary under a map, each
+//! interaction with the boundary does ([`boundary_next_event_estimate`]). Depth and roulette follow Mitsuba's
 //! `volpath`: `depth` counts scattering events and dielectric interactions, a path may see the light
 //! after at most `max_depth - 1` of them, and from `rr_depth` on it survives with probability
 //! `min(max(throughput) * eta^2, 0.95)`, or by the thesis's `min(1, max(throughput))`
@@ -94,8 +94,8 @@ pub enum Estimator {
     /// importance sampling: behind an index-matched boundary at every scattering event, with the
     /// transmittance to the box estimated by ratio tracking; with a rough dielectric boundary at
     /// every interaction with it (the shadow ray leaves the convex box at once; from inside the
-    /// medium it would meet the boundary, which bends it). Behind a smooth dielectric it is path
-    /// tracing.
+    /// medium it would meet the boundary, which bends it), unless the environment is constant
+    /// ([`Environment::IS_CONSTANT`]). Behind a smooth dielectric it is path tracing.
     NextEvent,
 }
 
@@ -182,10 +182,12 @@ impl PathState {
     }
 
     /// Whether this path samples the environment at its interactions with the boundary (a rough
-    /// dielectric; [`boundary_next_event_estimate`]).
+    /// dielectric under an environment that is not constant; [`boundary_next_event_estimate`]).
     #[inline]
     fn uses_boundary_next_event<S: Scene>(scene: &S) -> bool {
-        S::Bsdf::IS_ROUGH && scene.settings().estimator == Estimator::NextEvent
+        S::Bsdf::IS_ROUGH
+            && !S::Environment::IS_CONSTANT
+            && scene.settings().estimator == Estimator::NextEvent
     }
 
     /// Ends the path at a safety bound; it contributes zero.

@@ -244,16 +244,16 @@ fn estimator(parts: &Parts<'_>, settings: &PathSettings) -> &'static str {
              shadow ray reaches the environment (next-event estimation needs an index-matched or a \
              rough boundary)"
         }
+        (_, false, true) if parts.environment.kind() == EnvironmentKind::Constant => {
+            "path tracing: a path leaving the rough boundary by the BSDF's sample sees a constant \
+             environment as well as a light sample would (next-event estimation there samples maps)"
+        }
         (Estimator::NextEvent, false, true) => {
             "next-event estimation of the environment where paths meet the rough boundary (MIS \
              with the BSDF; behind it no straight shadow ray reaches the environment)"
         }
         (Estimator::PathTracing, false, true) => {
-            if parts.environment.kind() == EnvironmentKind::Constant {
-                "path tracing (--estimator nee samples the environment at the rough boundary)"
-            } else {
-                "path tracing (--estimator nee samples the map at the rough boundary)"
-            }
+            "path tracing (--estimator nee samples the map at the rough boundary)"
         }
         (Estimator::NextEvent, true, _) => {
             "next-event estimation of the environment (ratio tracking, MIS with the phase function)"
