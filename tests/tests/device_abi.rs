@@ -279,8 +279,8 @@ fn check_round_trips(descs: Vec<SceneDescription>, expected: BTreeSet<String>, l
 #[test]
 fn a_new_instantiation_needs_only_its_registry_line() {
     use volpt_core::{ConstantAlbedo, GridMedium, Isotropic, NullBoundary, VolumeScene};
-    use volpt_render::factory::parts::{MediumInput, Part};
-    use volpt_render::factory::{camera, Effects, FactoryCache};
+    use volpt_render::factory::{camera, medium_input, Effects, FactoryCache};
+    use volpt_scene::FromDescription;
 
     type New<'a> = GridMedium<'a, ConstantAlbedo, AnyLayout>;
     assert_eq!(New::NAME, "grid_density__constant_albedo__any_layout");
@@ -296,13 +296,14 @@ fn a_new_instantiation_needs_only_its_registry_line() {
                 && matches!(d.environment, EnvironmentDesc::Constant(_))
         })
         .expect("a constant albedo read in any layout");
-    let input = MediumInput::of(
+    let input = medium_input(
         &desc,
         Effects::Specialised,
         &FactoryCache::new(),
         &mut |_| (),
     );
-    let medium = <New as Part>::specialised(&input, &mut |_| ()).expect("the generic rule");
+    let medium =
+        <New as FromDescription>::specialised(&input, &mut |_| ()).expect("the generic rule");
     let EnvironmentDesc::Constant(rgb) = desc.environment else {
         unreachable!()
     };
