@@ -6,6 +6,8 @@
 //! where density and albedo are constants, else a grid medium whose reads ([`GridReads`]) are the
 //! ones the description's lookup and storage ask for ([`ReadsRule`]).
 
+use std::fmt;
+
 use serde::Serialize;
 use volpt_core::grid::{
     AnyLayout, DenseTrilinear, Grid, GridLookup as CoreLookup, GridMapping, GridReads, TexelFormat,
@@ -16,12 +18,14 @@ use volpt_core::{Aabb, ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium
 use crate::description::{Bounds, GridConvention, GridDesc, SampleLayout, SceneDescription};
 use crate::error::SceneError;
 use crate::from_description::FromDescription;
+use crate::mitsuba::export::rgb_element;
 use crate::mitsuba::plugin::{quoted, Arg, Ctx, Plugin};
 use crate::mitsuba::preprocess::Dialect;
 use crate::mitsuba::volume::{constant_error, volume, Role, VolumeValue};
 use crate::mitsuba::xml::Element;
 use crate::phase::PhaseDesc;
 use crate::simplification::Simplification;
+use crate::validate::{check_grid, CheckedData};
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct MediumDesc {
@@ -287,6 +291,378 @@ fn in_unit_range(arg: &Arg<'_>, v: [f32; 3]) -> Result<[f32; 3], SceneError> {
         Ok(v)
     } else {
         Err(constant_error(arg, "an albedo in [0, 1]", v))
+    }
+}
+
+impl MediumDesc {
+    /// Checks the numbers a renderer relies on (`checked`: the grids' values as checked when the
+    /// scene was assembled, not read again); `invalid` makes the error of a field. Returns the
+    /// largest density (delta tracking's majorant over the scale) and what the grids held.
+    pub(crate) fn check(
+        &self,
+        checked: Option<CheckedData>,
+        invalid: &impl Fn(&str, &str, String) -> SceneError,
+    ) -> Result<(f32, CheckedData), SceneError> {
+        if !(self.scale.is_finite() && self.scale >= 0.0) {
+            return Err(invalid(
+                "medium scale",
+                "a finite number >= 0",
+                self.scale.to_string(),
+            ));
+        }
+        let max_density = match &self.density {
+            DensityDesc::Constant(d) => {
+                if !(d.is_finite() && *d >= 0.0) {
+                    return Err(invalid(
+                        "medium density",
+                        "a finite number >= 0",
+                        d.to_string(),
+                    ));
+                }
+                *d
+            }
+            DensityDesc::Grid(grid) => match checked {
+                Some(data) => data.largest_density,
+                None => check_grid(grid, "density grid", f32::MAX, invalid)?,
+            },
+        };
+        let largest_density = match &self.density {
+            DensityDesc::Constant(_) => 0.0,
+            DensityDesc::Grid(_) => max_density,
+        };
+        let mut largest_albedo = 0.0;
+        match &self.albedo {
+            AlbedoDesc::Constant(rgb) => {
+                if !rgb.iter().all(|a| (0.0..=1.0).contains(a)) {
+                    return Err(invalid(
+                        "medium albedo",
+                        "three numbers in [0, 1]",
+                        format!("{rgb:?}"),
+                    ));
+                }
+            }
+            AlbedoDesc::Grid(grid) => {
+                largest_albedo = match checked {
+                    Some(data) => data.largest_albedo,
+                    None => check_grid(grid, "albedo grid", 1.0, invalid)?,
+                };
+            }
+        }
+        let sparse = self.grids().any(|(_, g)| g.layout == SampleLayout::Sparse);
+        if sparse && matches!(self.lookup, GridLookup::Texture | GridLookup::TextureHalf) {
+            return Err(invalid(
+                "grid lookup",
+                "trilinear, stochastic or nearest lookups for a sparse grid (textures hold dense grids; \
+                 read the VDB dense with sparse = \"never\" to use them)",
+                format!("{:?}", self.lookup),
+            ));
+        }
+        Ok((
+            max_density,
+            CheckedData {
+                largest_density,
+                largest_albedo,
+            },
+        ))
+    }
+
+    /// The largest extinction of the medium (delta tracking's majorant).
+    pub fn max_extinction(&self) -> f32 {
+        match &self.density {
+            DensityDesc::Constant(density) => self.scale * density,
+            DensityDesc::Grid(grid) => self.scale * grid.max_value(),
+        }
+    }
+
+    /// The largest density and the largest albedo component, each with its name (`"density"`,
+    /// `"albedo"`): a constant's own, a grid's as `checked` found it.
+    pub fn largest_values(&self, checked: CheckedData) -> [(&'static str, f32); 2] {
+        [
+            (
+                "density",
+                match &self.density {
+                    DensityDesc::Constant(v) => *v,
+                    DensityDesc::Grid(_) => checked.largest_density,
+                },
+            ),
+            (
+                "albedo",
+                match &self.albedo {
+                    AlbedoDesc::Constant(rgb) => rgb.iter().copied().fold(0.0, f32::max),
+                    AlbedoDesc::Grid(_) => checked.largest_albedo,
+                },
+            ),
+        ]
+    }
+
+    /// The medium's grids, each with what it holds (`"density"`, `"albedo"`), in that order.
+    pub fn grids(&self) -> impl Iterator<Item = (&'static str, &GridDesc)> {
+        let density = match &self.density {
+            DensityDesc::Grid(g) => Some(("density", g)),
+            DensityDesc::Constant(_) => None,
+        };
+        let albedo = match &self.albedo {
+            AlbedoDesc::Grid(g) => Some(("albedo", g)),
+            AlbedoDesc::Constant(_) => None,
+        };
+        density.into_iter().chain(albedo)
+    }
+
+    /// The values the description's serialisation leaves out (the grids' samples), the
+    /// density's then the albedo's (empty for a constant), which what fingerprints a scene
+    /// hashes on their own (the facade's `fingerprint::content`).
+    pub fn unserialised_values(&self) -> [&[f32]; 2] {
+        let density = match &self.density {
+            DensityDesc::Grid(g) => &g.data[..],
+            DensityDesc::Constant(_) => &[],
+        };
+        let albedo = match &self.albedo {
+            AlbedoDesc::Grid(g) => &g.data[..],
+            AlbedoDesc::Constant(_) => &[],
+        };
+        [density, albedo]
+    }
+
+    /// The `<medium>`'s type, its extinction and its albedo elements in a Mitsuba 3 scene; `grid`
+    /// writes a grid's file and returns the `gridvolume` that reads it (its arguments: the grid,
+    /// what it holds, Mitsuba's parameter).
+    pub(crate) fn to_mitsuba3(
+        &self,
+        grid: &mut dyn FnMut(&GridDesc, &str, &str) -> Result<String, SceneError>,
+    ) -> Result<(&'static str, String, String), SceneError> {
+        let (medium_type, sigma_t) = match &self.density {
+            DensityDesc::Constant(d) => (
+                "homogeneous",
+                format!("<float name=\"sigma_t\" value=\"{d}\"/>"),
+            ),
+            DensityDesc::Grid(g) => ("heterogeneous", grid(g, "density", "sigma_t")?),
+        };
+        let albedo = match &self.albedo {
+            AlbedoDesc::Constant(rgb) => rgb_element("albedo", rgb),
+            AlbedoDesc::Grid(g) => grid(g, "albedo", "albedo")?,
+        };
+        Ok((medium_type, sigma_t, albedo))
+    }
+
+    /// The facade's `medium.*` parameters: `(key, what it is)`. `medium.scale` is a number,
+    /// `medium.albedo` an RGB ([`MediumParam`]).
+    pub const PARAMS: &'static [(&'static str, &'static str)] = &[
+        (
+            "medium.scale",
+            "the density's scale (extinction = scale x density), finite and >= 0",
+        ),
+        (
+            "medium.albedo",
+            "the constant single-scattering albedo, RGB in [0, 1] (not a grid's)",
+        ),
+    ];
+
+    /// The value of parameter `key`, if it is one of [`MediumDesc::PARAMS`] (the phase's are
+    /// [`PhaseDesc::param`]'s); `Some(Err(why))` where this medium has no such value.
+    pub fn param(&self, key: &str) -> Option<Result<MediumParam, ParamRefused>> {
+        Some(match key {
+            "medium.scale" => Ok(MediumParam::Float(self.scale)),
+            "medium.albedo" => match &self.albedo {
+                AlbedoDesc::Constant(rgb) => Ok(MediumParam::Rgb(*rgb)),
+                AlbedoDesc::Grid(_) => Err(ALBEDO_GRID),
+            },
+            _ => return None,
+        })
+    }
+
+    /// Sets parameter `key` to `value`, if it is one of [`MediumDesc::PARAMS`] (`None`: the
+    /// medium is left alone). `Some(Err(why))` refuses the value, leaving the medium as it was.
+    pub fn set_param(&mut self, key: &str, value: MediumParam) -> Option<Result<(), ParamRefused>> {
+        Some(match key {
+            "medium.scale" => match value {
+                MediumParam::Float(v) if v.is_finite() && v >= 0.0 => {
+                    self.scale = v;
+                    Ok(())
+                }
+                _ => Err(ParamRefused::Value("a finite number >= 0")),
+            },
+            "medium.albedo" => match &mut self.albedo {
+                AlbedoDesc::Constant(rgb) => match value {
+                    MediumParam::Rgb(v) if v.iter().all(|c| c.is_finite()) => {
+                        if !v.iter().all(|c| (0.0..=1.0).contains(c)) {
+                            return Some(Err(ParamRefused::Value("RGB in [0, 1]")));
+                        }
+                        *rgb = v;
+                        Ok(())
+                    }
+                    _ => Err(ParamRefused::Value("three finite numbers")),
+                },
+                AlbedoDesc::Grid(_) => Err(ALBEDO_GRID),
+            },
+            _ => return None,
+        })
+    }
+
+    /// One medium of each kind (with an isotropic phase, a scale of 3 and dense storage); with
+    /// the boundary's, the phase's and the environment's examples, every registry medium part is
+    /// selected by some scene (tests cover the registry with them). The grids lie a little inside
+    /// and outside the unit cube, so that a grid's own mapping matters; their values differ in
+    /// every voxel, so that any change of mapping shows. The fourth and fifth media's
+    /// nearest-sample lookups select the any-layout grid media (with a constant albedo and with an
+    /// albedo grid); a grid decoded with the other lookup renders a different image, so both
+    /// lookups cross the device ABI. The sixth reads textures of half-precision texels: decoded as
+    /// f32 texels, its samples would differ. The last reads one texel per lookup (stochastic):
+    /// decoded as trilinear, it would read eight.
+    pub fn examples() -> Vec<Self> {
+        let bounds = Bounds {
+            min: [-0.6, -0.45, -0.5],
+            max: [0.55, 0.5, 0.6],
+        };
+        let grid = |channels: u32, convention| {
+            let n = 4 * 3 * 2 * channels as usize;
+            GridDesc {
+                layout: SampleLayout::Dense,
+                resolution: [4, 3, 2],
+                channels,
+                bounds,
+                convention,
+                data: (0..n)
+                    .map(|i| 0.2 + 0.8 * ((i * 7919) % n) as f32 / n as f32)
+                    .collect(),
+            }
+        };
+        let (vertex, cell) = (GridConvention::Vertex, GridConvention::Cell);
+        let media = [
+            (
+                DensityDesc::Constant(2.0),
+                AlbedoDesc::Constant([0.9, 0.7, 0.5]),
+                GridLookup::Trilinear,
+            ),
+            (
+                DensityDesc::Grid(grid(1, vertex)),
+                AlbedoDesc::Constant([0.8, 0.9, 0.6]),
+                GridLookup::Trilinear,
+            ),
+            (
+                DensityDesc::Grid(grid(1, cell)),
+                AlbedoDesc::Grid(grid(3, vertex)),
+                GridLookup::Trilinear,
+            ),
+            (
+                DensityDesc::Grid(grid(1, vertex)),
+                AlbedoDesc::Constant([0.8, 0.9, 0.6]),
+                GridLookup::Nearest,
+            ),
+            (
+                DensityDesc::Grid(grid(1, cell)),
+                AlbedoDesc::Grid(grid(3, vertex)),
+                GridLookup::Nearest,
+            ),
+            (
+                DensityDesc::Grid(grid(1, cell)),
+                AlbedoDesc::Grid(grid(3, vertex)),
+                GridLookup::TextureHalf,
+            ),
+            (
+                DensityDesc::Grid(grid(1, vertex)),
+                AlbedoDesc::Grid(grid(3, cell)),
+                GridLookup::Stochastic,
+            ),
+        ];
+        media
+            .into_iter()
+            .map(|(density, albedo, lookup)| MediumDesc {
+                density,
+                scale: 3.0,
+                albedo,
+                phase: PhaseDesc::Isotropic,
+                lookup,
+                storage: GridStorage::Dense,
+            })
+            .collect()
+    }
+}
+
+/// A value of a `medium.*` parameter ([`MediumDesc::PARAMS`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MediumParam {
+    Float(f32),
+    Rgb([f32; 3]),
+}
+
+/// Why a medium refuses a parameter ([`MediumDesc::param`], [`MediumDesc::set_param`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ParamRefused {
+    /// This medium has no such value: what the parameter needs, and what the medium has instead.
+    NotHere {
+        needs: &'static str,
+        found: &'static str,
+    },
+    /// The value is not what the parameter takes: what it takes.
+    Value(&'static str),
+}
+
+const ALBEDO_GRID: ParamRefused = ParamRefused::NotHere {
+    needs: "a constant albedo",
+    found: "a grid",
+};
+
+/// As `volpt info`'s `density` line begins (its scale follows).
+impl fmt::Display for DensityDesc {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            DensityDesc::Constant(d) => write!(f, "constant {d}"),
+            DensityDesc::Grid(g) => write!(f, "{}", InfoGrid(g)),
+        }
+    }
+}
+
+/// As `volpt info`'s `albedo` line prints it.
+impl fmt::Display for AlbedoDesc {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            AlbedoDesc::Constant(rgb) => write!(f, "constant {rgb:?}"),
+            AlbedoDesc::Grid(g) => write!(f, "{}", InfoGrid(g)),
+        }
+    }
+}
+
+impl GridLookup {
+    /// As `volpt info`'s `lookup` line prints it.
+    pub fn info(self) -> &'static str {
+        match self {
+            GridLookup::Trilinear => {
+                "trilinear (without --lookup, a GPU with fast math reads stochastic lookups \
+                 instead where the grids fit in its memory)"
+            }
+            GridLookup::Nearest => "nearest (biased: a blockier field)",
+            GridLookup::Texture => "texture (the texture unit's filter, 8-bit weights: biased)",
+            GridLookup::TextureHalf => "texture-f16 (half-precision texels, 8-bit weights: biased)",
+            GridLookup::Stochastic => {
+                "stochastic (one sample chosen by its trilinear weight: unbiased)"
+            }
+        }
+    }
+}
+
+/// A grid as `volpt info` prints it: its shape, placement and range of values.
+struct InfoGrid<'g>(&'g GridDesc);
+
+impl fmt::Display for InfoGrid<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let g = self.0;
+        let (lo, hi) = g
+            .samples()
+            .iter()
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &v| {
+                (lo.min(v), hi.max(v))
+            });
+        write!(
+            f,
+            "grid {}x{}x{}x{}, {:?}-centred, bounds {:?} .. {:?}, values {lo} .. {hi}",
+            g.resolution[0],
+            g.resolution[1],
+            g.resolution[2],
+            g.channels,
+            g.convention,
+            g.bounds.min,
+            g.bounds.max
+        )
     }
 }
 
