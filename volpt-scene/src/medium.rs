@@ -1,14 +1,18 @@
 //! The medium, everything about its descriptions in one place: what a description says
 //! ([`MediumDesc`]: its density, albedo, grid lookup and storage; its phase function is
-//! [`crate::phase`]'s), how Mitsuba's `<medium>` spells it, its checks, its Mitsuba 3 export, how
-//! `volpt info` prints it, the numbers a scene takes between renders, one example of each kind,
-//! and how each registry medium part is built from it ([`FromDescription`]): a homogeneous medium
+//! [`crate::phase`]'s), how Mitsuba's `<medium>` and a TOML scene's `[albedo]` spell it (a TOML
+//! scene's density is its `[volume]` grid file), its checks, its Mitsuba 3 export, how `volpt info`
+//! prints it, the numbers a scene takes between renders, the values serde leaves out, one example
+//! of each kind, and how each registry medium part is built from it ([`FromDescription`]): a
+//! homogeneous medium
 //! where density and albedo are constants, else a grid medium whose reads ([`GridReads`]) are the
 //! ones the description's lookup and storage ask for ([`ReadsRule`]).
 
 use std::fmt;
 
-use serde::Serialize;
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
 use volpt_core::grid::{
     AnyLayout, DenseTrilinear, Grid, GridLookup as CoreLookup, GridMapping, GridReads, TexelFormat,
     TextureTrilinear,
@@ -25,6 +29,8 @@ use crate::mitsuba::volume::{constant_error, volume, Role, VolumeValue};
 use crate::mitsuba::xml::Element;
 use crate::phase::PhaseDesc;
 use crate::simplification::Simplification;
+use crate::toml_scene::{Cx, OneOrThree};
+use crate::transfer::TransferFunction;
 use crate::validate::{check_grid, CheckedData};
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -291,6 +297,53 @@ fn in_unit_range(arg: &Arg<'_>, v: [f32; 3]) -> Result<[f32; 3], SceneError> {
         Ok(v)
     } else {
         Err(constant_error(arg, "an albedo in [0, 1]", v))
+    }
+}
+
+/// A TOML scene's `[albedo]` (its density is `[volume]`'s grid).
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AlbedoSpec {
+    /// A transfer function file (docs/guide.md, "Transfer functions") applied to the normalised density.
+    pub transfer_function: Option<String>,
+    /// A constant albedo, grey or RGB (default 0.9 grey, unless a transfer function is given).
+    pub value: Option<OneOrThree>,
+    /// A vec3 grid of the volume's `.vdb` file holding the albedo (the thesis's RGB albedo grid).
+    pub grid: Option<String>,
+}
+
+impl AlbedoSpec {
+    /// The albedo `[albedo]` describes: `grid` where it names one (read from the volume's file),
+    /// a transfer function applied to the `density` grid, or a constant; `resolve` makes a path
+    /// of the file relative to the scene's.
+    pub(crate) fn albedo(
+        &self,
+        cx: &Cx<'_>,
+        grid: Option<GridDesc>,
+        density: &GridDesc,
+        resolve: &dyn Fn(&str, &str) -> Result<PathBuf, SceneError>,
+    ) -> Result<AlbedoDesc, SceneError> {
+        Ok(match (&self.transfer_function, self.value) {
+            _ if grid.is_some() => AlbedoDesc::Grid(grid.unwrap()),
+            (Some(_), Some(_)) => {
+                return Err(cx.invalid("albedo", "either transfer_function or value", "both"))
+            }
+            (Some(tf), None) => {
+                let tf = TransferFunction::read(&resolve(tf, "albedo.transfer_function")?)?;
+                AlbedoDesc::Grid(tf.apply(density))
+            }
+            (None, value) => {
+                let rgb = value.map_or([0.9; 3], OneOrThree::rgb);
+                if rgb.iter().any(|c| !(0.0..=1.0).contains(c)) {
+                    return Err(cx.invalid(
+                        "albedo.value",
+                        "components in [0, 1]",
+                        format!("{rgb:?}"),
+                    ));
+                }
+                AlbedoDesc::Constant(rgb)
+            }
+        })
     }
 }
 
