@@ -4,9 +4,8 @@
 //! scene's density is its `[volume]` grid file), its checks, its Mitsuba 3 export, how `volpt info`
 //! prints it, the numbers a scene takes between renders, the values serde leaves out, one example
 //! of each kind, and how each registry medium part is built from it ([`FromDescription`]): a
-//! homogeneous medium
-//! where density and albedo are constants, else a grid medium whose reads ([`GridReads`]) are the
-//! ones the description's lookup and storage ask for ([`ReadsRule`]).
+//! homogeneous medium where density and albedo are constants, else a grid medium whose reads
+//! ([`GridReads`]) are the ones the description's lookup and storage ask for ([`ReadsRule`]).
 
 use std::fmt;
 
@@ -650,6 +649,7 @@ pub enum ParamRefused {
     Value(&'static str),
 }
 
+/// `medium.albedo` of a medium whose albedo is a grid: the parameter is a constant's.
 const ALBEDO_GRID: ParamRefused = ParamRefused::NotHere {
     needs: "a constant albedo",
     found: "a grid",
