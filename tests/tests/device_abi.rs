@@ -16,88 +16,22 @@ use volpt_render::{render, with_scene, Image, RenderOptions, RenderScene, SceneV
 use volpt_scene::description::*;
 use volpt_tests::cube_scene;
 
-/// A 4x3x2 grid with values that differ in every voxel, so that any change of mapping shows.
-fn grid(channels: u32, bounds: Bounds, convention: GridConvention) -> GridDesc {
-    let n = 4 * 3 * 2 * channels as usize;
-    GridDesc {
-        layout: volpt_scene::SampleLayout::Dense,
-        resolution: [4, 3, 2],
-        channels,
-        bounds,
-        convention,
-        data: (0..n)
-            .map(|i| 0.2 + 0.8 * ((i * 7919) % n) as f32 / n as f32)
-            .collect(),
-    }
-}
-
-/// A description of every combination of the axes the factory reads: the media below, and every
-/// example of the other axes.
+/// A description of every combination of the axes the factory reads: every example of each.
 fn descriptions() -> Vec<SceneDescription> {
-    // Grids a little inside and outside the box, so that the grid's own mapping matters.
-    let grid_bounds = Bounds {
-        min: [-0.6, -0.45, -0.5],
-        max: [0.55, 0.5, 0.6],
-    };
-    // The fourth and fifth media's nearest-sample lookups select the any-layout grid media (with a
-    // constant albedo and with an albedo grid); a grid decoded with the other lookup renders a
-    // different image, so both lookups cross the ABI. The sixth reads textures of half-precision texels:
-    // decoded as f32 texels, its samples would differ. The last reads one texel per lookup
-    // (stochastic): decoded as trilinear, it would read eight.
-    let media = [
-        (
-            DensityDesc::Constant(2.0),
-            AlbedoDesc::Constant([0.9, 0.7, 0.5]),
-            GridLookup::Trilinear,
-        ),
-        (
-            DensityDesc::Grid(grid(1, grid_bounds, GridConvention::Vertex)),
-            AlbedoDesc::Constant([0.8, 0.9, 0.6]),
-            GridLookup::Trilinear,
-        ),
-        (
-            DensityDesc::Grid(grid(1, grid_bounds, GridConvention::Cell)),
-            AlbedoDesc::Grid(grid(3, grid_bounds, GridConvention::Vertex)),
-            GridLookup::Trilinear,
-        ),
-        (
-            DensityDesc::Grid(grid(1, grid_bounds, GridConvention::Vertex)),
-            AlbedoDesc::Constant([0.8, 0.9, 0.6]),
-            GridLookup::Nearest,
-        ),
-        (
-            DensityDesc::Grid(grid(1, grid_bounds, GridConvention::Cell)),
-            AlbedoDesc::Grid(grid(3, grid_bounds, GridConvention::Vertex)),
-            GridLookup::Nearest,
-        ),
-        (
-            DensityDesc::Grid(grid(1, grid_bounds, GridConvention::Cell)),
-            AlbedoDesc::Grid(grid(3, grid_bounds, GridConvention::Vertex)),
-            GridLookup::TextureHalf,
-        ),
-        (
-            DensityDesc::Grid(grid(1, grid_bounds, GridConvention::Vertex)),
-            AlbedoDesc::Grid(grid(3, grid_bounds, GridConvention::Cell)),
-            GridLookup::Stochastic,
-        ),
-    ];
-    // The other axes' examples, from their files in volpt-scene: a new kind's example there is
-    // covered here.
+    // Every axis's examples, from its file in volpt-scene: a new kind's example there is covered
+    // here.
+    let media = MediumDesc::examples();
     let boundaries = BsdfDesc::examples();
     let phases = PhaseDesc::examples();
     let environments = EnvironmentDesc::examples();
     let mut descs = Vec::new();
-    for (density, albedo, lookup) in &media {
+    for medium in &media {
         for &bsdf in &boundaries {
             for &phase in &phases {
                 for environment in &environments {
                     let medium = MediumDesc {
-                        density: density.clone(),
-                        scale: 3.0,
-                        albedo: albedo.clone(),
                         phase,
-                        lookup: *lookup,
-                        storage: GridStorage::Dense,
+                        ..medium.clone()
                     };
                     let mut desc = cube_scene(12, 9, medium, bsdf, 1.0);
                     desc.environment = environment.clone();
@@ -279,8 +213,8 @@ fn check_round_trips(descs: Vec<SceneDescription>, expected: BTreeSet<String>, l
 #[test]
 fn a_new_instantiation_needs_only_its_registry_line() {
     use volpt_core::{ConstantAlbedo, GridMedium, Isotropic, NullBoundary, VolumeScene};
-    use volpt_render::factory::parts::{MediumInput, Part};
-    use volpt_render::factory::{camera, Effects, FactoryCache};
+    use volpt_render::factory::{camera, medium_input, Effects, FactoryCache};
+    use volpt_scene::FromDescription;
 
     type New<'a> = GridMedium<'a, ConstantAlbedo, AnyLayout>;
     assert_eq!(New::NAME, "grid_density__constant_albedo__any_layout");
@@ -296,13 +230,14 @@ fn a_new_instantiation_needs_only_its_registry_line() {
                 && matches!(d.environment, EnvironmentDesc::Constant(_))
         })
         .expect("a constant albedo read in any layout");
-    let input = MediumInput::of(
+    let input = medium_input(
         &desc,
         Effects::Specialised,
         &FactoryCache::new(),
         &mut |_| (),
     );
-    let medium = <New as Part>::specialised(&input, &mut |_| ()).expect("the generic rule");
+    let medium =
+        <New as FromDescription>::specialised(&input, &mut |_| ()).expect("the generic rule");
     let EnvironmentDesc::Constant(rgb) = desc.environment else {
         unreachable!()
     };

@@ -42,6 +42,7 @@ pub use grid::{
 pub use majorant::MajorantGrid;
 pub use medium::{
     AlbedoField, ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium, Medium, ReadAs,
+    TrackedMedium,
 };
 pub use path::{Estimator, PathCounters, PathSettings, PathState, Roulette};
 pub use phase::{HenyeyGreenstein, Isotropic, PhaseFunction};

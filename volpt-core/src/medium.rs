@@ -45,6 +45,22 @@ pub trait Medium {
     }
 }
 
+/// What the host's factory derives from a medium for tracking: a medium with a density grid
+/// tracks with a majorant grid of it, computed once per scene by the host and borrowed for `'a`;
+/// the defaults fit a medium without grids. The device never calls these: it receives the
+/// majorant grid through the part's parameters ([`Component`]).
+pub trait TrackedMedium<'a> {
+    /// The density grid and its scale, whose majorant grid tightens tracking.
+    fn density(&self) -> Option<(Grid<'a, 1>, f32)> {
+        None
+    }
+
+    /// Tracks with `grid` (`None`: with the global majorant).
+    fn track_with(&mut self, grid: Option<MajorantGrid<'a>>) {
+        let _ = grid;
+    }
+}
+
 #[derive(Clone, Copy, Debug)]
 pub struct HomogeneousMedium {
     pub sigma_t: f32,
@@ -170,6 +186,18 @@ impl<A: AlbedoField, R: GridReads> Medium for GridMedium<'_, A, R> {
     #[inline(always)]
     fn albedo_random(&self, p: Vec3, bits: u64) -> Spectrum {
         self.albedo.albedo_random(p, bits)
+    }
+}
+
+impl TrackedMedium<'_> for HomogeneousMedium {}
+
+impl<'a, A, R> TrackedMedium<'a> for GridMedium<'a, A, R> {
+    fn density(&self) -> Option<(Grid<'a, 1>, f32)> {
+        Some((self.density, self.scale))
+    }
+
+    fn track_with(&mut self, grid: Option<MajorantGrid<'a>>) {
+        self.majorants = grid;
     }
 }
 

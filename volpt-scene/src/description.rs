@@ -3,13 +3,15 @@
 //! Nothing here knows about a file format or about a backend. Units are Mitsuba's: world space is
 //! whatever the scene file says, extinction coefficients are per world unit, colours are linear RGB.
 //! Every type serialises (serde), so that a render's fingerprint can take in all of it. The
-//! phase, the boundary's surface and the environment are described in their axes' files
-//! ([`crate::phase`], [`crate::boundary`], [`crate::environment`]) and named here.
+//! medium, its phase, the boundary's surface and the environment are described in their axes'
+//! files ([`crate::medium`], [`crate::phase`], [`crate::boundary`], [`crate::environment`]) and
+//! named here.
 
 use serde::Serialize;
 
 pub use crate::boundary::BsdfDesc;
 pub use crate::environment::{EnvironmentDesc, LatLongDesc, LatLongRows};
+pub use crate::medium::{AlbedoDesc, DensityDesc, GridLookup, GridStorage, MediumDesc};
 pub use crate::phase::PhaseDesc;
 
 /// An axis-aligned box in world space.
@@ -85,62 +87,6 @@ pub struct IntegratorDesc {
 pub struct BoundaryDesc {
     pub bounds: Bounds,
     pub bsdf: BsdfDesc,
-}
-
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct MediumDesc {
-    /// Density; the extinction coefficient is `scale * density`.
-    pub density: DensityDesc,
-    pub scale: f32,
-    pub albedo: AlbedoDesc,
-    pub phase: PhaseDesc,
-    /// How the medium's grids are reconstructed between their samples.
-    pub lookup: GridLookup,
-    /// How a GPU stores the medium's grids (a renderer's choice, which the description carries
-    /// so that the kernel chosen for the scene can read it).
-    pub storage: GridStorage,
-}
-
-/// How a GPU stores a medium's grids.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
-pub enum GridStorage {
-    /// Samples in x-fastest order.
-    #[default]
-    Dense,
-    /// 8^3-sample bricks, each contiguous: fewer bus transactions for volumes read across PCIe.
-    Bricked,
-}
-
-/// How a grid is reconstructed between its samples (Mitsuba 3's `filter_type`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
-pub enum GridLookup {
-    /// Trilinear interpolation of the eight samples around a point.
-    #[default]
-    Trilinear,
-    /// The value of the nearest sample.
-    Nearest,
-    /// Trilinear filtering by a GPU's texture unit, whose weights have 8 fractional bits (the CPU
-    /// computes the same filter): an approximation of `Trilinear`, one instruction per lookup.
-    Texture,
-    /// `Texture` of samples held in half precision (rounded toward zero; at most 65504).
-    TextureHalf,
-    /// One of the eight samples around a point, chosen with probability equal to its trilinear
-    /// weight: an unbiased estimate of `Trilinear` for one read (on a GPU through the texture
-    /// unit, one texel unfiltered; bricked grids in software).
-    Stochastic,
-}
-
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub enum DensityDesc {
-    Constant(f32),
-    Grid(GridDesc),
-}
-
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub enum AlbedoDesc {
-    Constant([f32; 3]),
-    /// A 3-channel grid (a 1-channel grid is expanded to grey RGB by the loader).
-    Grid(GridDesc),
 }
 
 /// Where the grid's samples sit inside its bounding box.

@@ -1,9 +1,9 @@
-//! How a registry part of the phase, boundary or environment axis is built from its description:
-//! each axis's file ([`crate::phase`], [`crate::boundary`], [`crate::environment`]) implements
+//! How a registry part of each axis is built from its description: each axis's file
+//! ([`crate::medium`], [`crate::phase`], [`crate::boundary`], [`crate::environment`]) implements
 //! [`FromDescription`] for that axis's parts (`volpt_core::variant`), and the render factory asks
-//! an axis's parts in registry order, taking the first that accepts. The medium's parts keep their
-//! rule in the factory (`volpt_render::factory::Part`, the same shape), which derives its grids'
-//! reads and majorants there.
+//! an axis's parts in registry order, taking the first that accepts. What the factory derives from
+//! a built part (a medium's majorant grid, an environment's sampling distribution) is the part's
+//! own, beside its type in `volpt-core` (`TrackedMedium`, `SampledEnvironment`).
 
 use crate::simplification::Simplification;
 

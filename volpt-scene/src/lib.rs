@@ -1,7 +1,7 @@
 //! volpt's scenes: the plain-data description a renderer consumes, and the loaders that build it.
 //!
 //! - [`description`]: the scene as plain data ([`SceneDescription`]).
-//! - [`phase`], [`boundary`], [`environment`]: one axis of the scene each, everything about its
+//! - [`medium`], [`phase`], [`boundary`], [`environment`]: one axis of the scene each, everything about its
 //!   descriptions: what they say, how each format spells them, their checks, their export, how
 //!   `volpt info` prints them, and how each registry part of the axis is built from them.
 //! - [`from_description`]: the rule from a description to a registry part ([`FromDescription`]),
@@ -35,6 +35,7 @@ pub mod error;
 pub mod from_description;
 pub mod generate;
 pub mod limits;
+pub mod medium;
 pub mod metaimage;
 pub mod mitsuba;
 pub mod normalise;
@@ -59,6 +60,7 @@ pub use builder::{builder_for, Config, SceneAssembler, SceneBuilder};
 pub use description::*;
 pub use error::{GridProblem, SceneError, VolProblem};
 pub use from_description::FromDescription;
+pub use medium::{MediumInput, ReadsRule};
 pub use metaimage::{read_metaimage, write_metaimage, MetaImageOptions};
 pub use normalise::normalise;
 pub use param::NumberParam;

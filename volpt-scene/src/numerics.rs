@@ -12,7 +12,7 @@
 
 use std::path::Path;
 
-use crate::description::{Bounds, DensityDesc, MediumDesc, SceneDescription};
+use crate::description::{Bounds, MediumDesc, SceneDescription};
 use crate::error::SceneError;
 
 /// Shortest mean free path volpt renders, in `f32` position spacings of the box. At 16 the thick
@@ -32,10 +32,7 @@ pub fn position_spacing(bounds: &Bounds) -> f32 {
 
 /// The largest extinction of the medium (delta tracking's majorant).
 pub fn max_extinction(medium: &MediumDesc) -> f32 {
-    match &medium.density {
-        DensityDesc::Constant(density) => medium.scale * density,
-        DensityDesc::Grid(grid) => medium.scale * grid.max_value(),
-    }
+    medium.max_extinction()
 }
 
 /// Refuses a scene whose mean free path is too short for `f32` positions in its box (or whose

@@ -14,10 +14,11 @@ use serde::Deserialize;
 use crate::description::*;
 use crate::error::SceneError;
 use crate::raw::{read_raw, ByteOrder, RawLayout, ScalarType};
-use crate::{normalise, read_metaimage, read_vol, read_vtk, TransferFunction};
+use crate::{normalise, read_metaimage, read_vol, read_vtk};
 
 pub use crate::boundary::{BoundarySpec, BsdfKind, Ior};
 pub use crate::environment::EnvironmentSpec;
+pub use crate::medium::AlbedoSpec;
 pub use crate::phase::PhaseSpec;
 
 #[derive(Debug, Deserialize)]
@@ -100,17 +101,6 @@ pub enum FovAxisName {
     Smaller,
     Larger,
     Diagonal,
-}
-
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct AlbedoSpec {
-    /// A transfer function file (docs/guide.md, "Transfer functions") applied to the normalised density.
-    pub transfer_function: Option<String>,
-    /// A constant albedo, grey or RGB (default 0.9 grey, unless a transfer function is given).
-    pub value: Option<OneOrThree>,
-    /// A vec3 grid of the volume's `.vdb` file holding the albedo (the thesis's RGB albedo grid).
-    pub grid: Option<String>,
 }
 
 #[derive(Clone, Copy, Debug, Deserialize)]
@@ -416,23 +406,7 @@ fn assemble(
         }
         None => None,
     };
-    let albedo = match (&file.albedo.transfer_function, file.albedo.value) {
-        _ if albedo_grid.is_some() => AlbedoDesc::Grid(albedo_grid.unwrap()),
-        (Some(_), Some(_)) => {
-            return Err(cx.invalid("albedo", "either transfer_function or value", "both"))
-        }
-        (Some(tf), None) => {
-            let tf = TransferFunction::read(&resolve(tf, "albedo.transfer_function")?)?;
-            AlbedoDesc::Grid(tf.apply(&grid))
-        }
-        (None, value) => {
-            let rgb = value.map_or([0.9; 3], OneOrThree::rgb);
-            if rgb.iter().any(|c| !(0.0..=1.0).contains(c)) {
-                return Err(cx.invalid("albedo.value", "components in [0, 1]", format!("{rgb:?}")));
-            }
-            AlbedoDesc::Constant(rgb)
-        }
-    };
+    let albedo = file.albedo.albedo(cx, albedo_grid, &grid, &resolve)?;
     let phase = file.phase.phase(cx)?;
 
     let bsdf = file.boundary.bsdf(cx)?;

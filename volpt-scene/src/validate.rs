@@ -93,61 +93,7 @@ fn check(
     desc.boundary.bsdf.check(source)?;
 
     let medium = &desc.medium;
-    if !(medium.scale.is_finite() && medium.scale >= 0.0) {
-        return Err(invalid(
-            "medium scale",
-            "a finite number >= 0",
-            medium.scale.to_string(),
-        ));
-    }
-    let max_density = match &medium.density {
-        DensityDesc::Constant(d) => {
-            if !(d.is_finite() && *d >= 0.0) {
-                return Err(invalid(
-                    "medium density",
-                    "a finite number >= 0",
-                    d.to_string(),
-                ));
-            }
-            *d
-        }
-        DensityDesc::Grid(grid) => match checked {
-            Some(data) => data.largest_density,
-            None => check_grid(grid, "density grid", f32::MAX, &invalid)?,
-        },
-    };
-    let largest_density = match &medium.density {
-        DensityDesc::Constant(_) => 0.0,
-        DensityDesc::Grid(_) => max_density,
-    };
-    let mut largest_albedo = 0.0;
-    match &medium.albedo {
-        AlbedoDesc::Constant(rgb) => {
-            if !rgb.iter().all(|a| (0.0..=1.0).contains(a)) {
-                return Err(invalid(
-                    "medium albedo",
-                    "three numbers in [0, 1]",
-                    format!("{rgb:?}"),
-                ));
-            }
-        }
-        AlbedoDesc::Grid(grid) => {
-            largest_albedo = match checked {
-                Some(data) => data.largest_albedo,
-                None => check_grid(grid, "albedo grid", 1.0, &invalid)?,
-            };
-        }
-    }
-    let sparse = matches!(&medium.density, DensityDesc::Grid(g) if g.layout == SampleLayout::Sparse)
-        || matches!(&medium.albedo, AlbedoDesc::Grid(g) if g.layout == SampleLayout::Sparse);
-    if sparse && matches!(medium.lookup, GridLookup::Texture | GridLookup::TextureHalf) {
-        return Err(invalid(
-            "grid lookup",
-            "trilinear, stochastic or nearest lookups for a sparse grid (textures hold dense grids; \
-             read the VDB dense with sparse = \"never\" to use them)",
-            format!("{:?}", medium.lookup),
-        ));
-    }
+    let (max_density, data) = medium.check(checked, &invalid)?;
     medium.phase.check(source)?;
     // Delta tracking takes about majorant x distance tentative collisions per crossing.
     let majorant = f64::from(medium.scale) * f64::from(max_density);
@@ -171,10 +117,7 @@ fn check(
     }
 
     desc.environment.check(source, checked.is_none())?;
-    Ok(CheckedData {
-        largest_density,
-        largest_albedo,
-    })
+    Ok(data)
 }
 
 /// The error of a scene whose `field` is not what it must be; `source` names the scene.
@@ -205,7 +148,7 @@ pub(crate) fn finite_matrix(m: &Matrix4) -> bool {
 }
 
 /// Checks a grid's shape, box and values (finite, in `[0, max]`); returns its largest value.
-fn check_grid(
+pub(crate) fn check_grid(
     grid: &GridDesc,
     role: &str,
     max: f32,

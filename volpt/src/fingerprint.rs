@@ -15,7 +15,7 @@ use serde::Serialize;
 use volpt_core::PathSettings;
 use volpt_film::checkpoint::Fnv;
 use volpt_render::Effects;
-use volpt_scene::{AlbedoDesc, DensityDesc, SceneDescription};
+use volpt_scene::SceneDescription;
 
 /// The fingerprint of rendering `desc` with `settings` and `effects`; `content` is [`content`]`(desc)`.
 pub fn fingerprint(
@@ -52,20 +52,10 @@ pub fn fingerprint(
 /// The values of `desc`'s grids and environment map, each with its length, hashed (FNV-1a): what
 /// the description's serialisation leaves out.
 pub fn content(desc: &SceneDescription) -> u64 {
-    let data = [
-        match &desc.medium.density {
-            DensityDesc::Grid(g) => Some(&g.data[..]),
-            DensityDesc::Constant(_) => None,
-        },
-        match &desc.medium.albedo {
-            AlbedoDesc::Grid(g) => Some(&g.data[..]),
-            AlbedoDesc::Constant(_) => None,
-        },
-        Some(desc.environment.unserialised_values()),
-    ];
+    let [density, albedo] = desc.medium.unserialised_values();
+    let data = [density, albedo, desc.environment.unserialised_values()];
     let mut hash = Fnv::default();
     for values in data {
-        let values = values.unwrap_or_default();
         hash.write(&(values.len() as u64).to_le_bytes());
         for v in values {
             hash.write(&v.to_le_bytes());

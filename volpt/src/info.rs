@@ -8,7 +8,7 @@ use volpt_render::factory::{
     default_majorants, tracking_cost, Derived, Effects, EnvironmentKind, MajorantChoice,
     MajorantRule, Parts,
 };
-use volpt_scene::{AlbedoDesc, DensityDesc, GridDesc, GridLookup, SampleLayout, SceneDescription};
+use volpt_scene::{GridDesc, SampleLayout, SceneDescription};
 
 /// A scene described field by field, in `volpt info`'s order: `scene`, `variant`, `film`,
 /// `camera`, `integrator`, `bounds`, `boundary`, `density`, `majorant`, `tracking`, `estimator`,
@@ -93,63 +93,18 @@ pub fn describe(
     );
     field("bounds", format!("{:?} .. {:?}", b.min, b.max));
     field("boundary", desc.boundary.bsdf.to_string());
-    let grid = |g: &GridDesc| {
-        let (lo, hi) = g
-            .samples()
-            .iter()
-            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &v| {
-                (lo.min(v), hi.max(v))
-            });
-        format!(
-            "grid {}x{}x{}x{}, {:?}-centred, bounds {:?} .. {:?}, values {lo} .. {hi}",
-            g.resolution[0],
-            g.resolution[1],
-            g.resolution[2],
-            g.channels,
-            g.convention,
-            g.bounds.min,
-            g.bounds.max
-        )
-    };
-    let (density, majorant) = match &m.density {
-        DensityDesc::Constant(d) => (format!("constant {d}"), m.scale * d),
-        DensityDesc::Grid(g) => (grid(g), m.scale * g.max_value()),
-    };
-    field("density", format!("{density}, scale {}", m.scale));
-    field("majorant", format!("{majorant} per unit length"));
+    field("density", format!("{}, scale {}", m.density, m.scale));
+    field(
+        "majorant",
+        format!("{} per unit length", m.max_extinction()),
+    );
     field("tracking", tracking(desc, &parts, settings));
     field("estimator", estimator(&parts, settings).to_owned());
-    let albedo = match &m.albedo {
-        AlbedoDesc::Constant(rgb) => format!("constant {rgb:?}"),
-        AlbedoDesc::Grid(g) => grid(g),
-    };
-    field("albedo", albedo);
-    let mut memory = Vec::new();
-    if let DensityDesc::Grid(g) = &m.density {
-        memory.push(grid_memory("density", g));
-    }
-    if let AlbedoDesc::Grid(g) = &m.albedo {
-        memory.push(grid_memory("albedo", g));
-    }
+    field("albedo", m.albedo.to_string());
+    let memory: Vec<_> = m.grids().map(|(name, g)| grid_memory(name, g)).collect();
     if !memory.is_empty() {
         field("memory", memory.join("\n"));
-    }
-    let grids =
-        matches!(m.density, DensityDesc::Grid(_)) || matches!(m.albedo, AlbedoDesc::Grid(_));
-    if grids {
-        let lookup = match m.lookup {
-            GridLookup::Trilinear => {
-                "trilinear (without --lookup, a GPU with fast math reads stochastic lookups \
-                 instead where the grids fit in its memory)"
-            }
-            GridLookup::Nearest => "nearest (biased: a blockier field)",
-            GridLookup::Texture => "texture (the texture unit's filter, 8-bit weights: biased)",
-            GridLookup::TextureHalf => "texture-f16 (half-precision texels, 8-bit weights: biased)",
-            GridLookup::Stochastic => {
-                "stochastic (one sample chosen by its trilinear weight: unbiased)"
-            }
-        };
-        field("lookup", lookup.to_owned());
+        field("lookup", m.lookup.info().to_owned());
     }
     field(
         "math",

@@ -10,11 +10,12 @@ use volpt_core::PathSettings;
 use volpt_film::{Film, RenderOptions};
 use volpt_render::factory::{FactoryCache, Parts};
 use volpt_render::{Effects, Variant};
+use volpt_scene::medium::{MediumParam, ParamRefused};
 use volpt_scene::toml_scene::look_at;
 use volpt_scene::validate::CheckedData;
 use volpt_scene::{
-    AlbedoDesc, DensityDesc, GridDesc, GridLookup, GridStorage, NumberParam, PhaseDesc,
-    SampleLayout, SceneAssembler, SceneBuilder, SceneDescription,
+    GridLookup, GridStorage, MediumDesc, NumberParam, PhaseDesc, SampleLayout, SceneAssembler,
+    SceneBuilder, SceneDescription,
 };
 
 use crate::settings::RenderSettings;
@@ -100,22 +101,27 @@ pub enum ParamValue {
 }
 
 /// The parameters a scene takes between renders: key and what it is. The scene's own, then the
-/// phase's ([`PhaseDesc::PARAMS`]).
-pub const PARAMS: &[(&str, &str)] = &with_numbers::<{ SCENE_PARAMS.len() + PhaseDesc::PARAMS.len() }>(
-    SCENE_PARAMS,
-    PhaseDesc::PARAMS,
-);
+/// medium's ([`MediumDesc::PARAMS`]), then the phase's ([`PhaseDesc::PARAMS`]).
+pub const PARAMS: &[(&str, &str)] = &with_numbers::<
+    { SCENE_PARAMS.len() + MediumDesc::PARAMS.len() + PhaseDesc::PARAMS.len() },
+>(&[SCENE_PARAMS, MediumDesc::PARAMS], PhaseDesc::PARAMS);
 
-/// `keys`, then the key and description of each of `numbers`, `N` in all.
+/// Each of `keys`, then the key and description of each of `numbers`, `N` in all.
 const fn with_numbers<const N: usize>(
-    keys: &[(&'static str, &'static str)],
+    keys: &[&[(&'static str, &'static str)]],
     numbers: &[NumberParam],
 ) -> [(&'static str, &'static str); N] {
     let mut all = [("", ""); N];
     let mut i = 0;
-    while i < keys.len() {
-        all[i] = keys[i];
-        i += 1;
+    let mut k = 0;
+    while k < keys.len() {
+        let mut n = 0;
+        while n < keys[k].len() {
+            all[i] = keys[k][n];
+            i += 1;
+            n += 1;
+        }
+        k += 1;
     }
     let mut j = 0;
     while j < numbers.len() {
@@ -153,14 +159,6 @@ const SCENE_PARAMS: &[(&str, &str)] = &[
     (
         "camera.fov",
         "the field of view in degrees along the scene's fov axis, in (0, 180)",
-    ),
-    (
-        "medium.scale",
-        "the density's scale (extinction = scale x density), finite and >= 0",
-    ),
-    (
-        "medium.albedo",
-        "the constant single-scattering albedo, RGB in [0, 1] (not a grid's)",
     ),
 ];
 
@@ -300,16 +298,7 @@ impl Scene {
             let channels = if g.channels == 1 { 1 } else { 4 };
             g.resolution.iter().map(|&r| u64::from(r)).product::<u64>() * channels * 4
         };
-        let m = &self.desc.medium;
-        let density = match &m.density {
-            DensityDesc::Grid(g) => bytes(g),
-            DensityDesc::Constant(_) => 0,
-        };
-        let albedo = match &m.albedo {
-            AlbedoDesc::Grid(g) => bytes(g),
-            AlbedoDesc::Constant(_) => 0,
-        };
-        density + albedo
+        self.desc.medium.grids().map(|(_, g)| bytes(g)).sum()
     }
 
     /// How a GPU stores the grids (the backend's choice: [`crate::Backend::prepare`]).
@@ -343,14 +332,12 @@ impl Scene {
             "camera.target" => ParamValue::Vec3(self.look_at().1),
             "camera.up" => ParamValue::Vec3(self.look_at().2),
             "camera.fov" => ParamValue::Float(d.camera.fov_degrees),
-            "medium.scale" => ParamValue::Float(d.medium.scale),
-            "medium.albedo" => match &d.medium.albedo {
-                AlbedoDesc::Constant(rgb) => ParamValue::Rgb(*rgb),
-                AlbedoDesc::Grid(_) => return Err(not_here(key, "a constant albedo", "a grid")),
-            },
-            _ => match d.medium.phase.param(key) {
-                Some(value) => ParamValue::Float(value),
-                None => return Err(unknown(key)),
+            _ => match (d.medium.param(key), d.medium.phase.param(key)) {
+                (Some(Ok(MediumParam::Float(v))), _) => ParamValue::Float(v),
+                (Some(Ok(MediumParam::Rgb(v))), _) => ParamValue::Rgb(v),
+                (Some(Err(refused)), _) => return Err(refusal(key, refused, "")),
+                (None, Some(value)) => ParamValue::Float(value),
+                (None, None) => return Err(unknown(key)),
             },
         })
     }
@@ -432,19 +419,16 @@ impl Scene {
             "camera.fov" => {
                 d.camera.fov_degrees = float(&|v| v > 0.0 && v < 180.0, "degrees in (0, 180)")?
             }
-            "medium.scale" => {
-                d.medium.scale = float(&|v| v.is_finite() && v >= 0.0, "a finite number >= 0")?
-            }
-            "medium.albedo" => match &mut d.medium.albedo {
-                AlbedoDesc::Constant(rgb) => {
-                    let v = vec3()?;
-                    if !v.iter().all(|c| (0.0..=1.0).contains(c)) {
-                        return Err(wrong("RGB in [0, 1]"));
-                    }
-                    *rgb = v;
+            _ if MediumDesc::PARAMS.iter().any(|&(k, _)| k == key) => {
+                let medium = match value {
+                    ParamValue::Int(v) => MediumParam::Float(v as f32),
+                    ParamValue::Float(v) => MediumParam::Float(v),
+                    ParamValue::Rgb(v) | ParamValue::Vec3(v) => MediumParam::Rgb(v),
+                };
+                if let Some(Err(refused)) = d.medium.set_param(key, medium) {
+                    return Err(refusal(key, refused, &format!("{value:?}")));
                 }
-                AlbedoDesc::Grid(_) => return Err(not_here(key, "a constant albedo", "a grid")),
-            },
+            }
             _ => {
                 let Some(number) = PhaseDesc::PARAMS.iter().find(|p| p.key == key) else {
                     return Err(unknown(key));
@@ -474,11 +458,10 @@ impl Scene {
             camera: d.camera,
             spp: d.spp,
             integrator: d.integrator,
-            scale: d.medium.scale,
-            albedo: match &d.medium.albedo {
-                AlbedoDesc::Constant(rgb) => Some(*rgb),
-                AlbedoDesc::Grid(_) => None,
-            },
+            medium: MediumDesc::PARAMS
+                .iter()
+                .filter_map(|&(key, _)| Some((key, d.medium.param(key)?.ok()?)))
+                .collect(),
             phase: d.medium.phase,
             path: self.path,
             seed: self.seed,
@@ -491,9 +474,9 @@ impl Scene {
         d.camera = l.camera;
         d.spp = l.spp;
         d.integrator = l.integrator;
-        d.medium.scale = l.scale;
-        if let (Some(rgb), AlbedoDesc::Constant(now)) = (l.albedo, &mut d.medium.albedo) {
-            *now = rgb;
+        for (key, value) in l.medium {
+            // Each value was the medium's own, which its parameter takes.
+            let _ = d.medium.set_param(key, value);
         }
         d.medium.phase = l.phase;
         self.path = l.path;
@@ -506,8 +489,8 @@ struct Light {
     camera: volpt_scene::CameraDesc,
     spp: u32,
     integrator: volpt_scene::IntegratorDesc,
-    scale: f32,
-    albedo: Option<[f32; 3]>,
+    /// The medium's parameters that it has ([`MediumDesc::param`]).
+    medium: Vec<(&'static str, MediumParam)>,
     phase: PhaseDesc,
     path: PathSettings,
     seed: u32,
@@ -539,7 +522,12 @@ fn unknown(key: &str) -> Error {
     }
 }
 
-fn not_here(key: &str, expected: &str, found: &str) -> Error {
+/// The error of a parameter the medium refuses; `value` is the value given, as the error shows it.
+fn refusal(key: &str, refused: ParamRefused, value: &str) -> Error {
+    let (expected, found) = match refused {
+        ParamRefused::NotHere { needs, found } => (needs, found),
+        ParamRefused::Value(expected) => (expected, value),
+    };
     Error::Param {
         key: key.to_owned(),
         expected: expected.to_owned(),
@@ -554,9 +542,7 @@ fn check_lookup(desc: &SceneDescription, checked: CheckedData) -> Result<(), Err
         desc.medium.lookup,
         GridLookup::Texture | GridLookup::TextureHalf
     );
-    let sparse = |g: &GridDesc| g.layout == SampleLayout::Sparse;
-    let sparse = matches!(&desc.medium.density, DensityDesc::Grid(g) if sparse(g))
-        || matches!(&desc.medium.albedo, AlbedoDesc::Grid(g) if sparse(g));
+    let sparse = (desc.medium.grids()).any(|(_, g)| g.layout == SampleLayout::Sparse);
     if texture && sparse {
         return Err(Error::Settings(
             "--lookup texture and texture-f16 read dense grids, and this scene's grid is kept \
@@ -568,23 +554,7 @@ fn check_lookup(desc: &SceneDescription, checked: CheckedData) -> Result<(), Err
     if desc.medium.lookup != GridLookup::TextureHalf {
         return Ok(());
     }
-    let largest = [
-        (
-            "density",
-            match &desc.medium.density {
-                DensityDesc::Constant(v) => *v,
-                DensityDesc::Grid(_) => checked.largest_density,
-            },
-        ),
-        (
-            "albedo",
-            match &desc.medium.albedo {
-                AlbedoDesc::Constant(rgb) => rgb.iter().copied().fold(0.0, f32::max),
-                AlbedoDesc::Grid(_) => checked.largest_albedo,
-            },
-        ),
-    ];
-    for (name, largest) in largest {
+    for (name, largest) in desc.medium.largest_values(checked) {
         if largest > HALF_MAX {
             return Err(Error::Settings(format!(
                 "--lookup texture-f16: the medium's largest {name} is {largest}, above half \

@@ -6,15 +6,14 @@
 //! constant or lat-long environment. The axes and their values are the variant registry's
 //! ([`volpt_core::variant`]): from it this module generates one enum per axis ([`MediumPart`], ...,
 //! holding the built part), the choice of each axis's part (the first in registry order whose
-//! rule represents the description: [`Part`] for a medium, [`FromDescription`] in `volpt-scene`'s
-//! axis files for the other axes) and the one exhaustive `match` that turns four built parts into
-//! a scene type. Nothing here names a part: a registry line and the part's rule are all a new part
+//! rule represents the description: [`FromDescription`], in `volpt-scene`'s axis files) and the one
+//! exhaustive `match` that turns four built parts into a scene type. Nothing here names a part: a registry line and the part's rule are all a new part
 //! needs. A backend receives the scene through [`SceneVisitor`], so one generic function serves
 //! every variant.
 //!
 //! - this file: the axis enums, the choice and the dispatch, [`Parts`] and what is derived from
 //!   them;
-//! - [`parts`]: each medium's rule from the description to the part;
+//! - [`parts`]: what the media's rules read, with what the cache knows of the grids;
 //! - [`cache`]: what the factory reads from a scene's grids, kept between builds of one scene
 //!   ([`FactoryCache`]);
 //! - [`camera`](camera()) and [`path_settings`]: the camera and integrator settings a file asks for;
@@ -31,34 +30,26 @@ pub use camera::camera;
 pub use majorant_choice::{
     default_majorants, tracking_cost, MajorantChoice, MajorantRule, TrackingCost,
 };
-pub use parts::{Part, ReadsRule};
+pub use parts::{medium_input, MediumInput, ReadsRule};
 pub use settings::{default_estimator, path_settings};
 pub use volpt_scene::{FromDescription, Simplification};
 
-use parts::{aabb, MediumInput, TrackedMedium};
-use volpt_core::SampledEnvironment;
+use parts::aabb;
+use volpt_core::{SampledEnvironment, TrackedMedium};
 use volpt_scene::BoundaryInput;
 
 use std::fmt;
 
 use std::sync::Arc;
 use volpt_core::abi::SceneAbi;
-use volpt_core::grid::{
-    AnyLayout, DenseTrilinear, Grid, GridLookup, GridMapping, GridReads, TexelFormat,
-    TextureTrilinear,
-};
+use volpt_core::grid::Grid;
 
 use volpt_core::majorant::MajorantGrid;
 use volpt_core::math::tan;
 use volpt_core::path::Estimator;
-use volpt_core::{
-    Aabb, ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium, PathSettings,
-    PerspectiveCamera, Scene, Spectrum, Vec2, Vec3, VolumeScene,
-};
+use volpt_core::{Aabb, PathSettings, PerspectiveCamera, Scene, Vec2, Vec3, VolumeScene};
 use volpt_scene::description::{
-    AlbedoDesc, Bounds, BsdfDesc, CameraDesc, DensityDesc, EnvironmentDesc, FilmDesc, FovAxis,
-    GridConvention, GridDesc, GridLookup as GridLookupDesc, GridStorage, MediumDesc, PhaseDesc,
-    SampleLayout, SceneDescription,
+    Bounds, BsdfDesc, CameraDesc, EnvironmentDesc, FilmDesc, FovAxis, PhaseDesc, SceneDescription,
 };
 
 /// What a backend can render: the CPU needs a [`Scene`] it can share between threads, a GPU backend
@@ -75,7 +66,7 @@ pub trait SceneVisitor {
 
 /// One axis: the enum of its built parts, the enum of its kinds (the part without its data), and
 /// the choice of its part for a description: the first part of the registry's order whose
-/// `$rule` (a trait of [`Part`]'s shape) accepts. Axes whose parts borrow grids or maps from the
+/// `$rule` ([`FromDescription`]) accepts. Axes whose parts borrow grids or maps from the
 /// description take its lifetime `'a`.
 macro_rules! axis {
     ($(#[$doc:meta])* $part:ident $(<$lt:lifetime>)?, $kind:ident, $input:ty, $rule:ident,
@@ -145,7 +136,7 @@ macro_rules! factory {
         ($P:ident, $p:ident, $pt:ty) ($E:ident, $e:ident, $et:ty)])*]) => {
         axis!(
             /// The medium: extinction and albedo.
-            MediumPart<'a>, MediumKind, MediumInput<'a>, Part, [$(($Mv, $mv, $mvt))*]
+            MediumPart<'a>, MediumKind, MediumInput<'a>, FromDescription, [$(($Mv, $mv, $mvt))*]
         );
         axis!(
             /// The boundary of the medium's box.
@@ -308,7 +299,7 @@ impl<'a> Parts<'a> {
     pub fn of_cached(desc: &'a SceneDescription, effects: Effects, cache: &FactoryCache) -> Self {
         let mut simplifications = Vec::new();
         let mut fired = |rule| simplifications.push(rule);
-        let medium = MediumInput::of(desc, effects, cache, &mut fired);
+        let medium = medium_input(desc, effects, cache, &mut fired);
         Self {
             medium: MediumPart::choose(&medium, effects, &mut fired),
             boundary: BoundaryPart::choose(&BoundaryInput::of(desc), effects, &mut fired),

@@ -1,37 +1,28 @@
-//! From a medium's description to the medium part of a scene: each registry medium says when it
-//! represents the description exactly and how it is built ([`Part`]), and the factory asks them in
-//! registry order. A part is simpler than the description names only where the two are exactly
-//! equal ([`Simplification`]).
-//!
-//! - [`medium`]: the media, and which [`GridReads`] the description's lookup and storage ask for.
-//!
-//! The phase, boundary and environment parts have their rules beside their descriptions, in
-//! `volpt-scene`'s axis files ([`volpt_scene::FromDescription`]): their parts need nothing the
-//! factory derives. A medium's rule stays here because the factory derives its grids' reads
-//! ([`ReadsRule`]) and its majorant grid ([`TrackedMedium`]) from the built part.
+//! What the factory builds every medium from: the description's medium with each grid of one
+//! value over the box as that constant, found with the factory's [`FactoryCache`]. The media's
+//! rules ([`FromDescription`] for each registry medium, and which [`volpt_core::grid::GridReads`]
+//! the description's lookup and storage ask for, [`ReadsRule`]) are in `volpt-scene`'s medium file
+//! ([`volpt_scene::medium`]), beside the phase's, the boundary's and the environment's.
 
 use super::*;
 
-pub mod medium;
+pub use volpt_scene::medium::IsUniform;
+pub use volpt_scene::{MediumInput, ReadsRule};
 
-pub use medium::{MediumInput, ReadsRule, TrackedMedium};
-
-/// A registry medium as the factory builds it from a scene description
-/// ([`volpt_scene::FromDescription`]'s shape, which a trait of `volpt-scene` cannot have for the
-/// media's rules here). The factory asks the media in registry order ([`volpt_core::variant`]) and
-/// takes the first that accepts, so the axis lists its specialised parts before its general ones;
-/// a part needs no other edit of the factory.
-pub trait Part<'a>: Sized {
-    /// What the factory reads from the description for this axis, once for all its parts.
-    type Input;
-
-    /// This part for `input`, if it represents it exactly; `fired` hears of each
-    /// [`Simplification`] that made it simpler than the description names.
-    fn specialised(input: &Self::Input, fired: &mut dyn FnMut(Simplification)) -> Option<Self>;
-
-    /// This part for `input`, if it is the most general part of its axis that represents it
-    /// exactly ([`Effects::General`]).
-    fn general(input: &Self::Input) -> Option<Self>;
+/// `desc`'s medium as the factory's medium parts read it: for [`Effects::Specialised`], a grid of
+/// one value over the box as that constant (each such grid reported to `fired`).
+pub fn medium_input<'a>(
+    desc: &'a SceneDescription,
+    effects: Effects,
+    cache: &FactoryCache,
+    fired: &mut dyn FnMut(Simplification),
+) -> MediumInput<'a> {
+    let is_uniform = |data: &[f32], channels: usize| cache.is_uniform(data, channels);
+    let is_uniform: Option<&IsUniform<'_>> = match effects {
+        Effects::Specialised => Some(&is_uniform),
+        Effects::General => None,
+    };
+    MediumInput::of(desc, is_uniform, fired)
 }
 
 pub(super) fn aabb(b: &Bounds) -> Aabb {

@@ -18,9 +18,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use crate::description::{
-    AlbedoDesc, Bounds, DensityDesc, FovAxis, GridConvention, GridDesc, Matrix4, SceneDescription,
-};
+use crate::description::{Bounds, FovAxis, GridConvention, GridDesc, Matrix4, SceneDescription};
 use crate::error::SceneError;
 use crate::output::create_dir;
 use crate::vol::{write_vol, VolGrid};
@@ -84,17 +82,7 @@ pub fn write_mitsuba3(
     };
 
     let medium = &desc.medium;
-    let (medium_type, sigma_t) = match &medium.density {
-        DensityDesc::Constant(d) => (
-            "homogeneous",
-            format!("<float name=\"sigma_t\" value=\"{d}\"/>"),
-        ),
-        DensityDesc::Grid(g) => ("heterogeneous", grid(g, "density", "sigma_t")?),
-    };
-    let albedo = match &medium.albedo {
-        AlbedoDesc::Constant(rgb) => rgb_element("albedo", rgb),
-        AlbedoDesc::Grid(g) => grid(g, "albedo", "albedo")?,
-    };
+    let (medium_type, sigma_t, albedo) = medium.to_mitsuba3(&mut grid)?;
     let phase = medium.phase.to_mitsuba3();
     let bsdf = desc.boundary.bsdf.to_mitsuba3();
     let emitter = desc

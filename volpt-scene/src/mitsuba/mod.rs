@@ -15,7 +15,6 @@ pub(crate) mod emitter;
 pub(crate) mod export;
 mod integrator;
 pub(crate) mod ior;
-mod medium;
 mod obj;
 pub(crate) mod plugin;
 pub(crate) mod preprocess;
@@ -23,7 +22,7 @@ mod sensor;
 mod shape;
 pub(crate) mod spectrum;
 pub(crate) mod transform;
-mod volume;
+pub(crate) mod volume;
 pub(crate) mod xml;
 
 use std::path::Path;

@@ -4,7 +4,6 @@
 //! `toWorld`) or as an `obj` mesh; either is accepted when the result is exactly such a box.
 
 use super::boxes::{box_from_corners, transformed_box};
-use super::medium::medium;
 use super::obj::obj_vertices;
 use super::plugin::{invalid, Ctx, Plugin};
 use super::transform::{apply_point, transform, IDENTITY_F64};
@@ -115,7 +114,7 @@ pub(crate) fn boundary(
         ));
     };
     let surface = BsdfDesc::from_mitsuba(surface.target, ctx)?;
-    let medium = medium(interior.target, ctx)?;
+    let medium = MediumDesc::from_mitsuba(interior.target, ctx)?;
     p.finish()?;
     Ok((
         BoundaryDesc {

@@ -1,0 +1,972 @@
+//! The medium, everything about its descriptions in one place: what a description says
+//! ([`MediumDesc`]: its density, albedo, grid lookup and storage; its phase function is
+//! [`crate::phase`]'s), how Mitsuba's `<medium>` and a TOML scene's `[albedo]` spell it (a TOML
+//! scene's density is its `[volume]` grid file), its checks, its Mitsuba 3 export, how `volpt info`
+//! prints it, the numbers a scene takes between renders, the values serde leaves out, one example
+//! of each kind, and how each registry medium part is built from it ([`FromDescription`]): a
+//! homogeneous medium where density and albedo are constants, else a grid medium whose reads
+//! ([`GridReads`]) are the ones the description's lookup and storage ask for ([`ReadsRule`]).
+
+use std::fmt;
+
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+use volpt_core::grid::{
+    AnyLayout, DenseTrilinear, Grid, GridLookup as CoreLookup, GridMapping, GridReads, TexelFormat,
+    TextureTrilinear,
+};
+use volpt_core::{Aabb, ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium, Spectrum, Vec3};
+
+use crate::description::{Bounds, GridConvention, GridDesc, SampleLayout, SceneDescription};
+use crate::error::SceneError;
+use crate::from_description::FromDescription;
+use crate::mitsuba::export::rgb_element;
+use crate::mitsuba::plugin::{quoted, Arg, Ctx, Plugin};
+use crate::mitsuba::preprocess::Dialect;
+use crate::mitsuba::volume::{constant_error, volume, Role, VolumeValue};
+use crate::mitsuba::xml::Element;
+use crate::phase::PhaseDesc;
+use crate::simplification::Simplification;
+use crate::toml_scene::{Cx, OneOrThree};
+use crate::transfer::TransferFunction;
+use crate::validate::{check_grid, CheckedData};
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct MediumDesc {
+    /// Density; the extinction coefficient is `scale * density`.
+    pub density: DensityDesc,
+    pub scale: f32,
+    pub albedo: AlbedoDesc,
+    pub phase: PhaseDesc,
+    /// How the medium's grids are reconstructed between their samples.
+    pub lookup: GridLookup,
+    /// How a GPU stores the medium's grids (a renderer's choice, which the description carries
+    /// so that the kernel chosen for the scene can read it).
+    pub storage: GridStorage,
+}
+
+/// How a GPU stores a medium's grids.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub enum GridStorage {
+    /// Samples in x-fastest order.
+    #[default]
+    Dense,
+    /// 8^3-sample bricks, each contiguous: fewer bus transactions for volumes read across PCIe.
+    Bricked,
+}
+
+/// How a grid is reconstructed between its samples (Mitsuba 3's `filter_type`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub enum GridLookup {
+    /// Trilinear interpolation of the eight samples around a point.
+    #[default]
+    Trilinear,
+    /// The value of the nearest sample.
+    Nearest,
+    /// Trilinear filtering by a GPU's texture unit, whose weights have 8 fractional bits (the CPU
+    /// computes the same filter): an approximation of `Trilinear`, one instruction per lookup.
+    Texture,
+    /// `Texture` of samples held in half precision (rounded toward zero; at most 65504).
+    TextureHalf,
+    /// One of the eight samples around a point, chosen with probability equal to its trilinear
+    /// weight: an unbiased estimate of `Trilinear` for one read (on a GPU through the texture
+    /// unit, one texel unfiltered; bricked grids in software).
+    Stochastic,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub enum DensityDesc {
+    Constant(f32),
+    Grid(GridDesc),
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub enum AlbedoDesc {
+    Constant([f32; 3]),
+    /// A 3-channel grid (a 1-channel grid is expanded to grey RGB by the loader).
+    Grid(GridDesc),
+}
+
+/// Mitsuba 3's defaults for `sigma_t` and `albedo`.
+const DEFAULT_SIGMA_T: f32 = 1.0;
+const DEFAULT_ALBEDO: f32 = 0.75;
+
+impl MediumDesc {
+    /// Mitsuba's interior `<medium>`: `homogeneous` or `heterogeneous`, with its phase function.
+    ///
+    /// volpt tracks a grey extinction with an RGB albedo, so extinction must be equal in R, G and
+    /// B; the albedo may vary. Parameter names differ between generations (Mitsuba 0.6 `sigmaA`,
+    /// `sigmaS`, `density`; Mitsuba 3 `sigma_t`, `albedo`) and both are accepted in either. Where
+    /// a parameter is absent, Mitsuba 3's defaults apply (extinction 1, albedo 0.75); Mitsuba 0.6
+    /// has material-preset defaults volpt does not carry, so there it must be given.
+    pub(crate) fn from_mitsuba(el: &Element, ctx: &Ctx<'_>) -> Result<Self, SceneError> {
+        let p = Plugin::new(el, ctx);
+        let kind = p.kind()?;
+        if kind != "homogeneous" && kind != "heterogeneous" {
+            return Err(p.unsupported("volpt's media are homogeneous and heterogeneous"));
+        }
+        if let Some(arg) = p.find(&["densityMultiplier"])? {
+            return Err(SceneError::Unsupported {
+                path: arg.written.file.to_path_buf(),
+                line: arg.written.line,
+                what: arg.written.describe(),
+                reason: "this old name is not read: use <float name=\"scale\"> instead".into(),
+            });
+        }
+        if let Some(arg) = p.find(&["material"])? {
+            return Err(SceneError::Unsupported {
+                path: arg.written.file.to_path_buf(),
+                line: arg.written.line,
+                what: arg.written.describe(),
+                reason: "volpt has no material presets: give the coefficients (sigma_t and albedo)"
+                    .into(),
+            });
+        }
+        let scale = match p.find(&["scale"])? {
+            None => 1.0,
+            Some(arg) => {
+                let v = arg.float()?;
+                if v < 0.0 {
+                    return Err(arg.invalid("a scale >= 0", quoted(arg.value()?)));
+                }
+                v
+            }
+        };
+        let phase = match p.object("phase")? {
+            Some(arg) => PhaseDesc::from_mitsuba(arg.target, ctx)?,
+            None => PhaseDesc::Isotropic,
+        };
+        let (density, albedo) = if kind == "homogeneous" {
+            homogeneous(&p)?
+        } else {
+            heterogeneous(&p)?
+        };
+        // Sampling hints for Mitsuba's integrators.
+        p.ignore(&["sample_emitters", "has_spectral_extinction", "stepSize"]);
+        p.finish()?;
+        Ok(MediumDesc {
+            density,
+            scale,
+            albedo,
+            phase,
+            lookup: Default::default(),
+            storage: Default::default(),
+        })
+    }
+}
+
+fn homogeneous(p: &Plugin<'_>) -> Result<(DensityDesc, AlbedoDesc), SceneError> {
+    let sigma_a = p.find(&["sigmaA", "sigma_a"])?;
+    let sigma_s = p.find(&["sigmaS", "sigma_s"])?;
+    let sigma_t = p.find(&["sigmaT", "sigma_t"])?;
+    let albedo = p.find(&["albedo"])?;
+    match (sigma_a, sigma_s) {
+        (Some(a_arg), Some(s_arg)) => {
+            if let Some(extra) = sigma_t.or(albedo) {
+                return Err(extra.invalid(
+                    "either sigmaA and sigmaS, or sigmaT and albedo",
+                    "both kinds",
+                ));
+            }
+            let a = non_negative(&a_arg, constant(p, &a_arg)?)?;
+            let s = non_negative(&s_arg, constant(p, &s_arg)?)?;
+            let t = [a[0] + s[0], a[1] + s[1], a[2] + s[2]];
+            let grey_t = grey(
+                &a_arg,
+                "sigmaA + sigmaS equal in R, G and B (volpt's extinction is grey)",
+                t,
+            )?;
+            let albedo = s.map(|s| if grey_t > 0.0 { s / grey_t } else { 0.0 });
+            Ok((DensityDesc::Constant(grey_t), AlbedoDesc::Constant(albedo)))
+        }
+        (Some(one), None) | (None, Some(one)) => {
+            Err(one.invalid("sigmaA and sigmaS given together", "only one of them"))
+        }
+        (None, None) => {
+            let sigma_t = match sigma_t {
+                Some(arg) => {
+                    let v = non_negative(&arg, constant(p, &arg)?)?;
+                    grey(
+                        &arg,
+                        "an extinction equal in R, G and B (volpt's extinction is grey)",
+                        v,
+                    )?
+                }
+                None => default_for(
+                    p,
+                    DEFAULT_SIGMA_T,
+                    "<float name=\"sigma_t\"> (or sigmaA and sigmaS)",
+                )?,
+            };
+            let albedo = match albedo {
+                Some(arg) => in_unit_range(&arg, constant(p, &arg)?)?,
+                None => [default_for(p, DEFAULT_ALBEDO, "<rgb name=\"albedo\">")?; 3],
+            };
+            Ok((DensityDesc::Constant(sigma_t), AlbedoDesc::Constant(albedo)))
+        }
+    }
+}
+
+fn heterogeneous(p: &Plugin<'_>) -> Result<(DensityDesc, AlbedoDesc), SceneError> {
+    let density = match p.find(&["density", "sigma_t"])? {
+        None => DensityDesc::Constant(default_for(
+            p,
+            DEFAULT_SIGMA_T,
+            "<volume name=\"density\">",
+        )?),
+        Some(arg) => match volume(&arg, p.ctx, Role::Density)? {
+            VolumeValue::Grid(grid) => DensityDesc::Grid(grid),
+            VolumeValue::Constant(v) => {
+                let v = non_negative(&arg, v)?;
+                DensityDesc::Constant(grey(
+                    &arg,
+                    "an extinction equal in R, G and B (volpt's extinction is grey)",
+                    v,
+                )?)
+            }
+        },
+    };
+    let albedo = match p.find(&["albedo"])? {
+        None => {
+            AlbedoDesc::Constant([default_for(p, DEFAULT_ALBEDO, "<volume name=\"albedo\">")?; 3])
+        }
+        Some(arg) => match volume(&arg, p.ctx, Role::Albedo)? {
+            VolumeValue::Grid(grid) => AlbedoDesc::Grid(grid),
+            VolumeValue::Constant(v) => AlbedoDesc::Constant(in_unit_range(&arg, v)?),
+        },
+    };
+    if let Some(arg) = p.find(&["method"])? {
+        let raw = arg.string()?;
+        if !raw.trim().eq_ignore_ascii_case("woodcock") {
+            tracing::warn!(
+                "{}:{}: {} value {}: volpt always uses delta (Woodcock) tracking, which is unbiased",
+                arg.target.file.display(),
+                arg.target.line,
+                arg.target.describe(),
+                quoted(raw)
+            );
+        }
+    }
+    Ok((density, albedo))
+}
+
+/// A constant parameter of a homogeneous medium (a grid would need a heterogeneous one).
+fn constant(p: &Plugin<'_>, arg: &Arg<'_>) -> Result<[f32; 3], SceneError> {
+    match volume(arg, p.ctx, Role::Density)? {
+        VolumeValue::Constant(v) => Ok(v),
+        VolumeValue::Grid(_) => Err(SceneError::Unsupported {
+            path: arg.target.file.to_path_buf(),
+            line: arg.target.line,
+            what: arg.target.describe(),
+            reason: "a grid in a homogeneous medium: use <medium type=\"heterogeneous\">".into(),
+        }),
+    }
+}
+
+/// Mitsuba 3's default, or an error in a Mitsuba 0.6 scene (whose defaults are presets).
+fn default_for(p: &Plugin<'_>, value: f32, what: &str) -> Result<f32, SceneError> {
+    match p.ctx.dialect {
+        Dialect::Mitsuba3 => Ok(value),
+        Dialect::Mitsuba06 => Err(p.missing(format!(
+            "{what} (Mitsuba 0.6 would fall back to a material preset, which volpt does not have)"
+        ))),
+    }
+}
+
+fn grey(arg: &Arg<'_>, expected: &str, v: [f32; 3]) -> Result<f32, SceneError> {
+    let max = v.iter().fold(0.0f32, |m, c| m.max(c.abs()));
+    if v.iter().all(|c| (c - v[0]).abs() <= 1e-6 * max) {
+        Ok(v[0])
+    } else {
+        Err(constant_error(arg, expected, v))
+    }
+}
+
+fn non_negative(arg: &Arg<'_>, v: [f32; 3]) -> Result<[f32; 3], SceneError> {
+    if v.iter().all(|&c| c >= 0.0) {
+        Ok(v)
+    } else {
+        Err(constant_error(arg, "a coefficient >= 0", v))
+    }
+}
+
+fn in_unit_range(arg: &Arg<'_>, v: [f32; 3]) -> Result<[f32; 3], SceneError> {
+    if v.iter().all(|c| (0.0..=1.0).contains(c)) {
+        Ok(v)
+    } else {
+        Err(constant_error(arg, "an albedo in [0, 1]", v))
+    }
+}
+
+/// A TOML scene's `[albedo]` (its density is `[volume]`'s grid).
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AlbedoSpec {
+    /// A transfer function file (docs/guide.md, "Transfer functions") applied to the normalised density.
+    pub transfer_function: Option<String>,
+    /// A constant albedo, grey or RGB (default 0.9 grey, unless a transfer function is given).
+    pub value: Option<OneOrThree>,
+    /// A vec3 grid of the volume's `.vdb` file holding the albedo (the thesis's RGB albedo grid).
+    pub grid: Option<String>,
+}
+
+impl AlbedoSpec {
+    /// The albedo `[albedo]` describes: `grid` where it names one (read from the volume's file),
+    /// a transfer function applied to the `density` grid, or a constant; `resolve` makes a path
+    /// of the file relative to the scene's.
+    pub(crate) fn albedo(
+        &self,
+        cx: &Cx<'_>,
+        grid: Option<GridDesc>,
+        density: &GridDesc,
+        resolve: &dyn Fn(&str, &str) -> Result<PathBuf, SceneError>,
+    ) -> Result<AlbedoDesc, SceneError> {
+        Ok(match (&self.transfer_function, self.value) {
+            _ if grid.is_some() => AlbedoDesc::Grid(grid.unwrap()),
+            (Some(_), Some(_)) => {
+                return Err(cx.invalid("albedo", "either transfer_function or value", "both"))
+            }
+            (Some(tf), None) => {
+                let tf = TransferFunction::read(&resolve(tf, "albedo.transfer_function")?)?;
+                AlbedoDesc::Grid(tf.apply(density))
+            }
+            (None, value) => {
+                let rgb = value.map_or([0.9; 3], OneOrThree::rgb);
+                if rgb.iter().any(|c| !(0.0..=1.0).contains(c)) {
+                    return Err(cx.invalid(
+                        "albedo.value",
+                        "components in [0, 1]",
+                        format!("{rgb:?}"),
+                    ));
+                }
+                AlbedoDesc::Constant(rgb)
+            }
+        })
+    }
+}
+
+impl MediumDesc {
+    /// Checks the numbers a renderer relies on (`checked`: the grids' values as checked when the
+    /// scene was assembled, not read again); `invalid` makes the error of a field. Returns the
+    /// largest density (delta tracking's majorant over the scale) and what the grids held.
+    pub(crate) fn check(
+        &self,
+        checked: Option<CheckedData>,
+        invalid: &impl Fn(&str, &str, String) -> SceneError,
+    ) -> Result<(f32, CheckedData), SceneError> {
+        if !(self.scale.is_finite() && self.scale >= 0.0) {
+            return Err(invalid(
+                "medium scale",
+                "a finite number >= 0",
+                self.scale.to_string(),
+            ));
+        }
+        let max_density = match &self.density {
+            DensityDesc::Constant(d) => {
+                if !(d.is_finite() && *d >= 0.0) {
+                    return Err(invalid(
+                        "medium density",
+                        "a finite number >= 0",
+                        d.to_string(),
+                    ));
+                }
+                *d
+            }
+            DensityDesc::Grid(grid) => match checked {
+                Some(data) => data.largest_density,
+                None => check_grid(grid, "density grid", f32::MAX, invalid)?,
+            },
+        };
+        let largest_density = match &self.density {
+            DensityDesc::Constant(_) => 0.0,
+            DensityDesc::Grid(_) => max_density,
+        };
+        let mut largest_albedo = 0.0;
+        match &self.albedo {
+            AlbedoDesc::Constant(rgb) => {
+                if !rgb.iter().all(|a| (0.0..=1.0).contains(a)) {
+                    return Err(invalid(
+                        "medium albedo",
+                        "three numbers in [0, 1]",
+                        format!("{rgb:?}"),
+                    ));
+                }
+            }
+            AlbedoDesc::Grid(grid) => {
+                largest_albedo = match checked {
+                    Some(data) => data.largest_albedo,
+                    None => check_grid(grid, "albedo grid", 1.0, invalid)?,
+                };
+            }
+        }
+        let sparse = self.grids().any(|(_, g)| g.layout == SampleLayout::Sparse);
+        if sparse && matches!(self.lookup, GridLookup::Texture | GridLookup::TextureHalf) {
+            return Err(invalid(
+                "grid lookup",
+                "trilinear, stochastic or nearest lookups for a sparse grid (textures hold dense grids; \
+                 read the VDB dense with sparse = \"never\" to use them)",
+                format!("{:?}", self.lookup),
+            ));
+        }
+        Ok((
+            max_density,
+            CheckedData {
+                largest_density,
+                largest_albedo,
+            },
+        ))
+    }
+
+    /// The largest extinction of the medium (delta tracking's majorant).
+    pub fn max_extinction(&self) -> f32 {
+        match &self.density {
+            DensityDesc::Constant(density) => self.scale * density,
+            DensityDesc::Grid(grid) => self.scale * grid.max_value(),
+        }
+    }
+
+    /// The largest density and the largest albedo component, each with its name (`"density"`,
+    /// `"albedo"`): a constant's own, a grid's as `checked` found it.
+    pub fn largest_values(&self, checked: CheckedData) -> [(&'static str, f32); 2] {
+        [
+            (
+                "density",
+                match &self.density {
+                    DensityDesc::Constant(v) => *v,
+                    DensityDesc::Grid(_) => checked.largest_density,
+                },
+            ),
+            (
+                "albedo",
+                match &self.albedo {
+                    AlbedoDesc::Constant(rgb) => rgb.iter().copied().fold(0.0, f32::max),
+                    AlbedoDesc::Grid(_) => checked.largest_albedo,
+                },
+            ),
+        ]
+    }
+
+    /// The medium's grids, each with what it holds (`"density"`, `"albedo"`), in that order.
+    pub fn grids(&self) -> impl Iterator<Item = (&'static str, &GridDesc)> {
+        let density = match &self.density {
+            DensityDesc::Grid(g) => Some(("density", g)),
+            DensityDesc::Constant(_) => None,
+        };
+        let albedo = match &self.albedo {
+            AlbedoDesc::Grid(g) => Some(("albedo", g)),
+            AlbedoDesc::Constant(_) => None,
+        };
+        density.into_iter().chain(albedo)
+    }
+
+    /// The values the description's serialisation leaves out (the grids' samples), the
+    /// density's then the albedo's (empty for a constant), which what fingerprints a scene
+    /// hashes on their own (the facade's `fingerprint::content`).
+    pub fn unserialised_values(&self) -> [&[f32]; 2] {
+        let density = match &self.density {
+            DensityDesc::Grid(g) => &g.data[..],
+            DensityDesc::Constant(_) => &[],
+        };
+        let albedo = match &self.albedo {
+            AlbedoDesc::Grid(g) => &g.data[..],
+            AlbedoDesc::Constant(_) => &[],
+        };
+        [density, albedo]
+    }
+
+    /// The `<medium>`'s type, its extinction and its albedo elements in a Mitsuba 3 scene; `grid`
+    /// writes a grid's file and returns the `gridvolume` that reads it (its arguments: the grid,
+    /// what it holds, Mitsuba's parameter).
+    pub(crate) fn to_mitsuba3(
+        &self,
+        grid: &mut dyn FnMut(&GridDesc, &str, &str) -> Result<String, SceneError>,
+    ) -> Result<(&'static str, String, String), SceneError> {
+        let (medium_type, sigma_t) = match &self.density {
+            DensityDesc::Constant(d) => (
+                "homogeneous",
+                format!("<float name=\"sigma_t\" value=\"{d}\"/>"),
+            ),
+            DensityDesc::Grid(g) => ("heterogeneous", grid(g, "density", "sigma_t")?),
+        };
+        let albedo = match &self.albedo {
+            AlbedoDesc::Constant(rgb) => rgb_element("albedo", rgb),
+            AlbedoDesc::Grid(g) => grid(g, "albedo", "albedo")?,
+        };
+        Ok((medium_type, sigma_t, albedo))
+    }
+
+    /// The facade's `medium.*` parameters: `(key, what it is)`. `medium.scale` is a number,
+    /// `medium.albedo` an RGB ([`MediumParam`]).
+    pub const PARAMS: &'static [(&'static str, &'static str)] = &[
+        (
+            "medium.scale",
+            "the density's scale (extinction = scale x density), finite and >= 0",
+        ),
+        (
+            "medium.albedo",
+            "the constant single-scattering albedo, RGB in [0, 1] (not a grid's)",
+        ),
+    ];
+
+    /// The value of parameter `key`, if it is one of [`MediumDesc::PARAMS`] (the phase's are
+    /// [`PhaseDesc::param`]'s); `Some(Err(why))` where this medium has no such value.
+    pub fn param(&self, key: &str) -> Option<Result<MediumParam, ParamRefused>> {
+        Some(match key {
+            "medium.scale" => Ok(MediumParam::Float(self.scale)),
+            "medium.albedo" => match &self.albedo {
+                AlbedoDesc::Constant(rgb) => Ok(MediumParam::Rgb(*rgb)),
+                AlbedoDesc::Grid(_) => Err(ALBEDO_GRID),
+            },
+            _ => return None,
+        })
+    }
+
+    /// Sets parameter `key` to `value`, if it is one of [`MediumDesc::PARAMS`] (`None`: the
+    /// medium is left alone). `Some(Err(why))` refuses the value, leaving the medium as it was.
+    pub fn set_param(&mut self, key: &str, value: MediumParam) -> Option<Result<(), ParamRefused>> {
+        Some(match key {
+            "medium.scale" => match value {
+                MediumParam::Float(v) if v.is_finite() && v >= 0.0 => {
+                    self.scale = v;
+                    Ok(())
+                }
+                _ => Err(ParamRefused::Value("a finite number >= 0")),
+            },
+            "medium.albedo" => match &mut self.albedo {
+                AlbedoDesc::Constant(rgb) => match value {
+                    MediumParam::Rgb(v) if v.iter().all(|c| c.is_finite()) => {
+                        if !v.iter().all(|c| (0.0..=1.0).contains(c)) {
+                            return Some(Err(ParamRefused::Value("RGB in [0, 1]")));
+                        }
+                        *rgb = v;
+                        Ok(())
+                    }
+                    _ => Err(ParamRefused::Value("three finite numbers")),
+                },
+                AlbedoDesc::Grid(_) => Err(ALBEDO_GRID),
+            },
+            _ => return None,
+        })
+    }
+
+    /// One medium of each kind (with an isotropic phase, a scale of 3 and dense storage); with
+    /// the boundary's, the phase's and the environment's examples, every registry medium part is
+    /// selected by some scene (tests cover the registry with them). The grids lie a little inside
+    /// and outside the unit cube, so that a grid's own mapping matters; their values differ in
+    /// every voxel, so that any change of mapping shows. The fourth and fifth media's
+    /// nearest-sample lookups select the any-layout grid media (with a constant albedo and with an
+    /// albedo grid); a grid decoded with the other lookup renders a different image, so both
+    /// lookups cross the device ABI. The sixth reads textures of half-precision texels: decoded as
+    /// f32 texels, its samples would differ. The last reads one texel per lookup (stochastic):
+    /// decoded as trilinear, it would read eight.
+    pub fn examples() -> Vec<Self> {
+        let bounds = Bounds {
+            min: [-0.6, -0.45, -0.5],
+            max: [0.55, 0.5, 0.6],
+        };
+        let grid = |channels: u32, convention| {
+            let n = 4 * 3 * 2 * channels as usize;
+            GridDesc {
+                layout: SampleLayout::Dense,
+                resolution: [4, 3, 2],
+                channels,
+                bounds,
+                convention,
+                data: (0..n)
+                    .map(|i| 0.2 + 0.8 * ((i * 7919) % n) as f32 / n as f32)
+                    .collect(),
+            }
+        };
+        let (vertex, cell) = (GridConvention::Vertex, GridConvention::Cell);
+        let media = [
+            (
+                DensityDesc::Constant(2.0),
+                AlbedoDesc::Constant([0.9, 0.7, 0.5]),
+                GridLookup::Trilinear,
+            ),
+            (
+                DensityDesc::Grid(grid(1, vertex)),
+                AlbedoDesc::Constant([0.8, 0.9, 0.6]),
+                GridLookup::Trilinear,
+            ),
+            (
+                DensityDesc::Grid(grid(1, cell)),
+                AlbedoDesc::Grid(grid(3, vertex)),
+                GridLookup::Trilinear,
+            ),
+            (
+                DensityDesc::Grid(grid(1, vertex)),
+                AlbedoDesc::Constant([0.8, 0.9, 0.6]),
+                GridLookup::Nearest,
+            ),
+            (
+                DensityDesc::Grid(grid(1, cell)),
+                AlbedoDesc::Grid(grid(3, vertex)),
+                GridLookup::Nearest,
+            ),
+            (
+                DensityDesc::Grid(grid(1, cell)),
+                AlbedoDesc::Grid(grid(3, vertex)),
+                GridLookup::TextureHalf,
+            ),
+            (
+                DensityDesc::Grid(grid(1, vertex)),
+                AlbedoDesc::Grid(grid(3, cell)),
+                GridLookup::Stochastic,
+            ),
+        ];
+        media
+            .into_iter()
+            .map(|(density, albedo, lookup)| MediumDesc {
+                density,
+                scale: 3.0,
+                albedo,
+                phase: PhaseDesc::Isotropic,
+                lookup,
+                storage: GridStorage::Dense,
+            })
+            .collect()
+    }
+}
+
+/// A value of a `medium.*` parameter ([`MediumDesc::PARAMS`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MediumParam {
+    Float(f32),
+    Rgb([f32; 3]),
+}
+
+/// Why a medium refuses a parameter ([`MediumDesc::param`], [`MediumDesc::set_param`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ParamRefused {
+    /// This medium has no such value: what the parameter needs, and what the medium has instead.
+    NotHere {
+        needs: &'static str,
+        found: &'static str,
+    },
+    /// The value is not what the parameter takes: what it takes.
+    Value(&'static str),
+}
+
+/// `medium.albedo` of a medium whose albedo is a grid: the parameter is a constant's.
+const ALBEDO_GRID: ParamRefused = ParamRefused::NotHere {
+    needs: "a constant albedo",
+    found: "a grid",
+};
+
+/// As `volpt info`'s `density` line begins (its scale follows).
+impl fmt::Display for DensityDesc {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            DensityDesc::Constant(d) => write!(f, "constant {d}"),
+            DensityDesc::Grid(g) => write!(f, "{}", InfoGrid(g)),
+        }
+    }
+}
+
+/// As `volpt info`'s `albedo` line prints it.
+impl fmt::Display for AlbedoDesc {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            AlbedoDesc::Constant(rgb) => write!(f, "constant {rgb:?}"),
+            AlbedoDesc::Grid(g) => write!(f, "{}", InfoGrid(g)),
+        }
+    }
+}
+
+impl GridLookup {
+    /// As `volpt info`'s `lookup` line prints it.
+    pub fn info(self) -> &'static str {
+        match self {
+            GridLookup::Trilinear => {
+                "trilinear (without --lookup, a GPU with fast math reads stochastic lookups \
+                 instead where the grids fit in its memory)"
+            }
+            GridLookup::Nearest => "nearest (biased: a blockier field)",
+            GridLookup::Texture => "texture (the texture unit's filter, 8-bit weights: biased)",
+            GridLookup::TextureHalf => "texture-f16 (half-precision texels, 8-bit weights: biased)",
+            GridLookup::Stochastic => {
+                "stochastic (one sample chosen by its trilinear weight: unbiased)"
+            }
+        }
+    }
+}
+
+/// A grid as `volpt info` prints it: its shape, placement and range of values.
+struct InfoGrid<'g>(&'g GridDesc);
+
+impl fmt::Display for InfoGrid<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let g = self.0;
+        let (lo, hi) = g
+            .samples()
+            .iter()
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &v| {
+                (lo.min(v), hi.max(v))
+            });
+        write!(
+            f,
+            "grid {}x{}x{}x{}, {:?}-centred, bounds {:?} .. {:?}, values {lo} .. {hi}",
+            g.resolution[0],
+            g.resolution[1],
+            g.resolution[2],
+            g.channels,
+            g.convention,
+            g.bounds.min,
+            g.bounds.max
+        )
+    }
+}
+
+/// What the factory reads for the medium axis: the description's density and albedo, each a
+/// constant where the specialised factory found a grid of one value over the box.
+pub struct MediumInput<'a> {
+    medium: &'a MediumDesc,
+    /// The medium's box (the boundary's), which a one-voxel grid covers.
+    bounds: &'a Bounds,
+    density: Density<'a>,
+    albedo: Albedo<'a>,
+}
+
+/// Whether samples of so many channels per sample hold one value everywhere.
+pub type IsUniform<'u> = dyn Fn(&[f32], usize) -> bool + 'u;
+
+/// A medium's density as the description has it, before it becomes a part.
+enum Density<'a> {
+    Constant(&'a f32),
+    Grid(&'a GridDesc),
+}
+
+enum Albedo<'a> {
+    /// Three channels.
+    Constant(&'a [f32]),
+    Grid(&'a GridDesc),
+}
+
+impl<'a> MediumInput<'a> {
+    /// `desc`'s medium. With `is_uniform` (whether samples of so many channels hold one value
+    /// everywhere; the factory's, which remembers its answers), a grid of one value covering the
+    /// medium's box is that constant, and each such grid is reported to `fired`; without it
+    /// (the factory's general parts) every grid stays a grid.
+    pub fn of(
+        desc: &'a SceneDescription,
+        is_uniform: Option<&IsUniform<'_>>,
+        fired: &mut dyn FnMut(Simplification),
+    ) -> Self {
+        let medium = &desc.medium;
+        let bounds = &desc.boundary.bounds;
+        let uniform = |grid: &'a GridDesc| is_uniform.and_then(|u| uniform(grid, bounds, u));
+        let density = match &medium.density {
+            DensityDesc::Grid(grid) => match uniform(grid) {
+                Some(value) => {
+                    fired(Simplification::ConstantDensityGrid);
+                    Density::Constant(&value[0])
+                }
+                None => Density::Grid(grid),
+            },
+            DensityDesc::Constant(sigma) => Density::Constant(sigma),
+        };
+        let albedo = match &medium.albedo {
+            AlbedoDesc::Grid(grid) => match uniform(grid) {
+                Some(value) => {
+                    fired(Simplification::ConstantAlbedoGrid);
+                    Albedo::Constant(value)
+                }
+                None => Albedo::Grid(grid),
+            },
+            AlbedoDesc::Constant(rgb) => Albedo::Constant(rgb),
+        };
+        Self {
+            medium,
+            bounds,
+            density,
+            albedo,
+        }
+    }
+}
+
+/// The one value of `grid` per channel, if it has a single value everywhere and covers `bounds`
+/// (outside its own box a grid is zero, so a smaller grid is not constant over the medium).
+fn uniform<'g>(
+    grid: &'g GridDesc,
+    bounds: &Bounds,
+    is_uniform: &IsUniform<'_>,
+) -> Option<&'g [f32]> {
+    let covers =
+        (0..3).all(|i| grid.bounds.min[i] <= bounds.min[i] && grid.bounds.max[i] >= bounds.max[i]);
+    let channels = grid.channels as usize;
+    let samples = grid.samples();
+    let first = samples.get(..channels)?;
+    (covers && is_uniform(samples, channels)).then_some(first)
+}
+
+impl<'a> FromDescription<'a> for HomogeneousMedium {
+    type Input = MediumInput<'a>;
+
+    fn specialised(input: &MediumInput<'a>, _: &mut dyn FnMut(Simplification)) -> Option<Self> {
+        match (&input.density, &input.albedo) {
+            (Density::Constant(density), Albedo::Constant(albedo)) => Some(HomogeneousMedium {
+                sigma_t: input.medium.scale * **density,
+                albedo: Spectrum::new(albedo[0], albedo[1], albedo[2]),
+            }),
+            _ => None,
+        }
+    }
+
+    fn general(_: &MediumInput<'a>) -> Option<Self> {
+        None
+    }
+}
+
+/// A constant albedo never reads memory: the specialised part for grids of the reads `R` asks.
+impl<'a, R: ReadsRule> FromDescription<'a> for GridMedium<'a, ConstantAlbedo, R> {
+    type Input = MediumInput<'a>;
+
+    fn specialised(input: &MediumInput<'a>, _: &mut dyn FnMut(Simplification)) -> Option<Self> {
+        match input.albedo {
+            Albedo::Constant(albedo) if R::asked_by(input.medium) => Some(grid_medium(
+                input,
+                ConstantAlbedo(Spectrum::new(albedo[0], albedo[1], albedo[2])),
+            )),
+            _ => None,
+        }
+    }
+
+    fn general(_: &MediumInput<'a>) -> Option<Self> {
+        None
+    }
+}
+
+/// The general medium of the reads `R` asks: a constant albedo becomes a one-voxel grid (read
+/// only at real collisions, a few per path).
+impl<'a, R: ReadsRule> FromDescription<'a> for GridMedium<'a, GridAlbedo<'a, R>, R> {
+    type Input = MediumInput<'a>;
+
+    fn specialised(input: &MediumInput<'a>, _: &mut dyn FnMut(Simplification)) -> Option<Self> {
+        Self::general(input)
+    }
+
+    fn general(input: &MediumInput<'a>) -> Option<Self> {
+        if !R::asked_by(input.medium) {
+            return None;
+        }
+        let albedo = match input.albedo {
+            Albedo::Grid(albedo) => grid::<3>(albedo, input.medium.lookup),
+            Albedo::Constant(rgb) => one_voxel(input, rgb),
+        };
+        Some(grid_medium(input, GridAlbedo(albedo, R::default())))
+    }
+}
+
+/// A grid medium with `albedo`; a constant density becomes a one-voxel grid over the medium's box.
+fn grid_medium<'a, A, R: GridReads>(input: &MediumInput<'a>, albedo: A) -> GridMedium<'a, A, R> {
+    let medium = input.medium;
+    let density = match input.density {
+        Density::Grid(density) => grid::<1>(density, medium.lookup),
+        Density::Constant(sigma) => one_voxel(input, std::slice::from_ref(sigma)),
+    };
+    let max_density = density.samples().iter().copied().fold(0.0, f32::max);
+    GridMedium {
+        density,
+        scale: medium.scale,
+        majorant: medium.scale * max_density,
+        majorants: None,
+        albedo,
+        reads: R::default(),
+    }
+}
+
+/// Which [`GridReads`] a description's lookup and storage ask for: exactly one of them for every
+/// medium. A kernel carries the code of its reads alone.
+pub trait ReadsRule: GridReads {
+    fn asked_by(medium: &MediumDesc) -> bool;
+}
+
+/// Every grid that needs neither textures nor the any-layout reads.
+impl ReadsRule for DenseTrilinear {
+    fn asked_by(medium: &MediumDesc) -> bool {
+        !texture_reads(medium) && !any_layout(medium)
+    }
+}
+
+/// Nearest-sample lookups, bricked storage on a GPU, or a sparse grid, unless read through
+/// textures.
+impl ReadsRule for AnyLayout {
+    fn asked_by(medium: &MediumDesc) -> bool {
+        !texture_reads(medium) && any_layout(medium)
+    }
+}
+
+impl ReadsRule for TextureTrilinear {
+    fn asked_by(medium: &MediumDesc) -> bool {
+        texture_reads(medium)
+    }
+}
+
+/// Whether the medium's grids need the any-layout reads ([`AnyLayout`]): nearest-sample lookups,
+/// bricked storage on a GPU, or a sparse grid.
+fn any_layout(medium: &MediumDesc) -> bool {
+    medium.lookup == GridLookup::Nearest
+        || medium.storage != GridStorage::Dense
+        || sparse_grids(medium)
+}
+
+/// Whether a grid of the medium is sparse (read in software: a texture holds dense samples).
+fn sparse_grids(medium: &MediumDesc) -> bool {
+    let sparse = |g: &GridDesc| g.layout == SampleLayout::Sparse;
+    matches!(&medium.density, DensityDesc::Grid(g) if sparse(g))
+        || matches!(&medium.albedo, AlbedoDesc::Grid(g) if sparse(g))
+}
+
+/// Whether the medium's grids are read through textures ([`TextureTrilinear`]): the texture
+/// lookups, and stochastic lookups of dense grids (one unfiltered texel; bricked and sparse grids
+/// are read in software by [`AnyLayout`]).
+fn texture_reads(medium: &MediumDesc) -> bool {
+    match medium.lookup {
+        GridLookup::Stochastic => medium.storage == GridStorage::Dense && !sparse_grids(medium),
+        lookup => texel(lookup).is_some(),
+    }
+}
+
+/// What a texture holds per sample, if the lookup reads grids through textures
+/// ([`TextureTrilinear`]).
+fn texel(lookup: GridLookup) -> Option<TexelFormat> {
+    match lookup {
+        GridLookup::Texture | GridLookup::Stochastic => Some(TexelFormat::F32),
+        GridLookup::TextureHalf => Some(TexelFormat::F16),
+        GridLookup::Trilinear | GridLookup::Nearest => None,
+    }
+}
+
+fn aabb(b: &Bounds) -> Aabb {
+    Aabb::new(Vec3::from_array(b.min), Vec3::from_array(b.max))
+}
+
+/// A one-voxel grid of `value` (its channels) over the medium's box.
+fn one_voxel<'a, const C: usize>(input: &MediumInput<'_>, value: &'a [f32]) -> Grid<'a, C> {
+    Grid::new(
+        value,
+        [1, 1, 1],
+        GridMapping::cell_centred(aabb(input.bounds), [1, 1, 1]),
+    )
+    .with_texel(texel(input.medium.lookup).unwrap_or_default())
+}
+
+fn grid<const C: usize>(g: &GridDesc, lookup: GridLookup) -> Grid<'_, C> {
+    let bounds = aabb(&g.bounds);
+    let mapping = match g.convention {
+        GridConvention::Vertex => GridMapping::vertex_centred(bounds, g.resolution),
+        GridConvention::Cell => GridMapping::cell_centred(bounds, g.resolution),
+    };
+    let grid = match g.layout {
+        SampleLayout::Dense => Grid::new(&g.data, g.resolution, mapping),
+        SampleLayout::Sparse => Grid::sparse(&g.data, g.resolution, mapping),
+    }
+    .with_texel(texel(lookup).unwrap_or_default());
+    match lookup {
+        GridLookup::Nearest => grid.with_lookup(CoreLookup::Nearest),
+        GridLookup::Stochastic => grid.with_lookup(CoreLookup::Stochastic),
+        _ => grid,
+    }
+}
