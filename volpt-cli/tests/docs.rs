@@ -330,3 +330,43 @@ fn every_relative_link_of_the_readme_and_the_docs_resolves() {
     }
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }
+
+/// `docs/extending.md`'s worked example, a new phase function of new physics kept as a patch, touches
+/// exactly the three files the page names (and the test oracle), and still applies to this tree:
+/// a change that moves what a new part must touch fails here until the page and the patch follow.
+#[test]
+fn the_worked_extension_touches_three_files_and_applies() {
+    let patch = root().join("docs/extending-rayleigh.patch");
+    let text = std::fs::read_to_string(&patch).expect("docs/extending-rayleigh.patch");
+    let touched: BTreeSet<&str> = text
+        .lines()
+        .filter_map(|line| line.strip_prefix("diff --git a/"))
+        .filter_map(|rest| rest.split(" b/").next())
+        .collect();
+    let expected: BTreeSet<&str> = [
+        "volpt-core/src/phase.rs",
+        "volpt-core/src/variant.rs",
+        "volpt-scene/src/phase.rs",
+        "tests/src/reference.rs",
+    ]
+    .into_iter()
+    .collect();
+    assert_eq!(touched, expected);
+    let extending = std::fs::read_to_string(root().join("docs/extending.md")).unwrap();
+    assert!(extending.contains("extending-rayleigh.patch"));
+    // `git apply --check` reads only the working tree (no repository needed); where git is missing
+    // the file list above is still checked.
+    match std::process::Command::new("git")
+        .args(["apply", "--check"])
+        .arg(&patch)
+        .current_dir(root())
+        .output()
+    {
+        Ok(out) => assert!(
+            out.status.success(),
+            "docs/extending-rayleigh.patch no longer applies: {}",
+            String::from_utf8_lossy(&out.stderr)
+        ),
+        Err(e) => eprintln!("skipped: git apply --check ({e})"),
+    }
+}
