@@ -227,7 +227,7 @@ impl<'a> LatLongEnvironment<'a> {
 }
 
 impl Environment for LatLongEnvironment<'_> {
-    #[inline]
+    #[inline(always)]
     fn radiance(&self, dir: Vec3) -> Spectrum {
         let (u, t) = self.uv(dir);
         let x = u * self.width as f32 - 0.5;
@@ -247,7 +247,7 @@ impl Environment for LatLongEnvironment<'_> {
         (top * (1.0 - fy) + bottom * fy) * self.scale
     }
 
-    #[inline]
+    #[inline(always)]
     fn sample(&self, u: Vec2) -> Option<LightSample> {
         let (w, h) = (self.width as usize, self.height as usize);
         if self.distribution.len() != Self::distribution_len(self.width, self.height) {
@@ -290,7 +290,7 @@ impl Environment for LatLongEnvironment<'_> {
         })
     }
 
-    #[inline]
+    #[inline(always)]
     fn pdf(&self, dir: Vec3) -> f32 {
         let (w, h) = (self.width as usize, self.height as usize);
         if self.distribution.len() != Self::distribution_len(self.width, self.height) {

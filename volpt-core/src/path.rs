@@ -433,7 +433,9 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
     }
 }
 
-#[inline]
+// Inlined into every kernel's step: called by address, it would take the scene with it and keep
+// a copy of it in local memory (`ptx_entries::no_kernel_keeps_the_scene_in_local_memory`).
+#[inline(always)]
 fn interact_with_boundary<S: Scene>(scene: &S, path: &mut PathState, hit: BoxHit) {
     if S::Bsdf::IS_NULL {
         path.ray.origin = hit.point;

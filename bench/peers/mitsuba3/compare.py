@@ -27,6 +27,7 @@ import json
 import os
 import platform
 import re
+import shlex
 import statistics
 import subprocess
 import sys
@@ -86,6 +87,8 @@ class Mitsuba:
 
 def volpt_render(volpt, scene, params, spp, seed, out, backend, threads, extra):
     cmd = [volpt, "render", scene, "-o", out, "--spp", str(spp), "--seed", str(seed)] + extra
+    # VOLPT_RENDER_ARGS: more render options for volpt alone (e.g. "--estimator nee"), not exported.
+    cmd += shlex.split(os.environ.get("VOLPT_RENDER_ARGS", ""))
     for k, v in params.items():
         cmd += ["-D", f"{k}={v}"]
     if backend != "cpu":
