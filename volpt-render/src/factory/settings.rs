@@ -17,11 +17,11 @@ pub fn path_settings(desc: &SceneDescription) -> PathSettings {
 /// efficiency of path tracing on envmap-cube with an index-matched boundary). Around a rough
 /// dielectric, sampling the map where paths meet the boundary divides envmap-cube's variance per
 /// sample by 2.6 (as low as Mitsuba 3's `volpath`, which does the same), for 1.45x the time on the
-/// CPU but 3.2x on an H100 (its light samples are dependent reads of the map's distribution in
-/// paths of 3.4 segments): 1.8x the efficiency on the CPU, 0.8x on the GPU, so both backends keep
-/// path tracing there and trace the same paths. Under a constant environment a path tracer's
-/// escaping path already sees the whole light, and NEE's shadow rays cost more than its lower
-/// variance saves (smoke: 0.6x); a smooth dielectric rules NEE out (`docs/heterogeneous.md`).
+/// CPU but 3.6x on an H100 (its light samples are dependent reads of the map's distribution in
+/// paths of 3.4 segments): 1.8x the efficiency on the CPU, about 0.7x on the GPU, so both
+/// backends keep path tracing there and trace the same paths. Under a constant environment a path
+/// tracer's escaping path already sees the whole light, and NEE's shadow rays cost more than its
+/// lower variance saves (smoke: 0.6x); a smooth dielectric rules NEE out (`docs/heterogeneous.md`).
 pub fn default_estimator(desc: &SceneDescription) -> Estimator {
     match (&desc.boundary.bsdf, &desc.environment) {
         (BsdfDesc::Null, EnvironmentDesc::LatLong(_)) => Estimator::NextEvent,

@@ -12,7 +12,7 @@
 set -uo pipefail
 ROOT=$PWD
 B=$ROOT/.dev/s5
-R=$OUT
+R=$OUT  # files land in inlined/
 gunzip -f "$B/bin/volpt.gz"; chmod +x "$B/bin/volpt"
 ln -sfn "$B" "$ROOT/bundle"
 cd "$B"
