@@ -2,18 +2,21 @@
 //! kernels crate hold some 180 MB of PTX, which the build script packs into about a ninth
 //! ([`layout`]).
 //!
-//! Each kernel is decompressed when it is first asked for, with only the frame that holds it (one
-//! strategy's entries): the renderer JIT-compiles one kernel at a time anyway, and a frame, at most
-//! a tenth of the module, decompresses in milliseconds, so nothing is cached here; the renderer
-//! caches the compiled module.
+//! Each kernel is cut when it is first asked for, from the common text and the one frame that
+//! holds it (one strategy's entries): the renderer JIT-compiles one kernel at a time anyway. A
+//! frame, at most a tenth of the module, decompresses in some 20-30 ms, once per process: the
+//! process's packs ([`shared`]) keep the frames they decompressed, and [`prefetch`] decompresses a
+//! strategy's frame on another thread while the driver opens the GPU, so that the first render's
+//! kernel is cut without waiting for it.
 
 pub mod layout;
 
 use std::io::Read;
 use std::ops::Range;
+use std::sync::OnceLock;
 
 use thiserror::Error;
-use volpt_device::Math;
+use volpt_device::{Math, Strategy};
 
 use layout::{COMMON_FRAME, ENTRY_RECORD, FRAME_RECORD, MAGIC};
 
@@ -38,6 +41,41 @@ pub fn embedded(math: Math) -> Result<Option<KernelPack<'static>>, PackError> {
 /// Whether this build carries the workspace's kernels built for `math`.
 pub fn is_embedded(math: Math) -> bool {
     embedded_pack(math).is_some()
+}
+
+/// The process's pack of the workspace's kernels built for `math`, if this build carries it: read
+/// once, and shared by every renderer, so that a frame decompressed for one (or by [`prefetch`])
+/// serves all.
+pub fn shared(math: Math) -> Result<Option<&'static KernelPack<'static>>, PackError> {
+    static PACKS: [OnceLock<Option<KernelPack<'static>>>; 2] = [OnceLock::new(), OnceLock::new()];
+    let slot = &PACKS[match math {
+        Math::Exact => 0,
+        Math::Fast => 1,
+    }];
+    // A pack that does not parse is not kept: parsing it again says why.
+    match slot.get_or_init(|| embedded(math).ok().flatten()) {
+        Some(pack) => Ok(Some(pack)),
+        None => embedded(math).map(|_| None),
+    }
+}
+
+/// Decompresses, on a thread of its own, the common text and the frame of `strategy`'s kernels
+/// in the process's pack for `math` ([`shared`]), and returns at once: called as the GPU opens
+/// (a fifth of a second of the driver's), the first render of `strategy` finds its frame ready.
+/// Does nothing without embedded kernels or with `VOLPT_PTX` set (the renderer then reads its
+/// kernels from that file); a damaged pack is reported by the render that asks for its kernel.
+pub fn prefetch(math: Math, strategy: Strategy) {
+    if !is_embedded(math) || std::env::var_os(crate::renderer::PTX_OVERRIDE).is_some() {
+        return;
+    }
+    std::thread::spawn(move || {
+        if let Ok(Some(pack)) = shared(math) {
+            let group = layout::group_of(strategy.entry_prefix());
+            // An error here is the render's to report, when it asks for the kernel.
+            let _ = pack.frame_text(COMMON_FRAME);
+            let _ = pack.frame_text(group);
+        }
+    });
 }
 
 /// What is wrong with a kernel pack. A pack's every part carries a checksum, so these mean a pack
@@ -83,11 +121,28 @@ struct Frame<'a> {
     bytes: &'a [u8],
     /// Its text's length in bytes.
     text_len: u64,
+    /// Its text, once decompressed (`None`: it does not decompress).
+    text: OnceLock<Option<String>>,
 }
 
 impl Frame<'_> {
-    /// The frame's text, checked against its length and its checksum.
-    fn text(&self) -> Result<String, PackError> {
+    /// The frame's text, checked against its length and its checksum, decompressed on first use.
+    /// A thread that asks while another decompresses it waits for that text.
+    fn text(&self) -> Result<&str, PackError> {
+        match self.text.get_or_init(|| self.decompress().ok()) {
+            Some(text) => Ok(text),
+            // Decompressing is deterministic: the second try fails as the first did, and says why.
+            None => Err(self
+                .decompress()
+                .err()
+                .unwrap_or_else(|| PackError::Decompress {
+                    part: format!("frame `{}`", self.name),
+                    source: std::io::Error::other("it failed once and then decompressed"),
+                })),
+        }
+    }
+
+    fn decompress(&self) -> Result<String, PackError> {
         decompress(self.bytes, Some(self.text_len), || {
             format!("frame `{}`", self.name)
         })
@@ -143,6 +198,7 @@ impl<'a> KernelPack<'a> {
                         name: name.to_owned(),
                         bytes: reader.take(number(compressed).map_err(bad)?, &part)?,
                         text_len: number(text_len).map_err(bad)?,
+                        text: OnceLock::new(),
                     });
                 }
                 [ENTRY_RECORD, name, frame, start, len, at] => {
@@ -216,14 +272,24 @@ impl KernelPack<'_> {
         };
         let common = self.frames[0].text()?;
         let frame = self.frames[entry.frame].text()?;
-        let text = self.entry_text(entry, &frame)?;
-        self.check_at(entry, &common)?;
+        let text = self.entry_text(entry, frame)?;
+        self.check_at(entry, common)?;
         Ok(Some(layout::assemble(
-            &common,
+            common,
             entry.at,
             text,
             max_registers,
         )))
+    }
+
+    /// The text of the frame `name` ([`COMMON_FRAME`] or a group, [`layout::group_of`]), or `None`
+    /// if the pack has no such frame.
+    pub fn frame_text(&self, name: &str) -> Result<Option<&str>, PackError> {
+        self.frames
+            .iter()
+            .find(|frame| frame.name == name)
+            .map(Frame::text)
+            .transpose()
     }
 
     /// The whole module, every entry back in the common text: the PTX the pack was made of.
@@ -233,13 +299,13 @@ impl KernelPack<'_> {
             .iter()
             .map(Frame::text)
             .collect::<Result<Vec<_>, _>>()?;
-        let common = &texts[0];
-        let mut module = String::with_capacity(texts.iter().map(String::len).sum());
+        let common = texts[0];
+        let mut module = String::with_capacity(texts.iter().map(|t| t.len()).sum());
         let mut copied = 0;
         for entry in &self.entries {
             self.check_at(entry, common)?;
             module.push_str(&common[copied..entry.at]);
-            module.push_str(self.entry_text(entry, &texts[entry.frame])?);
+            module.push_str(self.entry_text(entry, texts[entry.frame])?);
             copied = entry.at;
         }
         module.push_str(&common[copied..]);
@@ -428,6 +494,54 @@ mod tests {
             KernelPack::parse(b"PK\x03\x04"),
             Err(PackError::NotAPack)
         ));
+    }
+
+    #[test]
+    fn a_frame_decompresses_once_and_serves_every_kernel_of_it() {
+        let bytes = packed();
+        let pack = KernelPack::parse(&bytes).unwrap();
+        let first = pack.frame_text("a").unwrap().unwrap();
+        assert!(first.contains(".entry a__x") && first.contains(".entry a__y"));
+        let again = pack.frame_text("a").unwrap().unwrap();
+        assert_eq!(
+            first.as_ptr(),
+            again.as_ptr(),
+            "the same text, not a second copy"
+        );
+        assert_eq!(pack.frame_text("c").unwrap(), None);
+        // Decompressed on several threads at once, a frame is still one text.
+        let pack = KernelPack::parse(&bytes).unwrap();
+        let texts: Vec<usize> = std::thread::scope(|threads| {
+            let handles: Vec<_> = (0..4)
+                .map(|_| threads.spawn(|| pack.frame_text("b").unwrap().unwrap().as_ptr() as usize))
+                .collect();
+            handles.into_iter().map(|h| h.join().unwrap()).collect()
+        });
+        assert!(texts.iter().all(|&t| t == texts[0]), "{texts:?}");
+        assert_eq!(
+            pack.kernel("b__x", None).unwrap(),
+            single_kernel_ptx(MODULE, "b__x", None)
+        );
+    }
+
+    #[test]
+    fn a_damaged_frame_is_an_error_every_time_it_is_asked_for() {
+        let bytes = packed();
+        let pack = KernelPack::parse(&bytes).unwrap();
+        let b = pack.frames.iter().find(|f| f.name == "b").unwrap();
+        // The last byte of frame `b`: inside its content checksum.
+        let end = b.bytes.as_ptr() as usize - bytes.as_ptr() as usize + b.bytes.len();
+        let mut damaged = bytes.clone();
+        damaged[end - 1] ^= 0x55;
+        let pack = KernelPack::parse(&damaged).unwrap();
+        for _ in 0..2 {
+            let error = pack.kernel("b__x", None).unwrap_err().to_string();
+            assert!(error.contains("frame `b`"), "{error}");
+        }
+        assert!(
+            pack.kernel("a__x", None).unwrap().is_some(),
+            "other frames still serve"
+        );
     }
 
     /// A pack of `index` (its lines) and frames of `texts`.

@@ -75,7 +75,7 @@ enum Kernels {
     /// The kernels this build embeds, packed.
     Embedded {
         math: Math,
-        pack: KernelPack<'static>,
+        pack: &'static KernelPack<'static>,
     },
 }
 
@@ -95,6 +95,10 @@ impl Kernels {
         ptx.ok_or_else(|| CudaError::MissingKernel(entry.to_owned()))
     }
 }
+
+/// The environment variable naming a PTX file whose kernels a renderer runs instead of the
+/// embedded ones.
+pub const PTX_OVERRIDE: &str = "VOLPT_PTX";
 
 /// One GPU and volpt's kernels, each JIT-compiled on first use.
 pub struct CudaRenderer {
@@ -173,7 +177,7 @@ impl CudaRenderer {
     pub fn new(ordinal: usize, math: Math) -> Result<Self, CudaError> {
         // `VOLPT_PTX=file.ptx` runs other kernels with this binary: A/B measurements of a kernel
         // change in one device session.
-        let kernels = match std::env::var_os("VOLPT_PTX") {
+        let kernels = match std::env::var_os(PTX_OVERRIDE) {
             Some(path) => Kernels::Module(std::fs::read_to_string(&path).map_err(|source| {
                 CudaError::PtxFile {
                     path: path.into(),
@@ -182,7 +186,7 @@ impl CudaRenderer {
             })?),
             None => Kernels::Embedded {
                 math,
-                pack: kernels::embedded(math)
+                pack: kernels::shared(math)
                     .map_err(|source| CudaError::CorruptKernels { math, source })?
                     .ok_or(CudaError::NoKernels(math))?,
             },

@@ -242,6 +242,10 @@ impl Backend {
                     },
                     budget: gpu.device_memory_budget,
                 };
+                // The first render's kernel is of this strategy (`auto` without a calibration
+                // runs auto::DEFAULT): its kernels decompress while the driver opens the GPUs.
+                let first = schedule.map_or(auto::DEFAULT, |s| s.strategy);
+                volpt_cuda::kernels::prefetch(math, first);
                 let renderers = ordinals
                     .into_iter()
                     .map(|ordinal| {
