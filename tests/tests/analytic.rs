@@ -444,6 +444,33 @@ fn the_throughput_roulette_leaves_a_white_furnace_exact() {
     );
 }
 
+/// The same behind a smooth dielectric boundary into a denser medium: the radiance's `1/eta^2` at
+/// the refraction in is not a loss of throughput (the refraction out restores it), so the
+/// thesis's rule kills no path there either and every path returns the environment.
+#[test]
+fn the_throughput_roulette_kills_no_path_for_entering_a_denser_medium() {
+    let desc = cube_scene(
+        16,
+        16,
+        homogeneous(5.0, 1.0, PhaseDesc::Isotropic),
+        BsdfDesc::Dielectric {
+            int_ior: 1.5,
+            ext_ior: 1.0,
+        },
+        1.0,
+    );
+    let settings = PathSettings {
+        rr_depth: 0,
+        estimator: Estimator::PathTracing,
+        roulette: Roulette::Throughput,
+        ..PathSettings::default()
+    };
+    let (mean, se, killed) = with_scene(&desc, settings, FurnaceSampleMean { paths: 20_000 });
+    assert_eq!(killed, 0, "mean {mean}, se {se}");
+    // `1/eta^2` and `eta^2` in f32: exact up to rounding.
+    assert!((mean - 1.0).abs() < 1e-5 && se < 1e-6, "mean {mean}, se {se}");
+}
+
 #[test]
 fn same_seed_same_image_and_different_seed_different_image() {
     let desc = cube_scene(

@@ -154,7 +154,8 @@ struct SceneArgs {
 enum RouletteArg {
     /// Mitsuba's: min(max(throughput) * eta^2, 0.95).
     Mitsuba,
-    /// The thesis's: min(1, max(throughput)).
+    /// The thesis's: min(1, max(throughput) * eta^2) (its throughput leaves out the radiance's
+    /// 1/eta^2 inside a denser medium).
     Throughput,
 }
 
