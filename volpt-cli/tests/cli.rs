@@ -68,6 +68,11 @@ fn malformed_xml_names_file_and_line() {
 }
 
 fn grid_scene(dir: &Path, vol_name: &str) -> PathBuf {
+    grid_scene_with(dir, vol_name, "", "")
+}
+
+/// `grid_scene` with more of the grid's and the medium's parameters (XML, each on its own line).
+fn grid_scene_with(dir: &Path, vol_name: &str, volume: &str, medium: &str) -> PathBuf {
     let scene = dir.join("grid.xml");
     let xml = format!(
         r#"<scene version="0.6.0">
@@ -78,8 +83,8 @@ fn grid_scene(dir: &Path, vol_name: &str) -> PathBuf {
   </sensor>
   <emitter type="constant"/>
   <medium type="heterogeneous" id="m">
-    <volume name="density" type="gridvolume"><string name="filename" value="{vol_name}"/></volume>
-    <volume name="albedo" type="constvolume"><spectrum name="value" value="0.9"/></volume>
+    <volume name="density" type="gridvolume"><string name="filename" value="{vol_name}"/>{volume}</volume>
+    <volume name="albedo" type="constvolume"><spectrum name="value" value="0.9"/></volume>{medium}
   </medium>
   <shape type="cube"><bsdf type="null"/><ref name="interior" id="m"/></shape>
 </scene>"#
@@ -129,6 +134,43 @@ fn nan_and_negative_densities_are_clear_errors() {
         let out = volpt(&["info", scene.to_str().unwrap()]);
         assert_clean_error(&out, &[name.as_str()]);
     }
+}
+
+/// Mitsuba's settings that volpt has no choice of (the medium's tracking method, the grid's
+/// filter and wrap mode) load with a warning that names the place, the value and what volpt
+/// does instead; the values volpt uses load silently, in any case and with spaces around them.
+#[test]
+fn settings_volpt_has_no_choice_of_are_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    write_vol(&dir.path().join("d.vol"), &grid(vec![1.0; 8])).unwrap();
+    let setting =
+        |name: &str, value: &str| format!("\n      <string name=\"{name}\" value=\"{value}\"/>");
+    let scene = grid_scene_with(
+        dir.path(),
+        "d.vol",
+        &(setting("filter_type", "nearest") + &setting("wrap_mode", "repeat")),
+        &setting("method", "ratio"),
+    );
+    let out = volpt(&["info", scene.to_str().unwrap()]);
+    assert_success(&out);
+    let err = stderr(&out);
+    for warning in [
+        "grid.xml:10: <string name=\"filter_type\"> value \"nearest\": volpt uses trilinear",
+        "grid.xml:11: <string name=\"wrap_mode\"> value \"repeat\": volpt uses clamp",
+        "grid.xml:13: <string name=\"method\"> value \"ratio\": volpt uses delta (Woodcock) \
+         tracking, which is unbiased",
+    ] {
+        assert!(err.contains(warning), "no warning {warning:?}: {err}");
+    }
+    let scene = grid_scene_with(
+        dir.path(),
+        "d.vol",
+        &(setting("filter_type", " Trilinear") + &setting("wrap_mode", "CLAMP")),
+        &setting("method", "woodcock "),
+    );
+    let out = volpt(&["info", scene.to_str().unwrap()]);
+    assert_success(&out);
+    assert!(!stderr(&out).contains("volpt uses"), "{}", stderr(&out));
 }
 
 /// Half-precision texels end at 65504: `--lookup texture-f16` refuses a grid beyond that, naming

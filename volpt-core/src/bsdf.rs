@@ -113,7 +113,7 @@ impl Bsdf for RoughDielectric {
     /// `wo`, chosen with the visible-normal density `D_wi(m)` and its lobe with probability `F` (or
     /// `1 - F`); the change of variables from `m` to `wo` is `1 / (4 |wo . m|)` on reflection and
     /// `eta^2 |wo . m| / (wi . m + eta wo . m)^2` on refraction; the weight is `G1(wo, m) / eta^2`.
-    #[inline(always)]
+    #[inline]
     fn eval(&self, n: Vec3, d: Vec3, wo: Vec3) -> BsdfEval {
         let zero = BsdfEval::default();
         let outside = d.dot(n) < 0.0;

@@ -236,18 +236,11 @@ fn heterogeneous(p: &Plugin<'_>) -> Result<(DensityDesc, AlbedoDesc), SceneError
             VolumeValue::Constant(v) => AlbedoDesc::Constant(in_unit_range(&arg, v)?),
         },
     };
-    if let Some(arg) = p.find(&["method"])? {
-        let raw = arg.string()?;
-        if !raw.trim().eq_ignore_ascii_case("woodcock") {
-            tracing::warn!(
-                "{}:{}: {} value {}: volpt always uses delta (Woodcock) tracking, which is unbiased",
-                arg.target.file.display(),
-                arg.target.line,
-                arg.target.describe(),
-                quoted(raw)
-            );
-        }
-    }
+    p.warn_unless(
+        &["method"],
+        "woodcock",
+        "delta (Woodcock) tracking, which is unbiased",
+    )?;
     Ok((density, albedo))
 }
 

@@ -269,6 +269,30 @@ impl<'a> Plugin<'a> {
         }
     }
 
+    /// Reads a string setting of Mitsuba's that volpt has no choice of: `accepted` (in any case,
+    /// spaces around it aside) silently, any other value with a warning that says where it is and
+    /// what volpt `uses` instead.
+    pub fn warn_unless(
+        &self,
+        names: &[&str],
+        accepted: &str,
+        uses: &str,
+    ) -> Result<(), SceneError> {
+        if let Some(arg) = self.find(names)? {
+            let raw = arg.string()?;
+            if !raw.trim().eq_ignore_ascii_case(accepted) {
+                tracing::warn!(
+                    "{}:{}: {} value {}: volpt uses {uses}",
+                    arg.target.file.display(),
+                    arg.target.line,
+                    arg.target.describe(),
+                    quoted(raw)
+                );
+            }
+        }
+        Ok(())
+    }
+
     /// Reports what was not read: properties with a warning, anything else as an error.
     pub fn finish(self) -> Result<(), SceneError> {
         let used = self.used.into_inner();

@@ -11,7 +11,7 @@
 use std::path::Path;
 
 use super::boxes::scaled_box;
-use super::plugin::{quoted, Arg, Ctx, Plugin};
+use super::plugin::{Arg, Ctx, Plugin};
 use super::preprocess::Dialect;
 use super::spectrum::rgb;
 use super::transform::{transform, IDENTITY_F64};
@@ -198,24 +198,8 @@ fn file_box(vol: &VolGrid) -> ([f64; 3], [f64; 3]) {
 
 /// volpt always interpolates trilinearly and clamps at the edges (Mitsuba 3's defaults).
 fn warn_on_lookup_settings(p: &Plugin<'_>) -> Result<(), SceneError> {
-    for (names, expected) in [
-        (&["filter_type"][..], "trilinear"),
-        (&["wrap_mode"][..], "clamp"),
-    ] {
-        if let Some(arg) = p.find(names)? {
-            let raw = arg.string()?;
-            if !raw.trim().eq_ignore_ascii_case(expected) {
-                tracing::warn!(
-                    "{}:{}: {} value {}: volpt uses {expected}",
-                    arg.target.file.display(),
-                    arg.target.line,
-                    arg.target.describe(),
-                    quoted(raw)
-                );
-            }
-        }
-    }
-    Ok(())
+    p.warn_unless(&["filter_type"], "trilinear", "trilinear")?;
+    p.warn_unless(&["wrap_mode"], "clamp", "clamp")
 }
 
 /// One grey channel to three equal ones, allocating fallibly (the grid may be large).
