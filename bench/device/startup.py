@@ -14,6 +14,7 @@ import time
 volpt = sys.argv[1] if len(sys.argv) > 1 else "bin/volpt"
 runs = int(sys.argv[2]) if len(sys.argv) > 2 else 5
 out = os.environ.get("OUT", "/tmp")
+os.makedirs(out, exist_ok=True)
 args = [volpt, "render", "scenes/example/cube.xml", "--resolution", "16x16", "--spp", "1",
         "--backend", "cuda", "-o", os.path.join(out, "tiny.exr")]
 env = dict(os.environ, RUST_LOG="volpt=debug,volpt_cuda=debug,volpt_scene=debug", NO_COLOR="1")
