@@ -468,7 +468,10 @@ fn the_throughput_roulette_kills_no_path_for_entering_a_denser_medium() {
     let (mean, se, killed) = with_scene(&desc, settings, FurnaceSampleMean { paths: 20_000 });
     assert_eq!(killed, 0, "mean {mean}, se {se}");
     // `1/eta^2` and `eta^2` in f32: exact up to rounding.
-    assert!((mean - 1.0).abs() < 1e-5 && se < 1e-6, "mean {mean}, se {se}");
+    assert!(
+        (mean - 1.0).abs() < 1e-5 && se < 1e-6,
+        "mean {mean}, se {se}"
+    );
 }
 
 #[test]
