@@ -21,7 +21,7 @@
 //! interaction with the boundary does ([`boundary_next_event_estimate`]). Depth and roulette follow Mitsuba's
 //! `volpath`: `depth` counts scattering events and dielectric interactions, a path may see the light
 //! after at most `max_depth - 1` of them, and from `rr_depth` on it survives with probability
-//! `min(max(throughput) * eta^2, 0.95)`, or by the thesis's `min(1, max(throughput))`
+//! `min(max(throughput) * eta^2, 0.95)`, or by the thesis's `min(1, max(throughput) * eta^2)`
 //! ([`Roulette`]).
 
 use core::ops::Range;
