@@ -145,15 +145,15 @@ fn settings_volpt_has_no_choice_of_are_warned_about() {
     write_vol(&dir.path().join("d.vol"), &grid(vec![1.0; 8])).unwrap();
     let setting =
         |name: &str, value: &str| format!("\n      <string name=\"{name}\" value=\"{value}\"/>");
-    let scene = grid_scene_with(
-        dir.path(),
-        "d.vol",
-        &(setting("filter_type", "nearest") + &setting("wrap_mode", "repeat")),
-        &setting("method", "ratio"),
-    );
-    let out = volpt(&["info", scene.to_str().unwrap()]);
-    assert_success(&out);
-    let err = stderr(&out);
+    // `volpt info`'s warnings for a grid's filter and wrap mode and a medium's method.
+    let warnings = |filter: &str, wrap: &str, method: &str| {
+        let grid = setting("filter_type", filter) + &setting("wrap_mode", wrap);
+        let scene = grid_scene_with(dir.path(), "d.vol", &grid, &setting("method", method));
+        let out = volpt(&["info", scene.to_str().unwrap()]);
+        assert_success(&out);
+        stderr(&out)
+    };
+    let err = warnings("nearest", "repeat", "ratio");
     for warning in [
         "grid.xml:10: <string name=\"filter_type\"> value \"nearest\": volpt uses trilinear",
         "grid.xml:11: <string name=\"wrap_mode\"> value \"repeat\": volpt uses clamp",
@@ -162,15 +162,8 @@ fn settings_volpt_has_no_choice_of_are_warned_about() {
     ] {
         assert!(err.contains(warning), "no warning {warning:?}: {err}");
     }
-    let scene = grid_scene_with(
-        dir.path(),
-        "d.vol",
-        &(setting("filter_type", " Trilinear") + &setting("wrap_mode", "CLAMP")),
-        &setting("method", "woodcock "),
-    );
-    let out = volpt(&["info", scene.to_str().unwrap()]);
-    assert_success(&out);
-    assert!(!stderr(&out).contains("volpt uses"), "{}", stderr(&out));
+    let err = warnings(" Trilinear", "CLAMP", "woodcock ");
+    assert!(!err.contains("volpt uses"), "{err}");
 }
 
 /// Half-precision texels end at 65504: `--lookup texture-f16` refuses a grid beyond that, naming
