@@ -10,7 +10,7 @@
 mod common;
 
 use common::{Moments, Z_MAX};
-use volpt_core::path::{fly, sample_pixel, scatter, step, trace, Truncation};
+use volpt_core::path::{fly, sample_pixel, scatter, step, trace, Truncation, NEGLIGIBLE_WEIGHT};
 use volpt_core::{
     Aabb, ConstantEnvironment, Estimator, HenyeyGreenstein, HomogeneousMedium, NullBoundary,
     PathCounters, PathSettings, PathState, PerspectiveCamera, Ray, Rng, Roulette, SmoothDielectric,
@@ -263,6 +263,73 @@ fn each_collision_weighs_the_throughput_by_the_albedo() {
         deepest = deepest.max(path.depth);
     }
     assert!(deepest >= 3, "paths collided at most {deepest} times");
+}
+
+/// Without roulette (`rr_depth` unlimited) a path still faces it once its weight
+/// `max(throughput) * eta^2` is below `NEGLIGIBLE_WEIGHT`: it survives with probability
+/// `weight / NEGLIGIBLE_WEIGHT` and then carries exactly that weight, so the throughput's mean is
+/// unchanged; a path above it draws no number for roulette. A rule without `eta^2`, a survivor's
+/// throughput left undivided or roulette above the bound each fail one of the assertions.
+#[test]
+fn a_negligible_weight_faces_roulette_without_bias() {
+    let scene = furnace(PathSettings {
+        rr_depth: PathSettings::UNLIMITED,
+        estimator: Estimator::PathTracing,
+        ..PathSettings::default()
+    });
+    // Inside a denser medium (eta 1.5), a weight a quarter of the bound: q = 1/4.
+    let eta = 1.5f32;
+    let q = 0.25f32;
+    let throughput = Spectrum::new(1.0, 0.5, 0.25) * (q * NEGLIGIBLE_WEIGHT / (eta * eta));
+    let collide = |sample: u32, throughput: Spectrum| {
+        let mut path = PathState::from_camera(&scene, 4, 3, sample, 5);
+        path.inside = true;
+        path.eta_scale = eta;
+        path.throughput = throughput;
+        let drawn = path.rng.dimension();
+        scatter(&scene, &mut path, Vec3::ZERO, None);
+        (path, path.rng.dimension() - drawn)
+    };
+    let paths = 100_000u32;
+    let (mut survived, mut moments) = (0u32, Moments::default());
+    for sample in 0..paths {
+        let (path, drawn) = collide(sample, throughput);
+        assert_eq!(
+            drawn, 3,
+            "the phase sample's two numbers and roulette's one"
+        );
+        let carried = if path.alive {
+            survived += 1;
+            let weight = path.throughput.max_element() * eta * eta;
+            assert!(
+                (weight / NEGLIGIBLE_WEIGHT - 1.0).abs() < 1e-6,
+                "a survivor carries {weight}, not {NEGLIGIBLE_WEIGHT}"
+            );
+            path.throughput.x
+        } else {
+            0.0
+        };
+        moments.push(carried as f64);
+    }
+    let expected = paths as f64 * q as f64;
+    let sd = (expected * (1.0 - q as f64)).sqrt();
+    assert!(
+        (survived as f64 - expected).abs() <= Z_MAX * sd,
+        "{survived} of {paths} survived, expected {expected} +- {sd}"
+    );
+    let (mean, se) = (moments.mean(), moments.std_error());
+    assert!(
+        (mean - throughput.x as f64).abs() <= Z_MAX * se,
+        "mean throughput after roulette {mean} +- {se}, before {}",
+        throughput.x
+    );
+    // Twice the bound: no roulette, no number drawn for it, the throughput only weighted by the
+    // albedo (1).
+    let above = throughput * (2.0 / q);
+    for sample in 0..1000 {
+        let (path, drawn) = collide(sample, above);
+        assert!(path.alive && path.throughput == above && drawn == 2);
+    }
 }
 
 /// `fly` up to a real collision and `scatter` there, with the albedo read by `scatter` or handed
