@@ -121,7 +121,8 @@ struct SceneArgs {
     /// Longest path, Mitsuba's max_depth; -1 is unlimited (default: the scene's integrator).
     #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(i64).range(-1..=u32::MAX as i64))]
     max_depth: Option<i64>,
-    /// Depth from which Russian roulette starts, Mitsuba's rr_depth; -1 disables it.
+    /// Depth from which Russian roulette starts, Mitsuba's rr_depth; -1 disables it (a path whose
+    /// weight falls below 2^-40 still faces it: unbiased, docs/guide.md).
     #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(i64).range(-1..=u32::MAX as i64))]
     rr_depth: Option<i64>,
     /// Render with the most general variant (grid density and albedo, Henyey-Greenstein, lat-long

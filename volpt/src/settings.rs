@@ -22,7 +22,8 @@ pub struct RenderSettings {
     pub resolution: Option<(u32, u32)>,
     /// Longest path (Mitsuba's `max_depth`); `Some(None)` is unlimited (-1).
     pub max_depth: Option<Option<u32>>,
-    /// Depth from which Russian roulette starts (Mitsuba's `rr_depth`); `Some(None)` disables it.
+    /// Depth from which Russian roulette starts (Mitsuba's `rr_depth`); `Some(None)` disables it,
+    /// except for paths of negligible weight (`volpt_core::path::NEGLIGIBLE_WEIGHT`).
     pub rr_depth: Option<Option<u32>>,
     /// One global majorant or a majorant grid (default: chosen per scene by the factory).
     pub tracking: Option<Tracking>,
