@@ -761,6 +761,9 @@ fn configuration(
     match (backend.strategy(), ran) {
         (Some(volpt::StrategyChoice::Auto), Some(ran)) => {
             let _ = write!(s, ", auto: {}", ran.strategy);
+            if let Some(cap) = ran.max_registers {
+                let _ = write!(s, " with <= {cap} registers");
+            }
         }
         (Some(strategy), _) => {
             let _ = write!(s, ", {strategy}");

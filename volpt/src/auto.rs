@@ -33,9 +33,19 @@ const CALIBRATION_PATHS: u64 = volpt_device::launch::FIRST_LAUNCH_PATHS;
 /// Timed renders per candidate; the fastest counts (the first also warms the kernel up).
 const TRIALS: usize = 2;
 
-/// The strategy of a render without `--strategy` that is too short to repay a calibration: the
-/// best fixed choice on most scenes (docs/strategies.md).
-pub const DEFAULT: Strategy = Strategy::RegenerationSk;
+/// The schedule of a render without `--strategy` that is too short to repay a calibration:
+/// regeneration-sk, the best fixed strategy on most scenes (docs/strategies.md), with at most 64
+/// registers a thread (the JIT's `.maxnreg`; a 128-thread block then needs 8192 of an SM's 65536
+/// registers, so 8 blocks fit). Against the compiler's choice on the seven scenes of the Mitsuba
+/// comparison (H100, 2026-11-27, `bench/results/2026-11-27-h100-session6/caps.txt`): envmap-cube
+/// 1.31x, ad 1.17x, cgg-logo 1.14x, bucky 1.09x, the rough cube 1.07x, the index-matched cube and
+/// smoke 0.98x.
+pub const DEFAULT: Schedule = Schedule {
+    strategy: Strategy::RegenerationSk,
+    max_registers: Some(64),
+    refill_at: None,
+    tiles: None,
+};
 
 /// The strategies a calibration times. Not the naive baselines (naive-sk, naive-mk: a batch of
 /// one sample per pixel waits for its longest path), and not the sorting, multi-kernel and
@@ -120,7 +130,7 @@ impl Choice {
     }
 }
 
-fn registers(cap: Option<u32>) -> String {
+pub(crate) fn registers(cap: Option<u32>) -> String {
     cap.map_or_else(
         || "compiler's registers".to_owned(),
         |n| format!("<= {n} registers"),

@@ -244,7 +244,7 @@ impl Backend {
                 };
                 // The first render's kernel is of this strategy (`auto` without a calibration
                 // runs auto::DEFAULT): its kernels decompress while the driver opens the GPUs.
-                let first = schedule.map_or(auto::DEFAULT, |s| s.strategy);
+                let first = schedule.map_or(auto::DEFAULT.strategy, |s| s.strategy);
                 volpt_cuda::kernels::prefetch(math, first);
                 let renderers = ordinals
                     .into_iter()
@@ -780,7 +780,7 @@ impl SceneVisitor for Render<'_> {
 }
 
 /// The cached `auto` choice for `key`, or a new calibration (noted and cached); without a cached
-/// choice and with `skip_calibration`, regeneration-sk ([`auto::DEFAULT`]).
+/// choice and with `skip_calibration`, [`auto::DEFAULT`].
 fn auto_schedule<S: RenderScene>(
     renderer: &CudaRenderer,
     cache: &AutoCache,
@@ -796,11 +796,12 @@ fn auto_schedule<S: RenderScene>(
     }
     if skip_calibration {
         tracing::debug!(
-            "strategy {}: this render is too short to repay auto's calibration (--strategy auto \
-             calibrates anyway)",
-            auto::DEFAULT.name()
+            "strategy {} with {}: this render is too short to repay auto's calibration \
+             (--strategy auto calibrates anyway)",
+            auto::DEFAULT.strategy.name(),
+            auto::registers(auto::DEFAULT.max_registers)
         );
-        return Ok(auto::DEFAULT.into());
+        return Ok(auto::DEFAULT);
     }
     observer.note("auto: calibrating the GPU strategies on this scene (cached afterwards)\n");
     let choice = auto::calibrate(renderer, scene, options)?;
