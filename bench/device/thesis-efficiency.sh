@@ -11,7 +11,8 @@
 # render(); volpt: `volpt bench`).
 #   bash bundle/thesis-efficiency.sh   -> $OUT/thesis-efficiency.txt
 # Needs the peer in bundle/thesis (see thesis.sh). Knobs: SPP (100), REFSPP (4096), TRIALS (5),
-# RES (400), SCENES ("cgg_logo ad"), LOOKUP (texture), MATH (fast), STRATEGY (regeneration-sk).
+# RES (400), SCENES ("cgg_logo ad"), LOOKUP (texture), MATH (fast), STRATEGY (empty: no --strategy,
+# volpt's default for a render this short, `volpt::auto::DEFAULT`).
 set -uo pipefail
 cd "$(dirname "$0")"
 OUT=${OUT:-$PWD/out}
@@ -25,7 +26,7 @@ RES=${RES:-400}
 SCENES=${SCENES:-cgg_logo ad}
 LOOKUP=${LOOKUP:-texture}
 MATH=${MATH:-fast}
-STRATEGY=${STRATEGY:-regeneration-sk}
+STRATEGY=${STRATEGY:-}
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/thesis-efficiency.XXXXXX")
 export RUST_BACKTRACE=0 RUST_LIB_BACKTRACE=0
 [ -d "$PEER/lib" ] && export LD_LIBRARY_PATH=$PEER/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
@@ -82,7 +83,7 @@ thesis_side() { # thesis_side SCENE SETTING BINARY
 volpt_side() { # volpt_side SCENE SETTING VOLPT-ARGS...
     local scene=$1 setting=$2 xml=$WORK/scenes/$1/volpath_bsdf.xml t mse
     shift 2
-    local args=(--backend cuda --strategy "$STRATEGY" --math "$MATH" --lookup "$LOOKUP" --resolution "${RES}x$RES" "$@")
+    local args=(--backend cuda ${STRATEGY:+--strategy "$STRATEGY"} --math "$MATH" --lookup "$LOOKUP" --resolution "${RES}x$RES" "$@")
     timeout 120 "$VOLPT" bench "$xml" "${args[@]}" --spp "$SPP" --trials "$TRIALS" --json >"$WORK/b.json" 2>"$WORK/v.log" \
         || { echo "FAIL volpt $scene $setting: $(grep -m 1 -E "Error|error" "$WORK/v.log")"; return; }
     t=$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["time_mean_s"])' "$WORK/b.json")
@@ -90,7 +91,7 @@ volpt_side() { # volpt_side SCENE SETTING VOLPT-ARGS...
         && "$VOLPT" render "$xml" "${args[@]}" --spp "$REFSPP" --seed 2 -o "$WORK/v-ref.exr" >/dev/null 2>"$WORK/v.log" \
         || { echo "FAIL volpt $scene $setting render: $(grep -m 1 -E "Error|error" "$WORK/v.log")"; return; }
     mse=$("$VOLPT" compare "$WORK/v.exr" "$WORK/v-ref.exr" | grep -o -E "mse [0-9.e+-]+" | cut -d' ' -f2)
-    row "$scene" "volpt $STRATEGY $MATH $LOOKUP" "$setting" "$t" "$mse"
+    row "$scene" "volpt ${STRATEGY:-default} $MATH $LOOKUP" "$setting" "$t" "$mse"
 }
 
 {
