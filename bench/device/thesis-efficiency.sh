@@ -28,6 +28,8 @@ LOOKUP=${LOOKUP:-texture}
 MATH=${MATH:-fast}
 STRATEGY=${STRATEGY:-}
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/thesis-efficiency.XXXXXX")
+# An empty auto cache: without --strategy, volpt's choice is then its default, not one cached earlier.
+export VOLPT_CACHE_DIR=$WORK/cache
 export RUST_BACKTRACE=0 RUST_LIB_BACKTRACE=0
 [ -d "$PEER/lib" ] && export LD_LIBRARY_PATH=$PEER/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 PEER_BIN=$PEER/bin

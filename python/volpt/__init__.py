@@ -61,8 +61,8 @@ def load(path: "str | os.PathLike[str]", settings: Optional[Mapping[str, Any]] =
 
     ``settings`` (positional) overrides what the scene file says, with the ``volpt render`` flags'
     names and values: ``spp``, ``seed``, ``resolution`` ((width, height)), ``max_depth`` and
-    ``rr_depth`` (-1: unlimited / never), ``tracking`` ("global", "grid"),
-    ``majorant_resolution``, ``estimator`` ("pt", "nee"), ``lookup`` ("trilinear", "nearest",
+    ``rr_depth`` (-1: unlimited / never; paths of negligible weight face roulette regardless),
+    ``tracking`` ("global", "grid"), ``majorant_resolution``, ``estimator`` ("pt", "nee"), ``lookup`` ("trilinear", "nearest",
     "texture", "texture-f16", "stochastic"), ``roulette`` ("mitsuba", "throughput"), ``effects``
     ("specialised", "general") and ``threads`` (CPU worker threads):
     ``volpt.load("cube.xml", {"resolution": (64, 48), "tracking": "grid"})``.

@@ -75,9 +75,10 @@ pub struct ConvergeArgs {
 /// One value of one knob.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Choice {
-    /// Russian roulette from the scene's `rr_depth` (5 if it has none), or never.
+    /// Russian roulette from the scene's `rr_depth` (5 if it has none), or never (but for paths of
+    /// negligible weight, `volpt_core::path::NEGLIGIBLE_WEIGHT`).
     Roulette(bool),
-    /// Roulette from this depth; `None` never.
+    /// Roulette from this depth; `None` never (but for paths of negligible weight).
     RrDepth(Option<u32>),
     /// Longest path; `None` unlimited.
     MaxDepth(Option<u32>),

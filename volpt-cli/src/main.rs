@@ -761,14 +761,14 @@ fn configuration(
     match (backend.strategy(), ran) {
         (Some(volpt::StrategyChoice::Auto), Some(ran)) => {
             let _ = write!(s, ", auto: {}", ran.strategy);
-            if let Some(cap) = ran.max_registers {
-                let _ = write!(s, " with <= {cap} registers");
-            }
         }
         (Some(strategy), _) => {
             let _ = write!(s, ", {strategy}");
         }
         (None, _) => {}
+    }
+    if let Some(cap) = ran.and_then(|ran| ran.max_registers) {
+        let _ = write!(s, " with <= {cap} registers");
     }
     if let Some(math) = backend.math() {
         let _ = write!(s, ", {math} math");

@@ -43,7 +43,8 @@ use crate::{Ray, Spectrum, Vec3};
 pub struct PathSettings {
     /// Longest path in segments (Mitsuba's `max_depth`); `u32::MAX` for unlimited.
     pub max_depth: u32,
-    /// Depth from which Russian roulette runs; `u32::MAX` for never.
+    /// Depth from which Russian roulette runs by [`Self::roulette`]; `u32::MAX` for never (a path of
+    /// negligible weight faces roulette whatever this says, [`NEGLIGIBLE_WEIGHT`]).
     pub rr_depth: u32,
     /// A safety bound on free flights per path. Without roulette and depth limit, a path in a
     /// non-absorbing medium behind a reflecting boundary can in principle bounce for ever; a path
@@ -91,14 +92,15 @@ pub enum Roulette {
 
 /// The weight `max(throughput) * eta^2` below which a path faces Russian roulette whatever the
 /// scene's `rr_depth` says: it survives with probability `weight / NEGLIGIBLE_WEIGHT` and then
-/// carries exactly this weight. Unbiased like any roulette; it only ends paths whose light is at
-/// most 2^-40 of the environment's, which without it can run for thousands of segments: in an
-/// albedo-0.9 medium without roulette the throughput `0.9^k` reaches the smallest subnormal after
-/// ~980 collisions and stays there (0.9 times it rounds back to it), so a random walk deep in a
-/// dense box (the thesis's homogeneous benchmark) runs until it escapes. There, in a simulation
-/// of a million walks, the longest path shrinks from 13,931 segments to 367 and the mean from 85.5
-/// to 42.8, with the same mean and variance of the returned light to ten digits
-/// (`bench/results/2026-11-27-h100-session6/walk.py`).
+/// carries this weight (up to rounding). Unbiased like any roulette (to the 2^-24 resolution of
+/// [`Rng::next_f32`], which matters only below a weight of 2^-64); it only ends paths whose light is
+/// at most 2^-40 of the environment's, which without it can run for thousands of segments: in an
+/// albedo-0.9 medium without roulette the throughput `0.9^k` stalls among the subnormals (0.9
+/// times 2^-147 rounds back to it) and never reaches 0, so a random walk deep in a dense box (the
+/// thesis's homogeneous benchmark) runs until it escapes. There, in a simulation of a million
+/// walks, the longest path shrinks from 13,931 segments to 367 and the mean from 85.5 to 42.8,
+/// while the mean and variance of the returned light agree to ten digits: the roulette's added
+/// variance is not measurable (`bench/results/2026-11-27-h100-session6/walk.py`).
 pub const NEGLIGIBLE_WEIGHT: f32 = 1.0 / (1u64 << 40) as f32;
 
 /// How a path gathers the environment's light.

@@ -265,71 +265,101 @@ fn each_collision_weighs_the_throughput_by_the_albedo() {
     assert!(deepest >= 3, "paths collided at most {deepest} times");
 }
 
-/// Without roulette (`rr_depth` unlimited) a path still faces it once its weight
-/// `max(throughput) * eta^2` is below `NEGLIGIBLE_WEIGHT`: it survives with probability
-/// `weight / NEGLIGIBLE_WEIGHT` and then carries exactly that weight, so the throughput's mean is
-/// unchanged; a path above it draws no number for roulette. A rule without `eta^2`, a survivor's
-/// throughput left undivided or roulette above the bound each fail one of the assertions.
-#[test]
-fn a_negligible_weight_faces_roulette_without_bias() {
-    let scene = furnace(PathSettings {
-        rr_depth: PathSettings::UNLIMITED,
-        estimator: Estimator::PathTracing,
-        ..PathSettings::default()
-    });
-    // Inside a denser medium (eta 1.5), a weight a quarter of the bound: q = 1/4.
-    let eta = 1.5f32;
-    let q = 0.25f32;
-    let throughput = Spectrum::new(1.0, 0.5, 0.25) * (q * NEGLIGIBLE_WEIGHT / (eta * eta));
-    let collide = |sample: u32, throughput: Spectrum| {
-        let mut path = PathState::from_camera(&scene, 4, 3, sample, 5);
-        path.inside = true;
-        path.eta_scale = eta;
-        path.throughput = throughput;
-        let drawn = path.rng.dimension();
-        scatter(&scene, &mut path, Vec3::ZERO, None);
-        (path, path.rng.dimension() - drawn)
-    };
-    let paths = 100_000u32;
-    let (mut survived, mut moments) = (0u32, Moments::default());
+/// Asserts that of `paths` paths that `advance` takes through one interaction a binomial count of
+/// probability `q` survives roulette (within `Z_MAX` sigma), each survivor with the weight
+/// `max(throughput) * eta^2` of the bound: together, the mean weight is the weight before.
+fn assert_negligible_roulette(what: &str, paths: u32, q: f32, advance: impl Fn(u32) -> PathState) {
+    let mut survived = 0u32;
     for sample in 0..paths {
-        let (path, drawn) = collide(sample, throughput);
-        assert_eq!(
-            drawn, 3,
-            "the phase sample's two numbers and roulette's one"
-        );
-        let carried = if path.alive {
+        let path = advance(sample);
+        if path.alive {
             survived += 1;
-            let weight = path.throughput.max_element() * eta * eta;
+            let weight = path.throughput.max_element() * path.eta_scale * path.eta_scale;
             assert!(
                 (weight / NEGLIGIBLE_WEIGHT - 1.0).abs() < 1e-6,
-                "a survivor carries {weight}, not {NEGLIGIBLE_WEIGHT}"
+                "{what}: a survivor carries {weight}, not {NEGLIGIBLE_WEIGHT}"
             );
-            path.throughput.x
-        } else {
-            0.0
-        };
-        moments.push(carried as f64);
+        }
     }
     let expected = paths as f64 * q as f64;
     let sd = (expected * (1.0 - q as f64)).sqrt();
     assert!(
         (survived as f64 - expected).abs() <= Z_MAX * sd,
-        "{survived} of {paths} survived, expected {expected} +- {sd}"
+        "{what}: {survived} of {paths} survived, expected {expected} +- {sd}"
     );
-    let (mean, se) = (moments.mean(), moments.std_error());
-    assert!(
-        (mean - throughput.x as f64).abs() <= Z_MAX * se,
-        "mean throughput after roulette {mean} +- {se}, before {}",
-        throughput.x
-    );
-    // Twice the bound: no roulette, no number drawn for it, the throughput only weighted by the
-    // albedo (1).
-    let above = throughput * (2.0 / q);
-    for sample in 0..1000 {
-        let (path, drawn) = collide(sample, above);
-        assert!(path.alive && path.throughput == above && drawn == 2);
+}
+
+/// Before `rr_depth` (unlimited, or not yet reached) a path still faces roulette once its weight
+/// `max(throughput) * eta^2` is below `NEGLIGIBLE_WEIGHT`: it survives with probability
+/// `weight / NEGLIGIBLE_WEIGHT` and then carries that weight, so the throughput's mean is
+/// unchanged; at the bound or above it a path draws no number for roulette. Both places that run
+/// roulette are checked: after a collision in a denser medium, and after a refraction or
+/// reflection at a smooth dielectric. A rule without `eta^2`, a survivor's throughput left
+/// undivided, roulette at or above the bound, the rule gated on an unlimited `rr_depth`, or the
+/// rule missing at the boundary each fail one of the assertions.
+#[test]
+fn a_negligible_weight_faces_roulette_without_bias() {
+    // A weight a quarter of the bound: q = 1/4.
+    let q = 0.25f32;
+    let eta = 1.5f32;
+    for rr_depth in [PathSettings::UNLIMITED, 1000] {
+        let scene = furnace(PathSettings {
+            rr_depth,
+            estimator: Estimator::PathTracing,
+            ..PathSettings::default()
+        });
+        // A collision inside a denser medium (eta 1.5), the albedo 1.
+        let collide = |sample: u32, throughput: Spectrum| {
+            let mut path = PathState::from_camera(&scene, 4, 3, sample, 5);
+            path.inside = true;
+            path.eta_scale = eta;
+            path.throughput = throughput;
+            let drawn = path.rng.dimension();
+            scatter(&scene, &mut path, Vec3::ZERO, None);
+            (path, path.rng.dimension() - drawn)
+        };
+        let throughput = Spectrum::new(1.0, 0.5, 0.25) * (q * NEGLIGIBLE_WEIGHT / (eta * eta));
+        let what = format!("collision, rr_depth {rr_depth}");
+        assert_negligible_roulette(&what, 100_000, q, |sample| {
+            let (path, drawn) = collide(sample, throughput);
+            assert_eq!(
+                drawn, 3,
+                "the phase sample's two numbers and roulette's one"
+            );
+            // Every component divided by q, not only the largest.
+            if path.alive {
+                let ratio = path.throughput / throughput;
+                assert!((ratio.max_element() / ratio.min_element() - 1.0).abs() < 1e-6);
+            }
+            path
+        });
+        // At the bound and at twice it: no roulette, no number drawn for it, the throughput only
+        // weighted by the albedo (1).
+        for at in [throughput / q, throughput * (2.0 / q)] {
+            for sample in 0..1000 {
+                let (path, drawn) = collide(sample, at);
+                assert!(path.alive && path.throughput == at && drawn == 2, "{what}");
+            }
+        }
     }
+    // The camera ray meets a smooth dielectric of relative IOR 1.5: a reflection keeps the
+    // throughput and `eta_scale`, a refraction scales the throughput by 1/eta^2 and `eta_scale` by
+    // eta, so the weight after either is the weight before.
+    let scene = furnace_behind(
+        SmoothDielectric { eta },
+        PathSettings {
+            rr_depth: PathSettings::UNLIMITED,
+            estimator: Estimator::PathTracing,
+            ..PathSettings::default()
+        },
+    );
+    assert_negligible_roulette("boundary", 40_000, q, |sample| {
+        let mut path = PathState::from_camera(&scene, 4, 3, sample, 6);
+        path.throughput = Spectrum::splat(q * NEGLIGIBLE_WEIGHT);
+        step(&scene, &mut path);
+        assert_eq!(path.depth, 1, "the camera ray meets the boundary");
+        path
+    });
 }
 
 /// `fly` up to a real collision and `scatter` there, with the albedo read by `scatter` or handed

@@ -142,7 +142,8 @@ pub struct Config {
     pub resolution: Option<(u32, u32)>,
     /// Mitsuba's `max_depth`: `Some(None)` is unlimited (-1).
     pub max_depth: Option<Option<u32>>,
-    /// Mitsuba's `rr_depth`: `Some(None)` disables Russian roulette (-1).
+    /// Mitsuba's `rr_depth`: `Some(None)` disables Russian roulette (-1), but for paths of
+    /// negligible weight.
     pub rr_depth: Option<Option<u32>>,
 }
 

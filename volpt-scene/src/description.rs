@@ -78,7 +78,8 @@ pub struct FilmDesc {
 pub struct IntegratorDesc {
     /// Longest path, counted in segments: 1 shows only directly visible light.
     pub max_depth: Option<u32>,
-    /// Depth from which Russian roulette is used; `None` disables it.
+    /// Depth from which Russian roulette is used; `None` disables it (but for paths of negligible
+    /// weight, `volpt_core::path::NEGLIGIBLE_WEIGHT`).
     pub rr_depth: Option<u32>,
 }
 

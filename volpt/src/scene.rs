@@ -144,7 +144,8 @@ const SCENE_PARAMS: &[(&str, &str)] = &[
     ),
     (
         "rr_depth",
-        "depth from which Russian roulette runs, an integer; -1 never",
+        "depth from which Russian roulette runs, an integer; -1 never (but for paths of negligible \
+         weight)",
     ),
     ("camera.origin", "the camera's position, a 3-vector"),
     (
