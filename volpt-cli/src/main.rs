@@ -767,8 +767,8 @@ fn configuration(
         }
         (None, _) => {}
     }
-    if let Some(cap) = ran.and_then(|ran| ran.max_registers) {
-        let _ = write!(s, " with <= {cap} registers");
+    if let Some(cap @ Some(_)) = ran.map(|ran| ran.max_registers) {
+        let _ = write!(s, " with {}", volpt::auto::registers(cap));
     }
     if let Some(math) = backend.math() {
         let _ = write!(s, ", {math} math");

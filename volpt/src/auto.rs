@@ -133,7 +133,8 @@ impl Choice {
     }
 }
 
-pub(crate) fn registers(cap: Option<u32>) -> String {
+/// A register cap as the reports name it: `<= N registers`, or the compiler's choice.
+pub fn registers(cap: Option<u32>) -> String {
     cap.map_or_else(
         || "compiler's registers".to_owned(),
         |n| format!("<= {n} registers"),
