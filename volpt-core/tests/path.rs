@@ -265,27 +265,40 @@ fn each_collision_weighs_the_throughput_by_the_albedo() {
     assert!(deepest >= 3, "paths collided at most {deepest} times");
 }
 
-/// Asserts that of `paths` paths that `advance` takes through one interaction a binomial count of
-/// probability `q` survives roulette (within `Z_MAX` sigma), each survivor with the weight
-/// `max(throughput) * eta^2` of the bound: together, the mean weight is the weight before.
+/// Asserts that of `paths` paths that `advance` takes through one interaction, each of weight
+/// `max(throughput) * eta^2 = q * NEGLIGIBLE_WEIGHT` before it, a binomial count of probability
+/// `q` survives roulette (within `Z_MAX` sigma), each survivor with the weight of the bound, and
+/// that the mean weight after it (0 for a path that died) is the weight before (within `Z_MAX`
+/// standard errors).
 fn assert_negligible_roulette(what: &str, paths: u32, q: f32, advance: impl Fn(u32) -> PathState) {
-    let mut survived = 0u32;
+    let (mut survived, mut weights) = (0u32, Moments::default());
     for sample in 0..paths {
         let path = advance(sample);
-        if path.alive {
+        let weight = if path.alive {
             survived += 1;
             let weight = path.throughput.max_element() * path.eta_scale * path.eta_scale;
             assert!(
                 (weight / NEGLIGIBLE_WEIGHT - 1.0).abs() < 1e-6,
                 "{what}: a survivor carries {weight}, not {NEGLIGIBLE_WEIGHT}"
             );
-        }
+            weight
+        } else {
+            0.0
+        };
+        weights.push(weight as f64);
     }
     let expected = paths as f64 * q as f64;
     let sd = (expected * (1.0 - q as f64)).sqrt();
     assert!(
         (survived as f64 - expected).abs() <= Z_MAX * sd,
         "{what}: {survived} of {paths} survived, expected {expected} +- {sd}"
+    );
+    let before = (q * NEGLIGIBLE_WEIGHT) as f64;
+    assert!(
+        weights.z_score(before).abs() <= Z_MAX,
+        "{what}: mean weight after roulette {} +- {}, before {before}",
+        weights.mean(),
+        weights.std_error()
     );
 }
 
