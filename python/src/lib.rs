@@ -20,7 +20,8 @@ use pyo3::types::{PyByteArray, PyDict, PyList, PyRange, PyTuple, PyType};
 use volpt::film::checkpoint::Checkpoint;
 use volpt::{
     Backend, BackendKind, BackendOptions, Effects, Error, Estimator, GpuOptions, GridLookup, Image,
-    Math, Observer, ParamValue, Part, RenderSettings, Roulette, StrategyChoice, Tracking, PARAMS,
+    Math, Observer, ParamValue, Part, RenderRequest, RenderSettings, Roulette, StrategyChoice,
+    Tracking, PARAMS,
 };
 
 /// How much CPU rendering passes between looks at Ctrl-C and the progress callback.
@@ -452,19 +453,17 @@ impl Scene {
         };
         let backend = open_backend(py, &options)?;
 
-        let mut this = slf.try_borrow_mut().map_err(|_| {
-            settings_error(
-                "render: the scene is in use by another thread (a render or a parameter change)"
-                    .into(),
-            )
+        // Renders only read the scene: threads render one scene at once (a parameter change
+        // waits for none of them, and is refused while one runs).
+        let this = slf.try_borrow().map_err(|_| {
+            settings_error("render: the scene is being changed by another thread".into())
         })?;
-        let scene = &mut this.inner;
-        backend.prepare(scene);
-        let range = samples.unwrap_or(0..spp.unwrap_or(scene.spp()));
-        let scene_seed = scene.seed();
-        if let Some(seed) = seed {
-            scene.set_seed(seed);
-        }
+        let scene = &this.inner;
+        let request = RenderRequest {
+            samples: samples.unwrap_or(0..spp.unwrap_or(scene.spp())),
+            seed,
+            ..RenderRequest::default()
+        };
         let observer = PyObserver {
             callback,
             done: AtomicU64::new(0),
@@ -476,21 +475,18 @@ impl Scene {
                 BackendKind::Cuda => CUDA_CHECK_EVERY,
             },
         };
-        let scene_ref: &volpt::Scene = scene;
         let result = py.allow_threads(|| {
-            let mut film = scene_ref.film();
-            backend
-                .render(scene_ref, &mut film, range.clone(), &observer)
-                .map(|rendered| (film, rendered))
+            let mut film = scene.film();
+            let rendered = backend.render(scene, &mut film, &request, &observer)?;
+            let fingerprint = backend.fingerprint(scene, &request)?;
+            Ok::<_, volpt::Error>((film, rendered, fingerprint))
         });
-        let part_seed = scene.seed();
-        let fingerprint = scene.fingerprint();
-        scene.set_seed(scene_seed);
+        let part_seed = request.seed.unwrap_or(scene.seed());
         drop(this);
         if let Some(error) = observer.error.lock().expect("not poisoned").take() {
             return Err(error);
         }
-        let (film, rendered) = result.map_err(to_py)?;
+        let (film, rendered, fingerprint) = result.map_err(to_py)?;
         if let Some(callback) = &observer.callback {
             let total = observer.total.load(Ordering::Relaxed).max(1);
             callback.call1(py, (total, total))?;

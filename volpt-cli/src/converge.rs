@@ -28,10 +28,12 @@ use std::time::Duration;
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
-use volpt::{Backend, Estimator, Film, Image, Math, PathSettings, Quiet, Scene, Strategy};
+use volpt::{
+    Backend, Estimator, Film, Image, Math, PathSettings, Quiet, RenderRequest, Scene, Strategy,
+};
 use volpt_render::path_settings;
 use volpt_scene::description::{AlbedoDesc, BsdfDesc, EnvironmentDesc};
-use volpt_scene::{GridStorage, SceneDescription};
+use volpt_scene::{GridLookup, SceneDescription};
 
 use crate::backend::{BackendKind, StrategyArg};
 use crate::plot::{log_log_png, log_log_svg, Series};
@@ -341,14 +343,14 @@ impl Halves {
     }
 }
 
-/// Adds samples `samples` (of the scene's seed) to `film`: every batch of the runs.
+/// Adds the samples `request` names to `film`: every batch of the runs.
 fn add_batch(
     backend: &Backend,
     scene: &Scene,
     film: &mut Film,
-    samples: std::ops::Range<u32>,
+    request: &RenderRequest,
 ) -> Result<Duration> {
-    let stats = backend.render(scene, film, samples, &Quiet)?.stats;
+    let stats = backend.render(scene, film, request, &Quiet)?.stats;
     if stats.counters.truncated > 0 {
         tracing::warn!(
             truncated = stats.counters.truncated,
@@ -359,7 +361,7 @@ fn add_batch(
 }
 
 pub fn run(args: &ConvergeArgs) -> Result<()> {
-    let mut scene = args.scene.load(Some(&args.sampling))?;
+    let scene = args.scene.load(Some(&args.sampling))?;
     let seed = scene.seed();
     let configurations = configurations(scene.description(), &args.sampling, &args.settings);
     // Before the reference, so that a configuration a backend cannot render costs nothing.
@@ -373,15 +375,10 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         );
     }
     let backend = args.sampling.open()?;
-    backend.prepare(&mut scene);
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
-    let reference = reference(args, &mut scene, &backend)?;
+    let reference = reference(args, &scene, &backend)?;
     drop(backend);
-    // `--lookup`'s, if given; else each configuration's backend's default (`Backend::prepare`).
-    let scene_lookup = scene
-        .lookup_chosen()
-        .then(|| scene.description().medium.lookup);
     let (w, h) = scene.resolution();
 
     let mut results = Vec::new();
@@ -398,11 +395,13 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
             config.label
         ));
         let backend = config.sampling.open()?;
-        scene.set_storage(GridStorage::Dense);
-        backend.prepare(&mut scene);
-        let lookup = config.lookup.map(Into::into).or(scene_lookup);
-        scene.set_lookup(lookup.unwrap_or_else(|| backend.default_lookup(&scene)))?;
-        scene.set_path_settings(config.settings);
+        // The configuration's lookup, if it names one; else `--lookup`'s, else its backend's
+        // default.
+        let request = RenderRequest {
+            path: Some(config.settings),
+            lookup: config.lookup.map(Into::into),
+            ..RenderRequest::default()
+        };
         let film = Film::new(w, h).with_accumulation(config.accumulation.into());
         let mut halves = Halves {
             films: [film.clone(), film],
@@ -415,8 +414,12 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
             let samples = halves.spp_each..halves.spp_each + spp;
             for (half, film) in (0u32..).zip(&mut halves.films) {
                 // One seed per half (not the reference's); each round continues its samples.
-                scene.set_seed(seed.wrapping_add(half + 1));
-                time += add_batch(&backend, &scene, film, samples.clone())?.as_secs_f64();
+                let batch = RenderRequest {
+                    samples: samples.clone(),
+                    seed: Some(seed.wrapping_add(half + 1)),
+                    ..request.clone()
+                };
+                time += add_batch(&backend, &scene, film, &batch)?.as_secs_f64();
             }
             halves.spp_each += spp;
             let (mse, rel_mse, variance) = halves.errors(&reference);
@@ -447,8 +450,8 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     write_outputs(args, &results)
 }
 
-/// The reference the errors are measured against; `scene` is left with its seed and settings.
-fn reference(args: &ConvergeArgs, scene: &mut Scene, backend: &Backend) -> Result<Reference> {
+/// The reference the errors are measured against.
+fn reference(args: &ConvergeArgs, scene: &Scene, backend: &Backend) -> Result<Reference> {
     let desc = scene.description();
     let (w, h) = (desc.film.width, desc.film.height);
     if let Some(path) = &args.reference {
@@ -470,7 +473,13 @@ fn reference(args: &ConvergeArgs, scene: &mut Scene, backend: &Backend) -> Resul
         );
         return Ok(Reference::Constant(rgb));
     }
-    let key = reference_key(args, desc);
+    // `--lookup`'s, if given; else the backend's default.
+    let lookup = if scene.lookup_chosen() {
+        desc.medium.lookup
+    } else {
+        backend.default_lookup(scene)
+    };
+    let key = reference_key(args, desc, lookup);
     let cached = [0, 1].map(|half| args.out.join(format!("reference-{key:016x}-{half}.exr")));
     if cached.iter().all(|p| p.exists()) {
         tracing::info!(path = %cached[0].display(), "using the cached reference");
@@ -478,23 +487,23 @@ fn reference(args: &ConvergeArgs, scene: &mut Scene, backend: &Backend) -> Resul
         return Ok(Reference::from_halves(&a?, &b?));
     }
     tracing::info!(spp = args.reference_spp, "rendering the reference");
-    let (seed, settings) = (scene.seed(), scene.path_settings());
-    scene.set_path_settings(reference_settings(desc));
+    let seed = scene.seed();
     let spp = args.reference_spp.div_ceil(2);
     let mut halves = Vec::new();
     for (half, path) in cached.iter().enumerate() {
-        // Seeds no batch of the runs uses (they count up from the base seed).
-        scene.set_seed(seed.wrapping_sub(1 + half as u32));
+        let request = RenderRequest::samples(0..spp)
+            .with_path(reference_settings(desc))
+            .with_lookup(lookup)
+            // Seeds no batch of the runs uses (they count up from the base seed).
+            .with_seed(seed.wrapping_sub(1 + half as u32));
         let terminal = crate::backend::Terminal::new(true);
         let mut film = scene.film();
-        backend.render(scene, &mut film, 0..spp, &terminal)?;
+        backend.render(scene, &mut film, &request, &terminal)?;
         terminal.finish();
         let image = film.image(spp);
         image.write_exr(path)?;
         halves.push(image);
     }
-    scene.set_seed(seed);
-    scene.set_path_settings(settings);
     Ok(Reference::from_halves(&halves[0], &halves[1]))
 }
 
@@ -526,12 +535,12 @@ fn white_furnace(desc: &SceneDescription) -> Option<[f32; 3]> {
 }
 
 /// FNV-1a of everything the reference depends on, so that a changed scene renders a new one.
-fn reference_key(args: &ConvergeArgs, desc: &SceneDescription) -> u64 {
+fn reference_key(args: &ConvergeArgs, desc: &SceneDescription, lookup: GridLookup) -> u64 {
     let key = format!(
         "{:?} {:?} {:?} {:?} {} {}",
         std::fs::canonicalize(&args.scene.scene).unwrap_or_else(|_| args.scene.scene.clone()),
         args.scene.settings(None).config(),
-        desc.medium.lookup,
+        lookup,
         reference_settings(desc),
         args.reference_spp,
         args.sampling.seed

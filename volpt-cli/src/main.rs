@@ -572,7 +572,8 @@ fn render_command(args: RenderArgs) -> Result<()> {
     });
     let mut scene = scene?;
     let backend = backend?;
-    backend.prepare(&mut scene);
+    // This one render's backend reads the grids in place (no copy of the description).
+    backend.adopt(&mut scene);
     let spp = scene.spp();
     let variant = scene.variant();
     tracing::info!(
@@ -591,14 +592,15 @@ fn render_command(args: RenderArgs) -> Result<()> {
     let (image, stats, spp, schedule) = match save {
         None => {
             let samples = args.samples.clone().unwrap_or(0..spp);
+            let request = volpt::RenderRequest::samples(samples.clone());
             let terminal = Terminal::new(true);
             let mut film = scene.film();
-            let rendered = backend.render(&scene, &mut film, samples.clone(), &terminal)?;
+            let rendered = backend.render(&scene, &mut film, &request, &terminal)?;
             terminal.finish();
             let count = samples.end - samples.start;
             if let Some(path) = &args.film {
                 let file = volpt::FilmFile {
-                    fingerprint: scene.fingerprint(),
+                    fingerprint: backend.fingerprint(&scene, &request)?,
                     seed: scene.seed(),
                     ranges: vec![samples.clone()],
                     film,
@@ -841,7 +843,7 @@ fn truncation_warning(c: &volpt_core::PathCounters) -> Option<String> {
 fn bench_command(args: BenchArgs) -> Result<()> {
     let mut scene = args.scene.load(Some(&args.sampling))?;
     let backend = args.sampling.open()?;
-    backend.prepare(&mut scene);
+    backend.adopt(&mut scene);
     let spp = scene.spp();
     let mut trials = Vec::new();
     let mut last = None;

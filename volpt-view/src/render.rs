@@ -165,7 +165,8 @@ impl Renderer {
         shared: Arc<Shared>,
     ) -> Result<(Self, Hello), ViewError> {
         let backend = Backend::open(options)?;
-        backend.prepare(&mut scene);
+        // The viewer's one backend reads the grids in place (no copy of the description).
+        backend.adopt(&mut scene);
         let view = initial_view(&mut scene)?;
         let full = scene.resolution();
         let hello = Hello {

@@ -17,7 +17,8 @@ use volpt_scene::GridLookup;
 use volpt_scene::GridStorage;
 
 use crate::auto::{self, AutoCache};
-use crate::{multi, Error, Observer, Scene};
+use crate::scene::Reading;
+use crate::{multi, Error, Observer, RenderRequest, Scene};
 
 /// The kind of machine a render runs on.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -271,16 +272,43 @@ impl Backend {
         }
     }
 
-    /// Gives `scene` the grid storage this backend renders from (bricks for `bricked`), so that
-    /// the factory picks kernels that read it. [`Backend::render`] refuses a scene not prepared.
-    ///
-    /// A scene whose lookup nobody chose (no `--lookup`, no [`Scene::set_lookup`]) also gets this
-    /// backend's default lookup ([`Backend::default_lookup`]).
-    pub fn prepare(&self, scene: &mut Scene) {
-        scene.set_storage(self.storage());
-        if !scene.lookup_chosen() {
-            scene.set_default_lookup(self.default_lookup(scene));
+    /// Makes `scene` read its grids as this backend does (its storage; its default lookup where
+    /// nobody chose one) in place. Optional: a render of a scene read otherwise renders the same
+    /// image from a copy of the scene's description, kept until the scene changes; adopting
+    /// saves that copy (the grids' size in host memory) where one owner renders on one backend.
+    pub fn adopt(&self, scene: &mut Scene) {
+        let reading = Reading {
+            storage: self.storage(),
+            lookup: self.default_lookup(scene),
+        };
+        scene.adopt(reading);
+    }
+
+    /// How this backend reads `scene`'s grids for `request`.
+    fn reading(&self, scene: &Scene, request: &RenderRequest) -> Reading {
+        let lookup = request.lookup.unwrap_or_else(|| {
+            if scene.lookup_chosen() {
+                scene.description().medium.lookup
+            } else {
+                self.default_lookup(scene)
+            }
+        });
+        Reading {
+            storage: self.storage(),
+            lookup,
         }
+    }
+
+    /// What makes the render `request` asks of `scene` on this backend the same render
+    /// ([`crate::fingerprint`]): a film's [`crate::Part::fingerprint`]. Refused where the
+    /// request's lookup does not fit the grids.
+    pub fn fingerprint(&self, scene: &Scene, request: &RenderRequest) -> Result<u64, Error> {
+        let desc = scene.read_as(self.reading(scene, request))?;
+        Ok(scene.fingerprint_of(
+            &desc,
+            &request.path.unwrap_or(scene.path_settings()),
+            request.effects.unwrap_or(scene.effects()),
+        ))
     }
 
     /// The lookup a render without `--lookup` uses: on a GPU with fast math, stochastic
@@ -393,17 +421,19 @@ impl Backend {
         }
     }
 
-    /// Adds samples `samples` of every pixel of `scene` to `film`, which holds the samples before
-    /// them (none, for a range that starts at 0). The observer sees progress and notes and may
-    /// stop the render between chunks ([`Observer::check_every`]).
+    /// Adds the samples `request` names of every pixel of `scene` to `film`, which holds the
+    /// samples before them (none, for a range that starts at 0), with the request's seed, path
+    /// settings and lookup over the scene's. The scene is only read: threads may render one scene
+    /// at once. The observer sees progress and notes and may stop the render between chunks
+    /// ([`Observer::check_every`]).
     pub fn render(
         &self,
         scene: &Scene,
         film: &mut Film,
-        samples: Range<u32>,
+        request: impl Into<RenderRequest>,
         observer: &dyn Observer,
     ) -> Result<Rendered, Error> {
-        self.render_chunks(scene, film, samples, observer, &mut |_, _| Ok(()))
+        self.render_chunks(scene, film, &request.into(), observer, &mut |_, _| Ok(()))
     }
 
     /// [`Backend::render`], calling `after_chunk(film, samples_done)` after every chunk: where a
@@ -412,19 +442,10 @@ impl Backend {
         &self,
         scene: &Scene,
         film: &mut Film,
-        samples: Range<u32>,
+        request: &RenderRequest,
         observer: &dyn Observer,
         after_chunk: &mut dyn FnMut(&Film, u32) -> Result<(), Error>,
     ) -> Result<Rendered, Error> {
-        let desc = scene.description();
-        if desc.medium.storage != self.storage() {
-            return Err(Error::Settings(format!(
-                "the scene's grids are stored {:?} but this backend reads them {:?}: call \
-                 Backend::prepare on the scene first",
-                desc.medium.storage,
-                self.storage()
-            )));
-        }
         let (width, height) = scene.resolution();
         if (film.width, film.height) != (width, height) {
             return Err(Error::Settings(format!(
@@ -432,51 +453,53 @@ impl Backend {
                 film.width, film.height
             )));
         }
+        let desc = scene.read_as(self.reading(scene, request))?;
+        let path = request.path.unwrap_or(scene.path_settings());
+        let effects = request.effects.unwrap_or(scene.effects());
+        let mut options = scene.options();
+        if let Some(seed) = request.seed {
+            options.seed = seed;
+        }
         let (factory, grids) = scene.grids();
         let visitor = Render {
             backend: self,
-            loaded: scene,
+            fingerprint: &|| scene.fingerprint_of(&desc, &path, effects),
             grids,
-            options: scene.options(),
+            options,
             film,
-            samples,
+            samples: request.samples.clone(),
             observer,
             after_chunk,
         };
-        with_scene_cached(
-            desc,
-            scene.path_settings(),
-            scene.effects(),
-            factory,
-            visitor,
-        )
+        with_scene_cached(&desc, path, effects, factory, visitor)
     }
 
-    /// The key of a scene's `auto` choice: the GPU, the math and the scene as rendered.
-    fn auto_key(&self, scene: &Scene) -> String {
-        self.auto_key_on(&self.device_name(), scene)
+    /// The key of a scene's `auto` choice: the GPU, the math and the scene as rendered (of
+    /// `fingerprint`).
+    fn auto_key(&self, fingerprint: u64) -> String {
+        self.auto_key_on(&self.device_name(), fingerprint)
     }
 
     /// Each GPU's `auto` key (one GPU: [`Backend::auto_key`]'s). Per GPU, because the fastest
     /// strategy is a property of the GPU model: GPUs of one model share one calibration (the
     /// second finds the first's choice cached), GPUs of different models each get their own.
-    fn auto_keys(&self, scene: &Scene) -> Vec<String> {
+    fn auto_keys(&self, fingerprint: u64) -> Vec<String> {
         match &self.0 {
             Inner::Cuda { renderers, .. } if renderers.len() > 1 => renderers
                 .iter()
-                .map(|r| self.auto_key_on(r.device_name(), scene))
+                .map(|r| self.auto_key_on(r.device_name(), fingerprint))
                 .collect(),
-            _ => vec![self.auto_key(scene)],
+            _ => vec![self.auto_key(fingerprint)],
         }
     }
 
-    /// The `auto` key of `scene` on the GPU named `device`.
-    fn auto_key_on(&self, device: &str, scene: &Scene) -> String {
+    /// The `auto` key of the scene of `fingerprint` on the GPU named `device`.
+    fn auto_key_on(&self, device: &str, fingerprint: u64) -> String {
         format!(
             "{}|{}|{:016x}",
             device,
             self.math().map_or("-", |m| m.name()),
-            scene.fingerprint()
+            fingerprint
         )
     }
 }
@@ -582,8 +605,9 @@ fn schedule(gpu: &GpuOptions) -> Result<Option<Schedule>, Error> {
 /// One render, handed the monomorphised scene by the factory.
 struct Render<'a> {
     backend: &'a Backend,
-    /// The scene as loaded, of which the visitor gets the monomorphised build.
-    loaded: &'a Scene,
+    /// The render's fingerprint, computed only where wanted (`auto`'s key): it hashes the grids
+    /// once per scene.
+    fingerprint: &'a dyn Fn() -> u64,
     /// The number naming its grids, for GPUs that keep them between renders.
     grids: u64,
     options: RenderOptions,
@@ -599,7 +623,7 @@ impl SceneVisitor for Render<'_> {
     fn visit<S: RenderScene>(self, scene: &S) -> Self::Output {
         let Render {
             backend,
-            loaded,
+            fingerprint,
             grids,
             options,
             film,
@@ -628,7 +652,7 @@ impl SceneVisitor for Render<'_> {
             } => {
                 // One key per GPU ([`Backend::auto_keys`]), computed only here: it fingerprints
                 // the scene.
-                let auto_keys = backend.auto_keys(loaded);
+                let auto_keys = backend.auto_keys(fingerprint());
                 let mut chosen: Vec<(&str, Schedule)> = Vec::new();
                 let mut schedules = Vec::with_capacity(renderers.len());
                 for (renderer, key) in renderers.iter().zip(&auto_keys) {

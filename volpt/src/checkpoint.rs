@@ -14,7 +14,7 @@ use volpt_film::checkpoint::Checkpoint;
 use volpt_film::{Film, FilmFile};
 
 use crate::films::{merge_films, MergeError, Merged};
-use crate::{Backend, Error, Observer, Rendered, Scene};
+use crate::{Backend, Error, Observer, RenderRequest, Rendered, Scene};
 
 /// Where to save and where to resume from, and how often to save.
 #[derive(Clone, Debug)]
@@ -39,7 +39,7 @@ pub fn render_checkpointed(
         ));
     }
     let spp = scene.spp();
-    let fingerprint = scene.fingerprint();
+    let fingerprint = backend.fingerprint(scene, &RenderRequest::samples(0..spp))?;
     let state = match &checkpointing.resume {
         Some(path) => {
             let state = Checkpoint::read(path, fingerprint, scene.resolution(), scene.seed())?;
@@ -76,7 +76,8 @@ pub fn render_checkpointed(
             .map_err(Error::from)
     };
     let rendered = if start < spp {
-        backend.render_chunks(scene, &mut film, start..spp, &chunked, &mut save)?
+        let request = RenderRequest::samples(start..spp).with_seed(seed);
+        backend.render_chunks(scene, &mut film, &request, &chunked, &mut save)?
     } else {
         Rendered {
             stats: volpt_film::RenderStats {
@@ -114,7 +115,7 @@ impl Observer for Chunked<'_> {
 /// A film of one render's samples `samples` (of every pixel), rendered anywhere.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Part {
-    /// The render's [`Scene::fingerprint`].
+    /// The render's fingerprint ([`Backend::fingerprint`]).
     pub fingerprint: u64,
     pub seed: u32,
     pub samples: Range<u32>,

@@ -16,7 +16,10 @@
 //! - [`scene`]: [`Scene`], a loaded scene with its resolved settings, its [`fingerprint`] and the
 //!   parameters that change between renders without reloading its grids ([`Scene::set`]).
 //! - [`backend`]: [`Backend`], the CPU or a GPU with its strategy (or `auto`), math and memory
-//!   placement, opened once and reused; [`Backend::render`] adds a sample range to a [`Film`].
+//!   placement, opened once and reused; [`Backend::render`] adds a request's samples to a
+//!   [`Film`].
+//! - [`request`]: [`RenderRequest`], one render's samples, seed, path settings and lookup over
+//!   the scene's: renders only read the scene, so threads share one.
 //! - [`observer`]: what a render tells its caller while it runs (progress, notes) and how the caller
 //!   stops it ([`Observer`]).
 //! - [`auto`]: the `auto` strategy: calibration renders, a cache per scene and GPU.
@@ -40,6 +43,7 @@ pub mod fingerprint;
 pub mod info;
 pub mod multi;
 pub mod observer;
+pub mod request;
 pub mod scene;
 pub mod settings;
 
@@ -51,6 +55,7 @@ pub use error::Error;
 pub use films::{merge_films, read_film, FilmFile, MergeError, Merged};
 pub use info::Info;
 pub use observer::{Observer, Quiet};
+pub use request::RenderRequest;
 pub use scene::{ParamValue, Scene, PARAMS};
 pub use settings::{RenderSettings, Tracking};
 

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Arc, OnceLock};
+use std::sync::{Arc, Mutex, OnceLock};
 
 use volpt_core::grid::HALF_MAX;
 use volpt_core::PathSettings;
@@ -37,10 +37,38 @@ pub struct Scene {
     /// would roll the camera at every move.
     up: [f32; 3],
     /// Whether the grid lookup was chosen (a setting, [`Scene::set_lookup`]) rather than left to
-    /// the backend's default ([`crate::Backend::prepare`]).
+    /// the backend's default ([`crate::Backend::default_lookup`]).
     lookup_chosen: bool,
     /// What is known of the grids, which no method changes once the scene is built.
     data: Arc<DataFacts>,
+    /// The description as a backend that stores or looks up the grids otherwise reads it, made by
+    /// the first render that needed it ([`Scene::read_as`]); dropped by every change of the
+    /// description.
+    read_otherwise: Mutex<Option<Arc<SceneDescription>>>,
+}
+
+/// How a backend reads a scene's grids: its storage, and the lookup a render uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Reading {
+    pub storage: GridStorage,
+    pub lookup: GridLookup,
+}
+
+/// A scene's description as one render reads it: the scene's own, or a copy read otherwise.
+pub(crate) enum ReadAs<'a> {
+    Own(&'a SceneDescription),
+    Copy(Arc<SceneDescription>),
+}
+
+impl std::ops::Deref for ReadAs<'_> {
+    type Target = SceneDescription;
+
+    fn deref(&self) -> &SceneDescription {
+        match self {
+            ReadAs::Own(desc) => desc,
+            ReadAs::Copy(desc) => desc,
+        }
+    }
 }
 
 /// What a scene's data (its grids and environment map) was found to be, computed once: a scene
@@ -87,6 +115,7 @@ impl Clone for Scene {
             up: self.up,
             lookup_chosen: self.lookup_chosen,
             data: Arc::new(data),
+            read_otherwise: Mutex::new(None),
         }
     }
 }
@@ -179,7 +208,7 @@ impl Scene {
         if let Some(lookup) = settings.lookup {
             desc.medium.lookup = lookup;
         }
-        check_lookup(&desc, checked)?;
+        check_lookup(&desc, desc.medium.lookup, checked)?;
         let m = &desc.camera.to_world;
         Ok(Self {
             up: [m[0][1], m[1][1], m[2][1]],
@@ -191,6 +220,7 @@ impl Scene {
             lookup_chosen: settings.lookup.is_some(),
             desc,
             data: Arc::new(DataFacts::new(checked)),
+            read_otherwise: Mutex::new(None),
         })
     }
 
@@ -248,21 +278,36 @@ impl Scene {
         crate::info::describe(&self.source, &self.desc, self.effects, &self.path)
     }
 
-    /// What makes two renders the same render ([`crate::fingerprint`]).
+    /// What makes two renders the same render ([`crate::fingerprint`]): of this scene rendered
+    /// as loaded, on the CPU. A render's own is [`crate::Backend::fingerprint`].
     pub fn fingerprint(&self) -> u64 {
+        self.fingerprint_of(&self.desc, &self.path, self.effects)
+    }
+
+    /// The fingerprint of rendering `desc` (this scene's, or it read otherwise) with `path` and
+    /// `effects`.
+    pub(crate) fn fingerprint_of(
+        &self,
+        desc: &SceneDescription,
+        path: &PathSettings,
+        effects: Effects,
+    ) -> u64 {
+        // The grids' values are the same however they are read.
         let content = *self
             .data
             .content
             .get_or_init(|| crate::fingerprint::content(&self.desc));
-        crate::fingerprint::fingerprint(&self.desc, &self.path, self.effects, content)
+        crate::fingerprint::fingerprint(desc, path, effects, content)
     }
 
-    /// Replaces the path settings (tracking, estimator, roulette, depths) the scene renders with.
+    /// Replaces the path settings (tracking, estimator, roulette, depths) the scene renders with
+    /// by default ([`crate::RenderRequest::path`] chooses them for one render).
     pub fn set_path_settings(&mut self, settings: PathSettings) {
         self.path = settings;
     }
 
-    /// The seed of the random streams: renders of different seeds are independent.
+    /// The seed of the random streams: renders of different seeds are independent. One render's
+    /// own is [`crate::RenderRequest::seed`].
     pub fn set_seed(&mut self, seed: u32) {
         self.seed = seed;
     }
@@ -272,24 +317,62 @@ impl Scene {
     }
 
     /// How the grids are reconstructed; refused where the grids' values do not fit the lookup.
-    /// A lookup set here is kept by [`crate::Backend::prepare`].
+    /// A lookup set here is every backend's (no backend default replaces it).
     pub fn set_lookup(&mut self, lookup: GridLookup) -> Result<(), Error> {
-        let before = std::mem::replace(&mut self.desc.medium.lookup, lookup);
-        check_lookup(&self.desc, self.data.checked)
-            .inspect_err(|_| self.desc.medium.lookup = before)
-            .map(|()| self.lookup_chosen = true)
+        check_lookup(&self.desc, lookup, self.data.checked)?;
+        self.desc.medium.lookup = lookup;
+        self.lookup_chosen = true;
+        self.changed();
+        Ok(())
+    }
+
+    /// Forgets the description read otherwise, made of the one just changed.
+    fn changed(&mut self) {
+        *self
+            .read_otherwise
+            .get_mut()
+            .unwrap_or_else(|p| p.into_inner()) = None;
+    }
+
+    /// The description read as `reading` says: the scene's own where it reads so, else a copy
+    /// (kept for the next render that reads it so). `reading`'s lookup is checked against the
+    /// grids as [`Scene::set_lookup`] checks it.
+    pub(crate) fn read_as(&self, reading: Reading) -> Result<ReadAs<'_>, Error> {
+        let reads = |d: &SceneDescription| {
+            d.medium.storage == reading.storage && d.medium.lookup == reading.lookup
+        };
+        if reads(&self.desc) {
+            return Ok(ReadAs::Own(&self.desc));
+        }
+        check_lookup(&self.desc, reading.lookup, self.data.checked)?;
+        let mut kept = self
+            .read_otherwise
+            .lock()
+            .unwrap_or_else(|p| p.into_inner());
+        if let Some(desc) = kept.as_ref().filter(|d| reads(d)) {
+            return Ok(ReadAs::Copy(desc.clone()));
+        }
+        let mut desc = self.desc.clone();
+        desc.medium.storage = reading.storage;
+        desc.medium.lookup = reading.lookup;
+        let desc = Arc::new(desc);
+        *kept = Some(desc.clone());
+        Ok(ReadAs::Copy(desc))
+    }
+
+    /// Reads the grids as `reading` says from now on, in place: renders that read them so need
+    /// no copy of the description ([`crate::Backend::adopt`]).
+    pub(crate) fn adopt(&mut self, reading: Reading) {
+        self.desc.medium.storage = reading.storage;
+        if !self.lookup_chosen {
+            self.desc.medium.lookup = reading.lookup;
+        }
+        self.changed();
     }
 
     /// Whether the lookup was chosen, by a setting or [`Scene::set_lookup`].
     pub fn lookup_chosen(&self) -> bool {
         self.lookup_chosen
-    }
-
-    /// A backend's default lookup for a scene whose lookup nobody chose (every default lookup
-    /// fits every grid).
-    pub(crate) fn set_default_lookup(&mut self, lookup: GridLookup) {
-        debug_assert!(!self.lookup_chosen);
-        self.desc.medium.lookup = lookup;
     }
 
     /// The device bytes of the medium's grids as f32 textures (an RGB albedo takes four
@@ -302,11 +385,6 @@ impl Scene {
         self.desc.medium.grids().map(|(_, g)| bytes(g)).sum()
     }
 
-    /// How a GPU stores the grids (the backend's choice: [`crate::Backend::prepare`]).
-    pub fn set_storage(&mut self, storage: GridStorage) {
-        self.desc.medium.storage = storage;
-    }
-
     /// Renders `width` x `height` pixels from now on, without reloading the grids (an
     /// interactive viewer's reduced resolution while the view moves). The field of view stays
     /// along the scene's fov axis, so a size of the same aspect ratio frames the same picture.
@@ -315,6 +393,7 @@ impl Scene {
         let before = self.desc.film;
         self.desc.film.width = width;
         self.desc.film.height = height;
+        self.changed();
         self.validate()
             .map_err(Error::from)
             .inspect_err(|_| self.desc.film = before)
@@ -356,10 +435,11 @@ impl Scene {
     /// value it refuses leaves the scene as it was.
     pub fn set(&mut self, key: &str, value: ParamValue) -> Result<(), Error> {
         let before = self.clone_light();
+        self.changed();
         let result = self.apply(key, value).and_then(|()| {
             volpt_scene::numerics::check_position_resolution(&self.desc, Path::new(&self.source))?;
             self.validate()?;
-            check_lookup(&self.desc, self.data.checked)
+            check_lookup(&self.desc, self.desc.medium.lookup, self.data.checked)
         });
         if result.is_err() {
             self.restore_light(before);
@@ -536,13 +616,14 @@ fn refusal(key: &str, refused: ParamRefused, value: &str) -> Error {
     }
 }
 
-/// Refuses a lookup the medium's grids cannot take: textures hold dense grids, and
+/// Refuses `lookup` where the medium's grids cannot take it: textures hold dense grids, and
 /// half-precision texels end at 65504.
-fn check_lookup(desc: &SceneDescription, checked: CheckedData) -> Result<(), Error> {
-    let texture = matches!(
-        desc.medium.lookup,
-        GridLookup::Texture | GridLookup::TextureHalf
-    );
+fn check_lookup(
+    desc: &SceneDescription,
+    lookup: GridLookup,
+    checked: CheckedData,
+) -> Result<(), Error> {
+    let texture = matches!(lookup, GridLookup::Texture | GridLookup::TextureHalf);
     let sparse = (desc.medium.grids()).any(|(_, g)| g.layout == SampleLayout::Sparse);
     if texture && sparse {
         return Err(Error::Settings(
@@ -552,7 +633,7 @@ fn check_lookup(desc: &SceneDescription, checked: CheckedData) -> Result<(), Err
                 .to_owned(),
         ));
     }
-    if desc.medium.lookup != GridLookup::TextureHalf {
+    if lookup != GridLookup::TextureHalf {
         return Ok(());
     }
     for (name, largest) in desc.medium.largest_values(checked) {

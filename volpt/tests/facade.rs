@@ -8,7 +8,10 @@ use common::CancelAfter;
 
 use std::path::{Path, PathBuf};
 
-use volpt::{merge, Backend, Error, Film, ParamValue, Part, Quiet, RenderSettings, Scene};
+use volpt::{
+    merge, Backend, Error, Film, GridLookup, ParamValue, Part, Quiet, RenderRequest, RenderSettings,
+    Scene,
+};
 
 fn example() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/example/cube.xml")
@@ -240,20 +243,21 @@ fn the_fingerprint_sees_the_render_and_not_the_sample_count_or_seed() {
     ] {
         assert_ne!(fp(changed.clone()), base, "{changed:?}");
     }
-    let mut bricked = scene.clone();
-    bricked.set_storage(volpt::scene_files::GridStorage::Bricked);
-    assert_ne!(bricked.fingerprint(), base, "the grid storage");
+    // A render's own: its lookup and path settings are part of it, its seed and samples not.
+    let cpu = Backend::cpu();
+    let request = |r: RenderRequest| cpu.fingerprint(&scene, &r).unwrap();
+    assert_eq!(request(RenderRequest::samples(0..6)), base);
+    assert_eq!(request(RenderRequest::samples(2..9).with_seed(11)), base);
+    let nearest = RenderRequest::samples(0..6).with_lookup(GridLookup::Nearest);
+    assert_ne!(request(nearest), base, "the request's lookup");
+    let mut path = scene.path_settings();
+    path.max_depth = 2;
+    assert_ne!(request(RenderRequest::samples(0..6).with_path(path)), base);
 }
 
 #[test]
-fn a_backend_that_stores_other_grids_or_a_film_of_another_size_is_refused() {
+fn a_film_of_another_size_is_refused() {
     let scene = Scene::load(example(), &small()).unwrap();
-    let mut stored = scene.clone();
-    stored.set_storage(volpt::scene_files::GridStorage::Bricked);
-    let err = Backend::cpu()
-        .render(&stored, &mut scene.film(), 0..1, &Quiet)
-        .unwrap_err();
-    assert!(err.to_string().contains("Backend::prepare"), "{err}");
     let err = Backend::cpu()
         .render(&scene, &mut Film::new(3, 3), 0..1, &Quiet)
         .unwrap_err();

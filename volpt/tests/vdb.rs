@@ -147,5 +147,12 @@ fn texture_lookups_of_a_sparse_grid_are_refused() {
         let mut scene = Scene::load(fixture("sparse-cloud.vdb"), &settings(None)).unwrap();
         assert!(scene.set_lookup(lookup).is_err());
         assert_eq!(scene.description().medium.lookup, GridLookup::Trilinear);
+        // Nor may one render ask for it.
+        let request = volpt::RenderRequest::samples(0..1).with_lookup(lookup);
+        let error = Backend::cpu()
+            .render(&scene, &mut scene.film(), &request, &Quiet)
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("sparse"), "{error}");
     }
 }
