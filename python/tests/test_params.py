@@ -109,6 +109,9 @@ BAD = [
     ("max_depth", -2, "parameter max_depth: expected an integer from -1 to 4294967295, found Int(-2)"),
     ("camera.target", (3.2, 2.4, 4), "parameter camera.target: expected a camera whose direction (target - origin) and up are non-zero and not parallel"),
     ("camera.origin", None, "parameter camera.origin: expected the camera's position, a 3-vector, found NoneType None"),
+    # Refused by the scene's own checks (a medium too dense for f32 positions): still this
+    # parameter's bad value.
+    ("medium.scale", 1e12, "parameter medium.scale: expected a finite extinction whose mean free path spans"),
 ]
 
 

@@ -437,8 +437,24 @@ impl Scene {
         let before = self.clone_light();
         self.changed();
         let result = self.apply(key, value).and_then(|()| {
-            volpt_scene::numerics::check_position_resolution(&self.desc, Path::new(&self.source))?;
-            self.validate()?;
+            // A value the scene's checks refuse is this parameter's bad value: the error names
+            // the parameter, and what the check expected of the scene.
+            let refused = |error: volpt_scene::SceneError| match error {
+                volpt_scene::SceneError::InvalidValue {
+                    field,
+                    expected,
+                    found,
+                    ..
+                } => Error::Param {
+                    key: key.to_owned(),
+                    expected: format!("{expected} (the scene's {field})"),
+                    found,
+                },
+                error => Error::Scene(error),
+            };
+            volpt_scene::numerics::check_position_resolution(&self.desc, Path::new(&self.source))
+                .map_err(refused)?;
+            self.validate().map_err(refused)?;
             check_lookup(&self.desc, self.desc.medium.lookup, self.data.checked)
         });
         if result.is_err() {

@@ -9,8 +9,8 @@ use common::CancelAfter;
 use std::path::{Path, PathBuf};
 
 use volpt::{
-    merge, Backend, Error, Film, GridLookup, ParamValue, Part, Quiet, RenderRequest, RenderSettings,
-    Scene,
+    merge, Backend, Error, Film, GridLookup, ParamValue, Part, Quiet, RenderRequest,
+    RenderSettings, Scene,
 };
 
 fn example() -> PathBuf {
@@ -197,11 +197,16 @@ fn bad_parameters_are_refused_by_name_and_change_nothing() {
         assert!(text.contains(key) && text.contains(needle), "{text}");
         assert_eq!(scene.fingerprint(), before, "{key} changed the scene");
     }
-    // A scale that makes the medium too dense for f32 positions is the loader's refusal.
+    // A scale that makes the medium too dense for f32 positions is refused by the loader's
+    // check, as a bad value of the parameter that was set.
     let err = scene
         .set("medium.scale", ParamValue::Float(1e12))
         .unwrap_err();
-    assert!(matches!(err, Error::Scene(_)), "{err}");
+    assert!(
+        matches!(&err, Error::Param { key, .. } if key == "medium.scale"),
+        "{err}"
+    );
+    assert!(err.to_string().contains("mean free path"), "{err}");
     assert_eq!(scene.fingerprint(), before);
 }
 

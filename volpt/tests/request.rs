@@ -8,8 +8,9 @@ use volpt::{
     Backend, Estimator, Film, GridLookup, Quiet, RenderRequest, RenderSettings, Roulette, Scene,
 };
 
+/// A scene with a density grid, so that lookups differ.
 fn example() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/example/cube.xml")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/bucky/scene.toml")
 }
 
 fn small() -> RenderSettings {
@@ -41,6 +42,7 @@ fn requests(scene: &Scene) -> Vec<RenderRequest> {
         RenderRequest::samples(1..3).with_seed(10),
         RenderRequest::samples(0..4).with_path(shallow),
         RenderRequest::samples(0..4).with_lookup(GridLookup::Nearest),
+        RenderRequest::samples(0..4).with_lookup(GridLookup::Stochastic),
         RenderRequest::samples(0..2)
             .with_lookup(GridLookup::Nearest)
             .with_seed(4)
@@ -87,7 +89,8 @@ fn a_request_renders_as_the_scene_changed_to_its_choices_and_leaves_the_scene_as
 fn concurrent_renders_of_one_shared_scene_equal_serial_ones() {
     let scene = Scene::load(example(), &small()).unwrap();
     let requests = requests(&scene);
-    let serial: Vec<Film> = requests.iter().map(|r| render(&scene, r)).collect();
+    // Each alone, on a scene of its own.
+    let serial: Vec<Film> = requests.iter().map(|r| render(&scene.clone(), r)).collect();
     // Every request at once, twice over, all sharing the one scene (and one backend).
     let backend = Backend::cpu();
     let concurrent: Vec<Film> = std::thread::scope(|threads| {
