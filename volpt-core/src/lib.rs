@@ -54,7 +54,7 @@ pub use mesh::{BvhNode, MeshTriangle, TriangleMesh};
 pub use path::{Estimator, PathCounters, PathSettings, PathState, Roulette};
 pub use phase::{HenyeyGreenstein, Isotropic, PhaseFunction};
 pub use rng::Rng;
-pub use scene::{Scene, VolumeScene};
+pub use scene::{Scene, VolumeScene, WithShape};
 pub use shape::Shape;
 
 /// Linear RGB radiance, throughput or albedo.

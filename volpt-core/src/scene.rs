@@ -97,3 +97,48 @@ impl<M: Medium, B: Bsdf, P: PhaseFunction, E: Environment, S: Shape> Scene
         &self.settings
     }
 }
+
+/// `scene` with its boundary's geometry replaced by `shape` (a closed mesh of the same box, say):
+/// every other part is the scene's own.
+#[derive(Clone, Copy, Debug)]
+pub struct WithShape<'s, S, Sh> {
+    pub scene: &'s S,
+    pub shape: Sh,
+}
+
+impl<S: Scene, Sh: Shape> Scene for WithShape<'_, S, Sh> {
+    type Medium = S::Medium;
+    type Bsdf = S::Bsdf;
+    type Phase = S::Phase;
+    type Environment = S::Environment;
+    type Shape = Sh;
+
+    #[inline]
+    fn camera(&self) -> &PerspectiveCamera {
+        self.scene.camera()
+    }
+    #[inline]
+    fn shape(&self) -> &Sh {
+        &self.shape
+    }
+    #[inline]
+    fn medium(&self) -> &S::Medium {
+        self.scene.medium()
+    }
+    #[inline]
+    fn boundary(&self) -> &S::Bsdf {
+        self.scene.boundary()
+    }
+    #[inline]
+    fn phase(&self) -> &S::Phase {
+        self.scene.phase()
+    }
+    #[inline]
+    fn environment(&self) -> &S::Environment {
+        self.scene.environment()
+    }
+    #[inline]
+    fn settings(&self) -> &PathSettings {
+        self.scene.settings()
+    }
+}

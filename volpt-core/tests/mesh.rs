@@ -448,3 +448,41 @@ fn the_cube_mesh_renders_the_box_image_bit_for_bit() {
         );
     }
 }
+
+/// The white furnace inside the torus: albedo 1 behind an index-matched boundary under a constant
+/// environment of radiance 1 returns exactly 1 on average, with path tracing and with next-event
+/// estimation, whose shadow rays must cross every chord of the torus (one through the hole meets
+/// the medium again).
+#[test]
+fn the_furnace_in_a_torus_returns_the_light_with_and_without_next_event_estimation() {
+    const SPP: u32 = 256;
+    let mesh = test_torus();
+    let buffers = built(&mesh);
+    for estimator in [Estimator::PathTracing, Estimator::NextEvent] {
+        let scene: Absorber<_> = VolumeScene {
+            camera: camera(),
+            bounds: buffers.mesh(),
+            medium: HomogeneousMedium {
+                sigma_t: 2.0,
+                albedo: Spectrum::ONE,
+            },
+            boundary: NullBoundary,
+            phase: HenyeyGreenstein { g: 0.3 },
+            environment: ConstantEnvironment(Spectrum::ONE),
+            settings: PathSettings {
+                estimator,
+                ..PathSettings::default()
+            },
+        };
+        let (pixels, counters) = image(&scene, SPP);
+        let n = counters.paths as f64;
+        assert_eq!(counters.truncated, 0);
+        let samples: Vec<f64> = pixels.iter().map(|p| p[1] / f64::from(SPP)).collect();
+        let mean = samples.iter().sum::<f64>() / samples.len() as f64;
+        let var =
+            samples.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (samples.len() - 1) as f64;
+        let z = (mean - 1.0) / (var / samples.len() as f64).sqrt();
+        eprintln!("{estimator:?}: mean {mean} over {n} paths, z {z:.2}");
+        assert!(z.abs() < Z_MAX, "{estimator:?}: mean {mean}, z {z}");
+    }
+}
