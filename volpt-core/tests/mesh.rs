@@ -326,7 +326,7 @@ type Absorber<S> =
 #[test]
 fn an_absorber_in_a_sphere_and_a_torus_transmits_exp_minus_sigma_chord() {
     const SIGMA_T: f32 = 1.3;
-    const SAMPLES: u32 = 2000;
+    const SAMPLES: u32 = 8000;
     let mut rng = TestRng::new(11);
     for (what, mesh) in [("sphere", test_sphere()), ("torus", test_torus())] {
         let buffers = built(&mesh);
@@ -343,6 +343,8 @@ fn an_absorber_in_a_sphere_and_a_torus_transmits_exp_minus_sigma_chord() {
             settings: PathSettings::default(),
         };
         let mut worst: f64 = 0.0;
+        // Over all rays: a small bias common to every ray shows here before in any one.
+        let (mut total_error, mut total_variance) = (0.0, 0.0);
         for (i, ray) in chord_rays(&mut rng, 40).into_iter().enumerate() {
             let chord = chord_f64(&mesh, &ray).expect("a closed mesh");
             let expected = (-f64::from(SIGMA_T) * chord).exp();
@@ -361,12 +363,16 @@ fn an_absorber_in_a_sphere_and_a_torus_transmits_exp_minus_sigma_chord() {
                 .max(1e-9);
             let z = (mean - expected).abs() / sd;
             worst = worst.max(z);
+            total_error += mean - expected;
+            total_variance += sd * sd;
             assert!(
                 z < Z_MAX,
                 "{what} {ray:?}: {mean} vs exp(-sigma chord) = {expected}"
             );
         }
-        eprintln!("{what}: worst |z| {worst:.2}");
+        let z = total_error / total_variance.sqrt();
+        eprintln!("{what}: worst |z| of a ray {worst:.2}, z over all rays {z:.2}");
+        assert!(z.abs() < Z_MAX, "{what}: z over all rays {z}");
     }
 }
 

@@ -150,19 +150,20 @@ pub fn parse_obj(bytes: &[u8]) -> Result<TriangleSoup, MeshProblem> {
                 for word in words {
                     let index = word.split('/').next().and_then(|w| w.parse::<i64>().ok());
                     let n = soup.vertices.len() as i64;
-                    let index =
-                        match index {
-                            Some(i) if i > 0 && i <= n => i - 1,
-                            Some(i) if i < 0 && -i <= n => n + i,
-                            _ => return Err(parse_error(
+                    let index = match index {
+                        Some(i) if i > 0 && i <= n => i - 1,
+                        Some(i) if i < 0 && -i <= n => n + i,
+                        _ => {
+                            return Err(parse_error(
                                 line_no,
                                 "face (f)",
                                 &format!(
                                     "vertex indices 1..={n} (or -1..=-{n}) of the vertices so far"
                                 ),
                                 word,
-                            )),
-                        };
+                            ))
+                        }
+                    };
                     face.push(index as u32);
                 }
                 if face.len() < 3 {
