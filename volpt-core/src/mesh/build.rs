@@ -239,7 +239,7 @@ fn plane(v: &[[f32; 3]; 3]) -> Option<([f32; 3], f32)> {
         e1[0] * e2[1] - e1[1] * e2[0],
     ];
     let len = libm::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    if !(len > 0.0) || !len.is_finite() {
+    if !len.is_finite() || len == 0.0 {
         return None;
     }
     // `+ 0.0` turns a -0 component into +0, as the box's normals are.
@@ -315,7 +315,7 @@ fn sah_split(prims: &mut [Prim], bounds: Aabb) -> Option<usize> {
     } else {
         2
     };
-    if !(extent[axis] > 0.0) {
+    if extent[axis] <= 0.0 || extent[axis].is_nan() {
         return median_split(prims, axis);
     }
     let bin_of = |p: &Prim| {
