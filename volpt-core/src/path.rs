@@ -402,35 +402,50 @@ fn next_event_estimate<S: Scene>(scene: &S, path: &mut PathState, p: Vec3) -> bo
         return true;
     };
     let phase = scene.phase().eval(path.ray.dir, light.dir);
-    let mut shadow = Ray::new(p, light.dir);
-    let mut transmittance = 1.0;
-    // Every chord of the shadow ray through the medium: one for a convex shape; a non-convex one
-    // (a torus) the ray may leave and enter again.
-    loop {
-        let Some(chord) = ratio_tracking(
-            scene.medium(),
-            &shadow,
-            scene.shape().exit_distance(&shadow),
-            &mut path.rng,
-            &mut path.tracking_steps,
-            scene.settings().max_tracking_steps,
-        ) else {
-            path.truncate(Truncation::TrackingSteps);
-            return false;
-        };
-        transmittance *= chord;
-        if S::Shape::CONVEX || transmittance <= 0.0 {
-            break;
-        }
+    let Some(transmittance) = shadow_transmittance(scene, path, Ray::new(p, light.dir)) else {
+        path.truncate(Truncation::TrackingSteps);
+        return false;
+    };
+    let weight = power_heuristic(light.pdf, phase) * phase * transmittance / light.pdf;
+    path.radiance += path.throughput * light.radiance * weight;
+    true
+}
+
+/// The transmittance along `shadow` to the environment, estimated by ratio tracking over each
+/// chord through the medium: one for a convex shape (the box's code is the single call); a ray
+/// that leaves a non-convex one (a torus) may enter it again. `None` when tracking runs out of
+/// steps.
+#[inline(always)]
+fn shadow_transmittance<S: Scene>(scene: &S, path: &mut PathState, shadow: Ray) -> Option<f32> {
+    let mut transmittance = chord_transmittance(scene, path, &shadow)?;
+    if S::Shape::CONVEX {
+        return Some(transmittance);
+    }
+    let mut shadow = shadow;
+    while transmittance > 0.0 {
         let exit = scene.shape().exit(&shadow);
         match scene.shape().entry(&Ray::new(exit.point, shadow.dir)) {
             Some(entry) => shadow.origin = entry.point,
             None => break,
         }
+        transmittance *= chord_transmittance(scene, path, &shadow)?;
     }
-    let weight = power_heuristic(light.pdf, phase) * phase * transmittance / light.pdf;
-    path.radiance += path.throughput * light.radiance * weight;
-    true
+    Some(transmittance)
+}
+
+/// Ratio tracking's estimate along `ray`, from inside the medium to where it leaves the shape.
+/// A function, not a closure: a closure called from two places may stay a function of its own,
+/// which on a GPU takes the scene into local memory.
+#[inline(always)]
+fn chord_transmittance<S: Scene>(scene: &S, path: &mut PathState, ray: &Ray) -> Option<f32> {
+    ratio_tracking(
+        scene.medium(),
+        ray,
+        scene.shape().exit_distance(ray),
+        &mut path.rng,
+        &mut path.tracking_steps,
+        scene.settings().max_tracking_steps,
+    )
 }
 
 /// Next-event estimation at a rough boundary hit at `hit` (Veach 1997, ch. 9; Mitsuba 3's `volpath`
