@@ -111,7 +111,7 @@ pub fn read_dicom_series(path: &Path) -> Result<GridDesc, SceneError> {
     let files = if path.is_dir() {
         folder_files(path)?
             .into_iter()
-            .filter(|p| !p.file_name().is_some_and(|n| n == "DICOMDIR"))
+            .filter(|p| p.file_name().is_none_or(|n| n != "DICOMDIR"))
             .collect()
     } else {
         vec![path.to_path_buf()]
