@@ -81,7 +81,10 @@ fn nrrd_and_dicom_render_alike_as_a_mitsuba_gridvolume_in_their_own_box() {
     assert!(expected.sums.iter().any(|s| s[0] > 0.0));
     // An empty cube would transmit the environment unchanged: the volume is seen.
     let background = expected.sums.iter().map(|s| s[0]).fold(0.0f64, f64::max);
-    assert!(expected.sums.iter().any(|s| s[0] < background), "no volume in view");
+    assert!(
+        expected.sums.iter().any(|s| s[0] < background),
+        "no volume in view"
+    );
     for name in NRRD.iter().skip(1).chain(&DICOM) {
         assert_eq!(render(&load(name)).sums, expected.sums, "{name}");
     }
