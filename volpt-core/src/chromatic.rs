@@ -137,7 +137,11 @@ pub fn choose_hero(rng: &mut Rng) -> u8 {
 pub fn rescale(r: &mut Spectrum, w: Spectrum) {
     let rw = *r * w;
     let mean = (rw.x + rw.y + rw.z) * (1.0 / 3.0);
-    *r = if mean > 0.0 { rw / mean } else { Spectrum::ZERO };
+    *r = if mean > 0.0 {
+        rw / mean
+    } else {
+        Spectrum::ZERO
+    };
 }
 
 /// Device parameters of a chromatic medium; a grid of length 0 is absent.
@@ -153,7 +157,10 @@ pub struct ChromaticParams {
     pub padding: u32,
 }
 
-fn optional_grid<const C: usize>(grid: Option<&Grid<'_, C>>, upload: &mut Upload<'_>) -> GridParams {
+fn optional_grid<const C: usize>(
+    grid: Option<&Grid<'_, C>>,
+    upload: &mut Upload<'_>,
+) -> GridParams {
     grid.map_or_else(GridParams::default, |g| {
         GridParams::new(g, upload, GridPlacement::Dense)
     })

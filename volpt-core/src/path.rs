@@ -32,13 +32,13 @@
 use core::ops::Range;
 
 use crate::bsdf::Bsdf;
+use crate::chromatic::choose_hero;
 use crate::environment::Environment;
 use crate::geometry::BoxHit;
 use crate::medium::Medium;
 use crate::phase::PhaseFunction;
 use crate::rng::Rng;
 use crate::scene::Scene;
-use crate::chromatic::choose_hero;
 use crate::tracking::{
     delta_tracking, ratio_tracking, spectral_delta_tracking, spectral_ratio_tracking, FreeFlight,
 };

@@ -200,11 +200,7 @@ fn grid_identity<B: Bsdf + Copy>(boundary: B, estimator: Estimator, what: &str) 
         let mut grey_grids = Grids::new();
         grey_grids.build_majorants(SIGMA_T[c]);
         // Channel c of the albedo in all three.
-        let albedo: Vec<f32> = grids
-            .albedo
-            .chunks(3)
-            .flat_map(|rgb| [rgb[c]; 3])
-            .collect();
+        let albedo: Vec<f32> = grids.albedo.chunks(3).flat_map(|rgb| [rgb[c]; 3]).collect();
         let medium = GridMedium {
             density: grey_grids.density(),
             scale: SIGMA_T[c],
@@ -343,7 +339,10 @@ fn spectral_weights_are_finite_and_bounded_on_extreme_media() {
                         "r_u {r:?}"
                     );
                     let mean = (r.x + r.y + r.z) / 3.0;
-                    assert!(r == Spectrum::ZERO || (mean - 1.0).abs() < 1e-4, "r_u {r:?}");
+                    assert!(
+                        r == Spectrum::ZERO || (mean - 1.0).abs() < 1e-4,
+                        "r_u {r:?}"
+                    );
                 }
                 assert!(path.radiance.is_finite() && path.radiance.min_element() >= 0.0);
             }

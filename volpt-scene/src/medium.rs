@@ -391,15 +391,16 @@ impl MediumDesc {
             }
         }
         let sparse = self.grids().any(|(_, g)| g.layout == SampleLayout::Sparse);
-        let plain_reads = self.lookup == GridLookup::Trilinear && self.storage == GridStorage::Dense;
-        if matches!(self.density, DensityDesc::Rgb(_)) && self.grids().next().is_some() {
-            if sparse || !plain_reads {
-                return Err(invalid(
-                    "grid lookup",
-                    "trilinear lookups of dense grids beside a chromatic extinction",
-                    format!("{:?} lookups, {:?} storage", self.lookup, self.storage),
-                ));
-            }
+        let plain_reads =
+            self.lookup == GridLookup::Trilinear && self.storage == GridStorage::Dense;
+        let chromatic_grids =
+            matches!(self.density, DensityDesc::Rgb(_)) && self.grids().next().is_some();
+        if chromatic_grids && (sparse || !plain_reads) {
+            return Err(invalid(
+                "grid lookup",
+                "trilinear lookups of dense grids beside a chromatic extinction",
+                format!("{:?} lookups, {:?} storage", self.lookup, self.storage),
+            ));
         }
         if sparse && matches!(self.lookup, GridLookup::Texture | GridLookup::TextureHalf) {
             return Err(invalid(
@@ -510,7 +511,11 @@ impl MediumDesc {
             // goes into `scale` ([`MediumDesc::mitsuba3_scale`]), the rest into the RGB.
             DensityDesc::Rgb(rgb) => {
                 let max = rgb.iter().copied().fold(0.0, f32::max);
-                let unit = if max > 0.0 { rgb.map(|c| c / max) } else { *rgb };
+                let unit = if max > 0.0 {
+                    rgb.map(|c| c / max)
+                } else {
+                    *rgb
+                };
                 ("homogeneous", rgb_element("sigma_t", &unit))
             }
             DensityDesc::Grid(g) => ("heterogeneous", grid(g, "density", "sigma_t")?),
@@ -795,7 +800,7 @@ impl<'a> MediumInput<'a> {
                 None => Density::Grid(grid),
             },
             DensityDesc::Constant(sigma) => Density::Constant(sigma),
-            DensityDesc::Rgb(rgb) if rgb.iter().all(|&c| c == rgb[0]) => {
+            DensityDesc::Rgb(rgb) if is_uniform.is_some() && rgb.iter().all(|&c| c == rgb[0]) => {
                 fired(Simplification::GreyExtinction);
                 Density::Constant(&rgb[0])
             }

@@ -153,7 +153,11 @@ pub fn write_mitsuba3(
         cube = matrix_transform(&cube_to_world, "        "),
         scale = medium.mitsuba3_scale(),
         // Mitsuba 3's `volpath` samples one channel without MIS: very noisy on chromatic media.
-        integrator = if medium.is_chromatic() { "volpathmis" } else { "volpath" },
+        integrator = if medium.is_chromatic() {
+            "volpathmis"
+        } else {
+            "volpath"
+        },
     );
     std::fs::write(&xml_path, xml).map_err(|error| SceneError::Io {
         path: xml_path,
