@@ -617,6 +617,11 @@ impl MediumDesc {
                 GridLookup::Trilinear,
             ),
             (
+                DensityDesc::Rgb([1.0, 2.5, 5.0]),
+                AlbedoDesc::Constant([0.95, 0.9, 0.85]),
+                GridLookup::Trilinear,
+            ),
+            (
                 DensityDesc::Grid(grid(1, vertex)),
                 AlbedoDesc::Constant([0.8, 0.9, 0.6]),
                 GridLookup::Trilinear,
