@@ -411,8 +411,11 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         let mut time = 0.0;
         let mut rows = Vec::new();
         for round in 0.. {
-            let spp = 1u32 << round.min(20);
-            let samples = halves.spp_each..halves.spp_each + spp;
+            // Each half's samples are u32 sample numbers: the rounds stop where they run out.
+            let Some(end) = halves.spp_each.checked_add(1u32 << round.min(20)) else {
+                break;
+            };
+            let (spp, samples) = (end - halves.spp_each, halves.spp_each..end);
             for (half, film) in (0u32..).zip(&mut halves.films) {
                 // One seed per half (not the reference's); each round continues its samples.
                 scene.set_seed(seed.wrapping_add(half + 1));
