@@ -28,7 +28,11 @@ fn fixture(name: &str) -> PathBuf {
 /// another thread: `Err` if that takes longer than `limit` (the old code did not return).
 fn load_and_bound(name: &'static str, limit: Duration) -> Result<Duration, String> {
     // An unoptimised build reads the brick table about ten times slower.
-    let limit = if cfg!(debug_assertions) { limit * 10 } else { limit };
+    let limit = if cfg!(debug_assertions) {
+        limit * 10
+    } else {
+        limit
+    };
     let (send, receive) = mpsc::channel();
     std::thread::spawn(move || {
         let started = Instant::now();
@@ -39,11 +43,18 @@ fn load_and_bound(name: &'static str, limit: Duration) -> Result<Duration, Strin
         assert_eq!(grid.resolution, [n; 3]);
         assert!(grid.samples().iter().all(|&v| v == 0.5 || v == 0.0));
         let bounds = Aabb::new(Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 1.0));
-        let density = Grid::<1>::sparse(&grid.data, grid.resolution, GridMapping::cell_centred(bounds, grid.resolution));
+        let density = Grid::<1>::sparse(
+            &grid.data,
+            grid.resolution,
+            GridMapping::cell_centred(bounds, grid.resolution),
+        );
         let res = MajorantGrid::resolution_for(bounds, 64);
         let mut majorants = vec![0.0; res.iter().map(|&r| r as usize).product()];
         build_majorants(&density, 2.0, bounds, res, &mut majorants);
-        assert!(majorants.iter().all(|&m| m == 1.0), "every cell bounds 2 x 0.5");
+        assert!(
+            majorants.iter().all(|&m| m == 1.0),
+            "every cell bounds 2 x 0.5"
+        );
         drop(grid);
         let builder = builder_for(&path).unwrap();
         SceneAssembler::new(Config::default())

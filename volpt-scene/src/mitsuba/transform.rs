@@ -206,14 +206,16 @@ fn lookat(step: &Element) -> Result<Transform, SceneError> {
         )
     })?;
     let parallel = crate::toml_scene::parallel(up, dir);
-    let left = normalize(cross(up, dir)).filter(|_| !parallel).ok_or_else(|| {
-        invalid(
-            step,
-            "<lookat up>",
-            "an up vector not parallel to the viewing direction",
-            quoted(step.attr("up").unwrap_or("")),
-        )
-    })?;
+    let left = normalize(cross(up, dir))
+        .filter(|_| !parallel)
+        .ok_or_else(|| {
+            invalid(
+                step,
+                "<lookat up>",
+                "an up vector not parallel to the viewing direction",
+                quoted(step.attr("up").unwrap_or("")),
+            )
+        })?;
     let new_up = cross(dir, left);
     Ok([
         [left[0], new_up[0], dir[0], origin[0]],
