@@ -1116,8 +1116,13 @@ fn merge(py: Python<'_>, films: Vec<PyRef<'_, Film>>) -> PyResult<Film> {
 #[pyfunction]
 fn read_exr(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyAny>> {
     let image = py
-        .allow_threads(|| Image::read_exr(&path))
-        .map_err(|e| to_py(e.into()))?;
+        .allow_threads(|| {
+            // What the header claims, against the memory limit, before the decoder allocates it
+            // (as `volpt compare` does).
+            volpt::scene_files::limits::check_exr(&path, "the image", 12)?;
+            Ok::<_, volpt::Error>(Image::read_exr(&path)?)
+        })
+        .map_err(to_py)?;
     to_numpy(
         py,
         &f32_bytes(&image.pixels),
