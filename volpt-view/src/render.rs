@@ -553,8 +553,7 @@ mod tests {
     use super::*;
 
     /// The included example cube looks down at the cube from above (its up, made perpendicular
-    /// to the view, has y 0.899, below the old snapping threshold of 0.9): the orbit's up is
-    /// still the world's +y.
+    /// to the view, has y 0.899): the orbit's up is still the world's +y, the axis nearest.
     #[test]
     fn the_example_cube_orbits_around_the_world_y_axis() {
         let path =
