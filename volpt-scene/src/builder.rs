@@ -49,7 +49,8 @@ impl SceneBuilder for TomlScene {
     }
 }
 
-/// A grid file on its own (`.mha`, `.mhd`, `.vtk`, `.vti`, `.vol`, `.vdb`): the volume is scaled and
+/// A grid file on its own (`.mha`, `.mhd`, `.vtk`, `.vti`, `.vol`, `.vdb`, `.nrrd`, `.nhdr`,
+/// `.tif`, `.tiff`, `.dcm`, or a folder: a TIFF stack or a DICOM series): the volume is scaled and
 /// centred into the unit cube at the origin (keeping its aspect), its values normalised onto
 /// density `[0, 100]`, and rendered in the thesis setup of a TOML scene with only `[volume]`.
 pub struct GridFile(pub PathBuf);
@@ -118,14 +119,20 @@ pub fn builder_for(path: &Path) -> Result<Box<dyn SceneBuilder>, SceneError> {
     Ok(match extension.as_deref() {
         Some("xml") => Box::new(MitsubaXml(path.to_owned())),
         Some("toml") => Box::new(TomlScene(path.to_owned())),
-        Some("mha" | "mhd" | "vtk" | "vti" | "vol" | "vdb") => Box::new(GridFile(path.to_owned())),
+        Some(
+            "mha" | "mhd" | "vtk" | "vti" | "vol" | "vdb" | "nrrd" | "nhdr" | "tif" | "tiff" | "dcm"
+            | "dicom",
+        ) => Box::new(GridFile(path.to_owned())),
+        // A folder: a TIFF stack or a DICOM series.
+        _ if path.is_dir() => Box::new(GridFile(path.to_owned())),
         _ => {
             return Err(SceneError::Unsupported {
                 path: path.to_owned(),
                 line: 0,
                 what: "this kind of scene file".into(),
                 reason: "expected a Mitsuba .xml, a volpt .toml scene, or a grid file \
-                         (.mha, .mhd, .vtk, .vti, .vol, .vdb)"
+                         (.mha, .mhd, .vtk, .vti, .vol, .vdb, .nrrd, .nhdr, .tif, .tiff, .dcm) or a folder \
+                         (a TIFF stack or a DICOM series)"
                     .into(),
             })
         }

@@ -19,6 +19,11 @@
 //! - [`metaimage`]: MetaImage `.mha`/`.mhd` grids, read and written.
 //! - [`vdb`]: OpenVDB `.vdb` grids (float density, vec3 albedo), read sparse.
 //! - [`sparse`]: sparse grids: stored 8^3 bricks and a brick table.
+//! - [`nrrd`]: NRRD `.nrrd`/`.nhdr` grids (3D Slicer, ITK, pynrrd), read.
+//! - [`tiff_stack`]: TIFF stacks (a multi-page TIFF or a folder of TIFFs), read.
+//! - [`dicom`]: DICOM series (a folder of CT slices), read, in Hounsfield units above air.
+//! - [`scanner`]: which of those reads a file or folder named without a format.
+//! - [`orient`]: placing a scanner's grid, stepping along signed or permuted axes, on volpt's axes.
 //! - [`vtk`]: VTK image data (legacy `STRUCTURED_POINTS` `.vtk`, XML `.vti`), read and written.
 //! - [`transfer`]: transfer functions from density to RGB albedo, and their text files.
 //! - [`limits`]: what untrusted input may make volpt allocate or do, checked before it does.
@@ -30,6 +35,7 @@ pub mod boundary;
 pub mod builder;
 mod contain;
 pub mod description;
+pub mod dicom;
 pub mod environment;
 pub mod error;
 pub mod from_description;
@@ -39,13 +45,17 @@ pub mod medium;
 pub mod metaimage;
 pub mod mitsuba;
 pub mod normalise;
+pub mod nrrd;
 pub mod numerics;
+mod orient;
 mod output;
 pub mod param;
 pub mod phase;
 pub mod raw;
+pub mod scanner;
 pub mod simplification;
 pub mod sparse;
+pub mod tiff_stack;
 pub mod toml_scene;
 pub mod transfer;
 pub mod validate;
@@ -58,14 +68,17 @@ use std::path::Path;
 pub use boundary::BoundaryInput;
 pub use builder::{builder_for, Config, SceneAssembler, SceneBuilder};
 pub use description::*;
+pub use dicom::read_dicom_series;
 pub use error::{GridProblem, SceneError, VolProblem};
 pub use from_description::FromDescription;
 pub use medium::{MediumInput, ReadsRule};
 pub use metaimage::{read_metaimage, write_metaimage, MetaImageOptions};
 pub use normalise::normalise;
+pub use nrrd::read_nrrd;
 pub use param::NumberParam;
 pub use raw::{read_raw, read_raw_into, write_raw, ByteOrder, RawLayout, ScalarType};
 pub use simplification::Simplification;
+pub use tiff_stack::read_tiff_stack;
 pub use transfer::TransferFunction;
 pub use vdb::{read_vdb, Sparsity, VdbOptions};
 pub use vol::{read_vol, write_vol, VolGrid};

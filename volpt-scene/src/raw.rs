@@ -532,7 +532,7 @@ pub(crate) fn grid_error(path: &Path, problem: GridProblem) -> SceneError {
 }
 
 /// Reads until `buffer` is full or the stream ends; returns the bytes read.
-fn read_full(reader: &mut impl Read, buffer: &mut [u8]) -> std::io::Result<usize> {
+pub(crate) fn read_full(reader: &mut impl Read, buffer: &mut [u8]) -> std::io::Result<usize> {
     let mut filled = 0;
     while filled < buffer.len() {
         match reader.read(&mut buffer[filled..]) {

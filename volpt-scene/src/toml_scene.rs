@@ -50,7 +50,8 @@ pub struct SceneFile {
 #[serde(deny_unknown_fields)]
 pub struct VolumeSpec {
     pub file: String,
-    /// `raw`, `metaimage`, `vtk` or `vol`; by default from the extension (`.raw` needs it said).
+    /// `raw`, `metaimage`, `vtk`, `vol`, `vdb`, `nrrd`, `tiff` or `dicom`; by default from the
+    /// extension (`.raw` needs it said), and for a folder from its files (TIFFs, else DICOM).
     pub format: Option<VolumeFormat>,
     /// Raw files: voxels per axis.
     pub resolution: Option<[u32; 3]>,
@@ -89,6 +90,11 @@ pub enum VolumeFormat {
     Vtk,
     Vol,
     Vdb,
+    Nrrd,
+    /// A multi-page TIFF, or a folder of TIFFs.
+    Tiff,
+    /// A folder of DICOM slices (one series), or one slice.
+    Dicom,
 }
 
 /// The image axis the field of view spans (`camera.fov_axis`), as Mitsuba names it.
@@ -562,10 +568,13 @@ fn read_volume(cx: &Cx<'_>, file: &Path, v: &VolumeSpec) -> Result<(GridDesc, Bo
         (None, Some("vtk" | "vti")) => VolumeFormat::Vtk,
         (None, Some("vol")) => VolumeFormat::Vol,
         (None, Some("vdb")) => VolumeFormat::Vdb,
+        (None, _) if crate::scanner::scanner_format(file)?.is_some() => {
+            crate::scanner::scanner_format(file)?.expect("checked")
+        }
         (None, _) => {
             return Err(cx.invalid(
                 "volume.format",
-                "raw, metaimage, vtk, vol or vdb (needed when the extension does not say)",
+                "raw, metaimage, vtk, vol, vdb, nrrd, tiff or dicom (needed when the extension does not say)",
                 file.display(),
             ))
         }
@@ -603,6 +612,9 @@ fn read_volume(cx: &Cx<'_>, file: &Path, v: &VolumeSpec) -> Result<(GridDesc, Bo
             crate::vdb::read_vdb(file, &options)?
         }
         VolumeFormat::MetaImage => read_metaimage(file)?,
+        VolumeFormat::Nrrd | VolumeFormat::Tiff | VolumeFormat::Dicom => {
+            crate::scanner::read_scanned(file, format).expect("a scanner format")?
+        }
         VolumeFormat::Vtk => read_vtk(file, v.array.as_deref())?,
         VolumeFormat::Vol => {
             let vol = read_vol(file)?;

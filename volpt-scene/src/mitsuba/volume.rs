@@ -69,7 +69,11 @@ fn vdb_grid(p: &Plugin<'_>, role: Role, path: &Path) -> Result<GridDesc, SceneEr
         vector: role == Role::Albedo,
         sparsity: crate::vdb::Sparsity::Auto,
     };
-    let mut grid = crate::vdb::read_vdb(path, &options)?;
+    own_box(p, crate::vdb::read_vdb(path, &options)?)
+}
+
+/// A grid read with its own box (a VDB file's, a scanner file's), mapped by `toWorld`/`to_world`.
+fn own_box(p: &Plugin<'_>, mut grid: GridDesc) -> Result<GridDesc, SceneError> {
     let to_world = match p.find(&["toWorld", "to_world"])? {
         Some(arg) => transform(&arg)?,
         None => IDENTITY_F64,
@@ -109,6 +113,11 @@ fn grid(p: &Plugin<'_>, role: Role) -> Result<GridDesc, SceneError> {
     };
     if crate::vdb::is_vdb(&path) {
         return vdb_grid(p, role, &path).map_err(referenced);
+    }
+    // NRRD, TIFF stacks and DICOM series: their own box, as a VDB file's.
+    if let Some(format) = crate::scanner::scanner_format(&path).map_err(referenced)? {
+        let grid = crate::scanner::read_scanned(&path, format).expect("a scanner format");
+        return own_box(p, grid.map_err(referenced)?);
     }
     let vol = read_vol(&path).map_err(referenced)?;
     match role {
