@@ -2,6 +2,9 @@
 //! returns (a pass end computed in `u32` once wrapped to a small number, and the pass loop never
 //! finished), on one device and on several, and its film file merges with its neighbour's.
 
+// Lists of sample ranges of one range.
+#![allow(clippy::single_range_in_vec_init)]
+
 use std::ops::Range;
 use std::path::Path;
 use std::sync::mpsc;
