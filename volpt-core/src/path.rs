@@ -34,6 +34,7 @@ use crate::medium::Medium;
 use crate::phase::PhaseFunction;
 use crate::rng::Rng;
 use crate::scene::Scene;
+use crate::shape::Shape;
 use crate::tracking::{delta_tracking, ratio_tracking, FreeFlight};
 use crate::{Ray, Spectrum, Vec3};
 
@@ -187,7 +188,7 @@ impl PathState {
             eta_scale: 1.0,
             segments: 0,
             tracking_steps: 0,
-            inside: scene.bounds().contains(ray.origin),
+            inside: scene.shape().contains(ray.origin),
             alive: true,
             truncated: Truncation::None,
             mis_pdf: 0.0,
@@ -280,7 +281,7 @@ fn advance<S: Scene, const DEFER_SCATTER: bool>(scene: &S, path: &mut PathState)
         return None;
     }
     if path.inside {
-        let t_exit = scene.bounds().exit_distance(&path.ray);
+        let t_exit = scene.shape().exit_distance(&path.ray);
         let collision = delta_tracking(
             scene.medium(),
             &path.ray,
@@ -298,13 +299,13 @@ fn advance<S: Scene, const DEFER_SCATTER: bool>(scene: &S, path: &mut PathState)
                 scatter(scene, path, p, None);
             }
             FreeFlight::Escaped => {
-                let exit = scene.bounds().exit(&path.ray);
+                let exit = scene.shape().exit(&path.ray);
                 interact_with_boundary(scene, path, exit)
             }
             FreeFlight::OutOfSteps => path.truncate(Truncation::TrackingSteps),
         }
     } else {
-        match scene.bounds().entry(&path.ray) {
+        match scene.shape().entry(&path.ray) {
             Some(hit) => interact_with_boundary(scene, path, hit),
             None => {
                 let mut light = path.throughput * scene.background(path.ray.dir);
@@ -401,21 +402,50 @@ fn next_event_estimate<S: Scene>(scene: &S, path: &mut PathState, p: Vec3) -> bo
         return true;
     };
     let phase = scene.phase().eval(path.ray.dir, light.dir);
-    let shadow = Ray::new(p, light.dir);
-    let Some(transmittance) = ratio_tracking(
-        scene.medium(),
-        &shadow,
-        scene.bounds().exit_distance(&shadow),
-        &mut path.rng,
-        &mut path.tracking_steps,
-        scene.settings().max_tracking_steps,
-    ) else {
+    let Some(transmittance) = shadow_transmittance(scene, path, Ray::new(p, light.dir)) else {
         path.truncate(Truncation::TrackingSteps);
         return false;
     };
     let weight = power_heuristic(light.pdf, phase) * phase * transmittance / light.pdf;
     path.radiance += path.throughput * light.radiance * weight;
     true
+}
+
+/// The transmittance along `shadow` to the environment, estimated by ratio tracking over each
+/// chord through the medium: one for a convex shape (the box's code is the single call); a ray
+/// that leaves a non-convex one (a torus) may enter it again. `None` when tracking runs out of
+/// steps.
+#[inline(always)]
+fn shadow_transmittance<S: Scene>(scene: &S, path: &mut PathState, shadow: Ray) -> Option<f32> {
+    let mut transmittance = chord_transmittance(scene, path, &shadow)?;
+    if S::Shape::CONVEX {
+        return Some(transmittance);
+    }
+    let mut shadow = shadow;
+    while transmittance > 0.0 {
+        let exit = scene.shape().exit(&shadow);
+        match scene.shape().entry(&Ray::new(exit.point, shadow.dir)) {
+            Some(entry) => shadow.origin = entry.point,
+            None => break,
+        }
+        transmittance *= chord_transmittance(scene, path, &shadow)?;
+    }
+    Some(transmittance)
+}
+
+/// Ratio tracking's estimate along `ray`, from inside the medium to where it leaves the shape.
+/// A function, not a closure: a closure called from two places may stay a function of its own,
+/// which on a GPU takes the scene into local memory.
+#[inline(always)]
+fn chord_transmittance<S: Scene>(scene: &S, path: &mut PathState, ray: &Ray) -> Option<f32> {
+    ratio_tracking(
+        scene.medium(),
+        ray,
+        scene.shape().exit_distance(ray),
+        &mut path.rng,
+        &mut path.tracking_steps,
+        scene.settings().max_tracking_steps,
+    )
 }
 
 /// Next-event estimation at a rough boundary hit at `hit` (Veach 1997, ch. 9; Mitsuba 3's `volpath`
@@ -427,13 +457,24 @@ fn next_event_estimate<S: Scene>(scene: &S, path: &mut PathState, p: Vec3) -> bo
 /// in its way and the transmittance is 1 (reflection for a path that arrives from outside,
 /// refraction out for one from inside); a direction into the box meets the medium and the boundary
 /// again, which a straight shadow ray cannot pass, so it adds nothing and the BSDF's sample of it
-/// keeps its full weight (`mis_pdf` 0).
+/// keeps its full weight (`mis_pdf` 0). A non-convex mesh may lie in the way out: a direction that
+/// meets it again adds nothing here, and the BSDF's sample of it meets the mesh before any light,
+/// where its weight is set anew.
 #[inline(always)]
 fn boundary_next_event_estimate<S: Scene>(scene: &S, path: &mut PathState, hit: &BoxHit) {
     let Some(light) = scene.environment().sample(path.rng.next_2d()) else {
         return;
     };
     if light.dir.dot(hit.normal) <= 0.0 {
+        return;
+    }
+    // A non-convex shape may stand in the way, which bends the shadow ray.
+    if !S::Shape::CONVEX
+        && scene
+            .shape()
+            .entry(&Ray::new(hit.point, light.dir))
+            .is_some()
+    {
         return;
     }
     let bsdf = scene.boundary().eval(hit.normal, path.ray.dir, light.dir);
