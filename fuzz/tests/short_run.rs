@@ -69,3 +69,13 @@ fn exr_envmap() {
 fn vdb() {
     short_run(Target::Vdb);
 }
+
+#[test]
+fn film_file() {
+    short_run(Target::FilmFile);
+}
+
+#[test]
+fn viewer_message() {
+    short_run(Target::ViewerMessage);
+}

@@ -15,6 +15,7 @@ extern crate alloc;
 pub mod abi;
 pub mod bsdf;
 pub mod camera;
+pub mod chromatic;
 pub mod environment;
 pub mod frame;
 pub mod fresnel;
@@ -37,6 +38,7 @@ pub mod variant;
 pub use abi::{Component, SceneAbi};
 pub use bsdf::{Bsdf, BsdfEval, BsdfSample, NullBoundary, RoughDielectric, SmoothDielectric};
 pub use camera::PerspectiveCamera;
+pub use chromatic::ChromaticMedium;
 pub use environment::{
     ConstantEnvironment, Environment, LatLongEnvironment, LatLongRows, SampledEnvironment,
 };
