@@ -197,3 +197,23 @@ impl Component for ChromaticMedium<'_> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{rescale, Spectrum};
+
+    /// Where no channel with density left could have sampled the event, `r` becomes zero (the
+    /// path ends) instead of 0/0; elsewhere it keeps mean 1 within [0, 3].
+    #[test]
+    fn rescale_is_zero_where_no_channel_sampled_the_event_and_bounded_elsewhere() {
+        let mut r = Spectrum::new(3.0, 0.0, 0.0);
+        rescale(&mut r, Spectrum::new(0.0, 1.0, 1.0));
+        assert_eq!(r, Spectrum::ZERO);
+        let mut r = Spectrum::new(3.0, 0.0, 0.0);
+        rescale(&mut r, Spectrum::new(1e-30, 1.0, 1.0));
+        assert_eq!(r, Spectrum::new(3.0, 0.0, 0.0));
+        let mut r = Spectrum::ONE;
+        rescale(&mut r, Spectrum::new(1.0, 0.5, 0.0));
+        assert_eq!(r, Spectrum::new(2.0, 1.0, 0.0));
+    }
+}
