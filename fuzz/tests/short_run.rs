@@ -69,3 +69,18 @@ fn exr_envmap() {
 fn vdb() {
     short_run(Target::Vdb);
 }
+
+#[test]
+fn nrrd() {
+    short_run(Target::Nrrd);
+}
+
+#[test]
+fn tiff_stack() {
+    short_run(Target::TiffStack);
+}
+
+#[test]
+fn dicom_series() {
+    short_run(Target::DicomSeries);
+}
