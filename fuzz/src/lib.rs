@@ -1,4 +1,5 @@
-//! Fuzz targets for every parser of volpt's scene inputs (issue 12), shared by two drivers:
+//! Fuzz targets for every parser of volpt's scene inputs (issue 12), its film files and the
+//! viewer's messages (issue 43), shared by two drivers:
 //!
 //! - `cargo test -p volpt-fuzz` runs every target on its seeds and a few thousand deterministic
 //!   mutations of them (stable Rust, no tools, seconds): CI's short run.
@@ -53,10 +54,15 @@ pub enum Target {
     TiffStack,
     /// A folder of DICOM slices (one per part), as `volpt render FOLDER` loads it.
     DicomSeries,
+    /// A film file (or checkpoint), read and merged as `volpt merge` does.
+    FilmFile,
+    /// One text message of the viewer's WebSocket protocol, parsed and applied to a scene as the
+    /// viewer's render thread applies it.
+    ViewerMessage,
 }
 
 impl Target {
-    pub const ALL: [Target; 12] = [
+    pub const ALL: [Target; 14] = [
         Self::MitsubaXml,
         Self::Vol,
         Self::MetaImage,
@@ -69,6 +75,8 @@ impl Target {
         Self::Nrrd,
         Self::TiffStack,
         Self::DicomSeries,
+        Self::FilmFile,
+        Self::ViewerMessage,
     ];
 
     /// The name `fuzz/run` knows the target by.
@@ -86,6 +94,8 @@ impl Target {
             Self::Nrrd => "nrrd",
             Self::TiffStack => "tiff_stack",
             Self::DicomSeries => "dicom_series",
+            Self::FilmFile => "film_file",
+            Self::ViewerMessage => "viewer_message",
         }
     }
 
@@ -160,7 +170,60 @@ impl Target {
                     Vec::new(),
                 );
             }
+            Self::FilmFile => {
+                let path = write(dir, "part.vfilm", data);
+                if let Ok(film) = volpt::FilmFile::read(&path, FUZZ_MEMORY_LIMIT) {
+                    let _ = film.image();
+                    let _ = volpt::merge_films(vec![("part".into(), film)], None);
+                }
+            }
+            Self::ViewerMessage => VIEWER_SCENE.with(|scene| {
+                apply_viewer_message(&mut scene.borrow_mut(), &String::from_utf8_lossy(data))
+            }),
         }
+    }
+}
+
+thread_local! {
+    /// The scene viewer messages change: the example cube, loaded once per thread.
+    static VIEWER_SCENE: std::cell::RefCell<volpt::Scene> = std::cell::RefCell::new(
+        volpt::Scene::load(
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/example/cube.xml"),
+            &volpt::RenderSettings {
+                resolution: Some((8, 8)),
+                ..volpt::RenderSettings::default()
+            },
+        )
+        .expect("the example scene loads"),
+    );
+}
+
+/// What the viewer does with a text message: parse it, and apply a camera move or a parameter to
+/// the scene (a refused value leaves the scene as it was, so inputs do not build on each other).
+fn apply_viewer_message(scene: &mut volpt::Scene, text: &str) {
+    use volpt::ParamValue;
+    use volpt_view::protocol::{param_value, ClientMessage};
+    match ClientMessage::parse(text) {
+        Ok(ClientMessage::Camera {
+            origin,
+            target,
+            fov,
+            ..
+        }) => {
+            let _ = scene
+                .set("camera.origin", ParamValue::Vec3(origin))
+                .and_then(|()| scene.set("camera.target", ParamValue::Vec3(target)))
+                .and_then(|()| match fov {
+                    Some(fov) => scene.set("camera.fov", ParamValue::Float(fov)),
+                    None => Ok(()),
+                });
+        }
+        Ok(ClientMessage::Set { key, value }) => {
+            if let Ok(value) = param_value(&key, &value) {
+                let _ = scene.set(&key, value);
+            }
+        }
+        _ => {}
     }
 }
 
@@ -354,6 +417,46 @@ pub fn seeds(target: Target) -> Vec<Vec<u8>> {
                 &fixture("volpt-cli/tests/fixtures/toml/tiny.raw"),
             ]),
         ],
+        Target::FilmFile => {
+            let film = |w: u32, h: u32| {
+                let mut film = volpt::Film::new(w, h);
+                for (i, sum) in film.flat_sums_mut().iter_mut().enumerate() {
+                    *sum = i as f64 * 0.5;
+                }
+                film
+            };
+            vec![
+                written("part.vfilm", &|p| {
+                    volpt::FilmFile {
+                        fingerprint: 7,
+                        seed: 3,
+                        ranges: vec![0..4, 9..12],
+                        film: film(3, 2),
+                    }
+                    .write(p)
+                    .expect("write a film seed")
+                }),
+                written("render.ckpt", &|p| {
+                    volpt::film::Checkpoint::write_film(p, 7, 3, 5, &film(2, 2))
+                        .expect("write a checkpoint seed")
+                }),
+            ]
+        }
+        Target::ViewerMessage => [
+            r#"{"type":"camera","origin":[3.2,2.4,4],"target":[0,-0.1,0],"fov":30,"interactive":true}"#,
+            r#"{"type":"camera","origin":[0,5,0],"target":[0,0,0]}"#,
+            r#"{"type":"set","key":"medium.albedo","value":[0.5,0.25,1]}"#,
+            r#"{"type":"set","key":"max_depth","value":-1}"#,
+            r#"{"type":"set","key":"phase.g","value":0.5}"#,
+            r#"{"type":"set","key":"spp","value":4294967295}"#,
+            r#"{"type":"exposure","value":-2}"#,
+            r#"{"type":"format","format":"png"}"#,
+            r#"{"type":"ack","frame":18446744073709551615}"#,
+            r#"{"type":"reset"}"#,
+        ]
+        .iter()
+        .map(|m| m.as_bytes().to_vec())
+        .collect(),
         Target::TransferFunction => vec![
             fixture("volpt-scene/tests/fixtures/transfer/bucky.txt"),
             fixture("volpt-cli/tests/fixtures/toml/tiny.tf"),

@@ -92,3 +92,13 @@ fn tiff_stack() {
 fn dicom_series() {
     short_run(Target::DicomSeries);
 }
+
+#[test]
+fn film_file() {
+    short_run(Target::FilmFile);
+}
+
+#[test]
+fn viewer_message() {
+    short_run(Target::ViewerMessage);
+}

@@ -1009,7 +1009,10 @@ impl Film {
             (None, None) => (0, (0, 0), 0),
         };
         let checkpoint = py
-            .allow_threads(|| Checkpoint::read(&path, fingerprint, size, seed))
+            .allow_threads(|| {
+                let limit = volpt::scene_files::limits::memory_limit();
+                Checkpoint::read(&path, fingerprint, size, seed, limit)
+            })
             .map_err(|e| to_py(e.into()))?;
         Ok(Film {
             part: Part {
@@ -1085,8 +1088,10 @@ impl Film {
 fn read_header(path: &Path) -> Option<(u64, (u32, u32), u32)> {
     use std::io::Read;
     let mut header = [0u8; 32];
-    std::fs::File::open(path)
+    // A regular file only: opening a FIFO would block for ever.
+    volpt::film::regular::open_regular(path)
         .ok()?
+        .0
         .read_exact(&mut header)
         .ok()?;
     let u32_at = |i: usize| u32::from_le_bytes(header[i..i + 4].try_into().expect("4 bytes"));
@@ -1111,8 +1116,13 @@ fn merge(py: Python<'_>, films: Vec<PyRef<'_, Film>>) -> PyResult<Film> {
 #[pyfunction]
 fn read_exr(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyAny>> {
     let image = py
-        .allow_threads(|| Image::read_exr(&path))
-        .map_err(|e| to_py(e.into()))?;
+        .allow_threads(|| {
+            // What the header claims, against the memory limit, before the decoder allocates it
+            // (as `volpt compare` does).
+            volpt::scene_files::limits::check_exr(&path, "the image", 12)?;
+            Ok::<_, volpt::Error>(Image::read_exr(&path)?)
+        })
+        .map_err(to_py)?;
     to_numpy(
         py,
         &f32_bytes(&image.pixels),

@@ -20,6 +20,9 @@ said otherwise):
 - transform.vdb: a float grid "smoke" (and a second float grid "other") over index box
   [-8, 8) x [16, 24) x [0, 24) with voxel size (0.5, 0.25, 2) and translation (1, 2, 3).
 - cloud-rgb.vdb: a float grid "density" (a ball) and a vec3s grid "albedo" of (0.25, 0.5, 0.75).
+- fill1024.vdb, fill4096.vdb: `fill()` of value 0.5 over the boxes [0, 1024)^3 and [0, 4096)^3:
+  OpenVDB stores them as tiles (1024^3: 512 tiles of 128^3 in one 4096^3 node, 8.8 KB; 4096^3:
+  one root tile, 594 bytes), no leaves.
 - sparse-cloud.vdb: two small balls at opposite corners of a 512^3 index box: about 4,300 active
   voxels, a dense box over 30,000 times larger.
 """
@@ -114,6 +117,14 @@ def sparse_cloud(out):
     vdb.write(os.path.join(out, "sparse-cloud.vdb"), grids=[grid])
 
 
+def fills(out):
+    for n in (1024, 4096):
+        grid = vdb.FloatGrid(0.0)
+        grid.fill((0, 0, 0), (n - 1, n - 1, n - 1), 0.5, True)
+        grid.name = "density"
+        vdb.write(os.path.join(out, f"fill{n}.vdb"), grids=[grid])
+
+
 def large_cloud(out, n, seed=7):
     """Smooth blobs filling a few percent of an n^3 box: the benchmark's sparse volume, never
     committed. One blob in each of 24 of the 27 cells of a 3^3 lattice, so that no two blobs'
@@ -169,6 +180,7 @@ def main():
     transform(out)
     cloud_rgb(out)
     sparse_cloud(out)
+    fills(out)
     print(f"OpenVDB {vdb.LIBRARY_VERSION}, file format {vdb.FILE_FORMAT_VERSION}: fixtures in {out}")
 
 

@@ -178,7 +178,10 @@ fn round_trips(layout: GridLayout) {
 /// bricked and sparse grids select.
 fn reads_any_layout_or_no_grid(v: &str) -> bool {
     let medium = v.split('/').next().unwrap_or_default();
-    medium == HomogeneousMedium::NAME || medium.ends_with(&format!("__{}", AnyLayout::NAME))
+    // The examples' chromatic medium has a constant albedo: it reads no grid.
+    medium == HomogeneousMedium::NAME
+        || medium == volpt_core::ChromaticMedium::NAME
+        || medium.ends_with(&format!("__{}", AnyLayout::NAME))
 }
 
 /// Each description renders the same through the device ABI (grids placed in `layout` where

@@ -116,6 +116,14 @@ fn scenes() -> Vec<(&'static str, SceneDescription, &'static str)> {
         1.0,
     );
     unit_ior.integrator.rr_depth = None;
+    let mut grey_rgb = cube_scene(
+        12,
+        12,
+        homogeneous(1.0, 0.8, PhaseDesc::Isotropic),
+        BsdfDesc::Null,
+        1.0,
+    );
+    grey_rgb.medium.density = DensityDesc::Rgb([2.5; 3]);
     vec![
         (
             "constant grids, g = 0",
@@ -125,6 +133,11 @@ fn scenes() -> Vec<(&'static str, SceneDescription, &'static str)> {
         (
             "IOR ratio 1",
             unit_ior,
+            "homogeneous/index_matched/isotropic/constant",
+        ),
+        (
+            "RGB extinction of equal channels",
+            grey_rgb,
             "homogeneous/index_matched/isotropic/constant",
         ),
     ]
@@ -220,7 +233,18 @@ fn edges() -> Vec<Edge> {
         })
     };
     let short_of_the_box = |g: &mut GridDesc| g.bounds.max[1] = 0.4999;
+    let rgb = |sigma: [f32; 3]| scene_with(|d| d.medium.density = DensityDesc::Rgb(sigma));
     vec![
+        Edge {
+            rule: Simplification::GreyExtinction,
+            fires: vec![("RGB extinction 2, 2, 2".into(), rgb([2.0; 3]))],
+            fired: "homogeneous/index_matched/isotropic/constant",
+            beside: vec![
+                ("blue 1 ulp denser".into(), rgb([2.0, 2.0, next_up(2.0)])),
+                ("red 0.1% lighter".into(), rgb([1.998, 2.0, 2.0])),
+            ],
+            general: "chromatic/index_matched/isotropic/constant",
+        },
         Edge {
             rule: Simplification::ZeroAsymmetry,
             fires: vec![("g = 0".into(), hg(0.0)), ("g = -0".into(), hg(-0.0))],

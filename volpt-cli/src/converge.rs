@@ -411,8 +411,11 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         let mut time = 0.0;
         let mut rows = Vec::new();
         for round in 0.. {
-            let spp = 1u32 << round.min(20);
-            let samples = halves.spp_each..halves.spp_each + spp;
+            // Each half's samples are u32 sample numbers: the rounds stop where they run out.
+            let Some(end) = halves.spp_each.checked_add(1u32 << round.min(20)) else {
+                break;
+            };
+            let (spp, samples) = (end - halves.spp_each, halves.spp_each..end);
             for (half, film) in (0u32..).zip(&mut halves.films) {
                 // One seed per half (not the reference's); each round continues its samples.
                 scene.set_seed(seed.wrapping_add(half + 1));
@@ -452,6 +455,8 @@ fn reference(args: &ConvergeArgs, scene: &mut Scene, backend: &Backend) -> Resul
     let desc = scene.description();
     let (w, h) = (desc.film.width, desc.film.height);
     if let Some(path) = &args.reference {
+        // What the header claims, against the memory limit, before the decoder allocates it.
+        volpt_scene::limits::check_exr(path, "the reference image", 12)?;
         let image = Image::read_exr(path)?;
         if (image.width, image.height) != (w, h) {
             bail!(
@@ -474,7 +479,10 @@ fn reference(args: &ConvergeArgs, scene: &mut Scene, backend: &Backend) -> Resul
     let cached = [0, 1].map(|half| args.out.join(format!("reference-{key:016x}-{half}.exr")));
     if cached.iter().all(|p| p.exists()) {
         tracing::info!(path = %cached[0].display(), "using the cached reference");
-        let [a, b] = [&cached[0], &cached[1]].map(|p| Image::read_exr(p));
+        let [a, b] = [&cached[0], &cached[1]].map(|p| {
+            volpt_scene::limits::check_exr(p, "the cached reference", 12)?;
+            anyhow::Ok(Image::read_exr(p)?)
+        });
         return Ok(Reference::from_halves(&a?, &b?));
     }
     tracing::info!(spp = args.reference_spp, "rendering the reference");

@@ -8,9 +8,14 @@
 // Inline PTX for exact hardware instructions (math::sqrt); nvptx builds already need nightly features.
 #![cfg_attr(target_arch = "nvptx64", feature(asm_experimental_arch))]
 
+// The host builds meshes' BVHs (`mesh::build`); the kernels never enable it.
+#[cfg(feature = "alloc")]
+extern crate alloc;
+
 pub mod abi;
 pub mod bsdf;
 pub mod camera;
+pub mod chromatic;
 pub mod environment;
 pub mod frame;
 pub mod fresnel;
@@ -19,18 +24,21 @@ pub mod grid;
 pub mod majorant;
 pub mod math;
 pub mod medium;
+pub mod mesh;
 pub mod microfacet;
 pub mod path;
 pub mod phase;
 pub mod rng;
 pub mod sampling;
 pub mod scene;
+pub mod shape;
 pub mod tracking;
 pub mod variant;
 
 pub use abi::{Component, SceneAbi};
 pub use bsdf::{Bsdf, BsdfEval, BsdfSample, NullBoundary, RoughDielectric, SmoothDielectric};
 pub use camera::PerspectiveCamera;
+pub use chromatic::ChromaticMedium;
 pub use environment::{
     ConstantEnvironment, Environment, LatLongEnvironment, LatLongRows, SampledEnvironment,
 };
@@ -44,10 +52,12 @@ pub use medium::{
     AlbedoField, ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium, Medium, ReadAs,
     TrackedMedium,
 };
+pub use mesh::{BvhNode, MeshTriangle, TriangleMesh};
 pub use path::{Estimator, PathCounters, PathSettings, PathState, Roulette};
 pub use phase::{HenyeyGreenstein, Isotropic, PhaseFunction};
 pub use rng::Rng;
-pub use scene::{Scene, VolumeScene};
+pub use scene::{Scene, VolumeScene, WithShape};
+pub use shape::Shape;
 
 /// Linear RGB radiance, throughput or albedo.
 pub type Spectrum = glam::Vec3;

@@ -115,6 +115,7 @@ pub fn build_majorants(
         density.res[1] as i64 - 1,
         density.res[2] as i64 - 1,
     ];
+    let mut last_read = SlotMax::NONE;
     for (i, bound) in out.iter_mut().enumerate() {
         let x = (i % res[0] as usize) as u32;
         let y = ((i / res[0] as usize) % res[1] as usize) as u32;
@@ -134,7 +135,9 @@ pub fn build_majorants(
             from as u32..=to as u32
         };
         let max = match density.layout {
-            GridLayout::Sparse => sparse_max(density, [range(0), range(1), range(2)]),
+            GridLayout::Sparse => {
+                sparse_max(density, [range(0), range(1), range(2)], &mut last_read)
+            }
             _ => {
                 let mut max = 0.0f32;
                 for sz in range(2) {
@@ -151,13 +154,37 @@ pub fn build_majorants(
     }
 }
 
+/// The last stored brick [`sparse_max`] read: its slot, its largest sample, and whether all
+/// its samples are that one value (a VDB tile's brick, shared by every brick the tile covers).
+#[derive(Clone, Copy)]
+struct SlotMax {
+    slot: u32,
+    max: f32,
+    uniform: bool,
+}
+
+impl SlotMax {
+    const NONE: Self = Self {
+        slot: u32::MAX,
+        max: 0.0,
+        uniform: false,
+    };
+}
+
 /// The largest sample of a [`GridLayout::Sparse`] grid in the index ranges `ranges`, brick by
 /// brick: the background brick holds one value, so it is read once, not once per sample (a
-/// 2048^3 box of a few percent stored bricks is otherwise billions of reads of the same value).
-/// The same maximum as reading every sample, so a sparse grid's majorants equal its dense copy's.
-fn sparse_max(density: &Grid<'_, 1>, ranges: [RangeInclusive<u32>; 3]) -> f32 {
+/// 2048^3 box of a few percent stored bricks is otherwise billions of reads of the same value);
+/// and a brick that stands for a run of bricks (a uniform region: a VDB tile's, up to 4096^3
+/// voxels) is read once per run (`last`), not once per brick of the run (billions of reads of one
+/// brick for a 1024^3 tile). The same maximum as
+/// reading every sample, so a sparse grid's majorants equal its dense copy's.
+fn sparse_max(density: &Grid<'_, 1>, ranges: [RangeInclusive<u32>; 3], last: &mut SlotMax) -> f32 {
     let [rx, ry, rz] = ranges;
     let bricks = |r: &RangeInclusive<u32>| (r.start() / BRICK)..=(r.end() / BRICK);
+    let clip = |r: &RangeInclusive<u32>, o: u32| {
+        (*r.start()).max(o) - o..=(*r.end()).min(o + BRICK - 1) - o
+    };
+    let whole = |r: &RangeInclusive<u32>| *r.start() == 0 && *r.end() == BRICK - 1;
     let mut max = 0.0f32;
     let background = density.data[0];
     for bz in bricks(&rz) {
@@ -170,17 +197,22 @@ fn sparse_max(density: &Grid<'_, 1>, ranges: [RangeInclusive<u32>; 3]) -> f32 {
                     max = max.max(background);
                     continue;
                 }
-                let clip = |r: &RangeInclusive<u32>, o: u32| {
-                    (*r.start()).max(o) - o..=(*r.end()).min(o + BRICK - 1) - o
-                };
-                // The brick's samples, read directly: one table lookup per brick, not per sample.
+                // The brick's samples, read directly: one table lookup per brick, not per sample,
+                // and one pass over a brick's 512 values per run of bricks that share it.
                 let samples = (BRICK * BRICK * BRICK) as usize;
                 let brick = &density.data[slot as usize * samples..][..samples];
+                if slot != last.slot {
+                    *last = SlotMax {
+                        slot,
+                        max: brick.iter().fold(0.0f32, |m, &v| m.max(v)),
+                        uniform: brick.iter().all(|&v| v == brick[0]),
+                    };
+                }
                 let (cx, cy, cz) = (clip(&rx, x0), clip(&ry, y0), clip(&rz, z0));
-                let whole = |r: &RangeInclusive<u32>| *r.start() == 0 && *r.end() == BRICK - 1;
-                if whole(&cx) && whole(&cy) && whole(&cz) {
-                    // Most bricks lie inside the cell's range: one pass over 512 contiguous values.
-                    max = brick.iter().fold(max, |m, &v| m.max(v));
+                // Most bricks lie inside the cell's range; a uniform brick's every part has its
+                // one value.
+                if (whole(&cx) && whole(&cy) && whole(&cz)) || last.uniform {
+                    max = max.max(last.max);
                     continue;
                 }
                 for z in cz {

@@ -139,6 +139,19 @@ pub fn recip(v: crate::Vec3) -> crate::Vec3 {
     }
 }
 
+/// `a / b`: the correctly rounded quotient, or in the fast kernels `div.approx` ([`div`]'s
+/// arithmetic for one component, so that a mesh's planes and the box's slabs agree bit for bit).
+#[inline]
+pub fn div_scalar(a: f32, b: f32) -> f32 {
+    div(crate::Vec3::splat(a), crate::Vec3::splat(b)).x
+}
+
+/// `1 / x`: [`recip`]'s arithmetic for one component.
+#[inline]
+pub fn recip_scalar(x: f32) -> f32 {
+    recip(crate::Vec3::splat(x)).x
+}
+
 /// The GPU's approximate instructions, one function each.
 #[cfg(all(target_arch = "nvptx64", volpt_fast_math))]
 mod approx {

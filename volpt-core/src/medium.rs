@@ -1,7 +1,8 @@
 //! Participating media: extinction and single-scattering albedo as functions of position.
 //!
-//! Extinction is grey (one `sigma_t` for all channels); albedo is RGB. Delta tracking then needs one
-//! majorant and no spectral MIS, and coloured albedo only scales the path throughput.
+//! Extinction is grey (one `sigma_t` for all channels) in every medium here; albedo is RGB. Delta
+//! tracking then needs one majorant and no spectral MIS, and coloured albedo only scales the path
+//! throughput. A chromatic extinction is [`crate::chromatic`]'s ([`Medium::CHROMATIC`]).
 
 use bytemuck::{Pod, Zeroable};
 
@@ -17,6 +18,10 @@ pub trait Medium {
     /// The albedo is the same everywhere and reads no memory: a strategy that orders albedo reads
     /// (sorting-sk) has nothing to order.
     const CONSTANT_ALBEDO: bool = false;
+    /// The extinction differs between channels: paths track it by a hero channel with spectral
+    /// MIS ([`crate::chromatic`]) and read [`Medium::sigma_t_rgb`]; [`Medium::sigma_t`] and the
+    /// majorants bound every channel. A grey medium compiles none of that.
+    const CHROMATIC: bool = false;
 
     /// An upper bound of `sigma_t` over the medium (the majorant of delta tracking).
     fn majorant(&self) -> f32;
@@ -28,6 +33,18 @@ pub trait Medium {
     }
     fn sigma_t(&self, p: Vec3) -> f32;
     fn albedo(&self, p: Vec3) -> Spectrum;
+
+    /// The extinction per channel (a chromatic medium's; a grey one's in all three).
+    #[inline(always)]
+    fn sigma_t_rgb(&self, p: Vec3) -> Spectrum {
+        Spectrum::splat(self.sigma_t(p))
+    }
+
+    /// The extinction per channel if it is the same everywhere (transmittance is then exact).
+    #[inline(always)]
+    fn uniform_sigma_t_rgb(&self) -> Option<Spectrum> {
+        None
+    }
 
     /// An unbiased estimate of [`Medium::sigma_t`] at `p`, which may use the low 39 bits of
     /// `bits` (random, independent of everything else the caller draws): a stochastic grid

@@ -24,17 +24,25 @@
 //! `min(max(throughput) * eta^2, 0.95)`, or by the thesis's `min(1, max(throughput) * eta^2)`
 //! ([`Roulette`]); before `rr_depth`, or with roulette off, a path faces roulette only once that
 //! weight is negligible ([`NEGLIGIBLE_WEIGHT`]).
+//!
+//! A chromatic medium ([`Medium::CHROMATIC`]) is tracked by the path's hero channel with spectral
+//! MIS ([`crate::chromatic`]): the light a path gathers is then its throughput times its path
+//! densities `r_u`; a grey medium's path never reads them.
 
 use core::ops::Range;
 
 use crate::bsdf::Bsdf;
+use crate::chromatic::choose_hero;
 use crate::environment::Environment;
 use crate::geometry::BoxHit;
 use crate::medium::Medium;
 use crate::phase::PhaseFunction;
 use crate::rng::Rng;
 use crate::scene::Scene;
-use crate::tracking::{delta_tracking, ratio_tracking, FreeFlight};
+use crate::shape::Shape;
+use crate::tracking::{
+    delta_tracking, ratio_tracking, spectral_delta_tracking, spectral_ratio_tracking, FreeFlight,
+};
 use crate::{Ray, Spectrum, Vec3};
 
 /// The integrator's limits.
@@ -154,11 +162,16 @@ pub struct PathState {
     pub tracking_steps: u32,
     pub inside: bool,
     pub alive: bool,
+    /// The channel whose extinction samples this path's collisions in a chromatic medium.
+    pub hero: u8,
     /// Whether, and by which safety bound, the path was cut.
     pub truncated: Truncation,
     /// The phase function's density of the current direction if next-event estimation also
     /// sampled the environment at its origin (the escape is then weighted by MIS), else 0.
     pub mis_pdf: f32,
+    /// In a chromatic medium, the path's density under each channel over their mean (pbrt-v4's
+    /// rescaled `r_u`; mean 1, each in `[0, 3]`): the light it gathers is `throughput * r_u`.
+    pub r_u: Spectrum,
 }
 
 /// Which safety bound of [`PathSettings`] ended a path (it then contributes zero).
@@ -178,6 +191,11 @@ impl PathState {
         let camera = scene.camera();
         let mut rng = Rng::new(seed, py * camera.width + px, sample);
         let ray = camera.generate_ray(px, py, rng.next_2d());
+        let hero = if S::Medium::CHROMATIC {
+            choose_hero(&mut rng)
+        } else {
+            0
+        };
         Self {
             ray,
             throughput: Spectrum::ONE,
@@ -187,10 +205,23 @@ impl PathState {
             eta_scale: 1.0,
             segments: 0,
             tracking_steps: 0,
-            inside: scene.bounds().contains(ray.origin),
+            inside: scene.shape().contains(ray.origin),
             alive: true,
+            hero,
             truncated: Truncation::None,
             mis_pdf: 0.0,
+            r_u: Spectrum::ONE,
+        }
+    }
+
+    /// What the path's light is multiplied by: its throughput, times its path densities `r_u` in a
+    /// chromatic medium (the balance heuristic's weight over the channels).
+    #[inline(always)]
+    fn weight<S: Scene>(&self) -> Spectrum {
+        if S::Medium::CHROMATIC {
+            self.throughput * self.r_u
+        } else {
+            self.throughput
         }
     }
 
@@ -228,8 +259,8 @@ impl PathState {
     /// Russian roulette after an interaction: from `rr_depth` on by the scene's rule, before it
     /// (or with roulette off) only once the path's weight is negligible ([`NEGLIGIBLE_WEIGHT`]).
     #[inline]
-    fn russian_roulette(&mut self, settings: &PathSettings) {
-        let weight = self.throughput.max_element() * self.eta_scale * self.eta_scale;
+    fn russian_roulette<S: Scene>(&mut self, settings: &PathSettings) {
+        let weight = self.weight::<S>().max_element() * self.eta_scale * self.eta_scale;
         let q = if self.depth > settings.rr_depth {
             match settings.roulette {
                 Roulette::Mitsuba => weight.min(0.95),
@@ -280,15 +311,34 @@ fn advance<S: Scene, const DEFER_SCATTER: bool>(scene: &S, path: &mut PathState)
         return None;
     }
     if path.inside {
-        let t_exit = scene.bounds().exit_distance(&path.ray);
-        let collision = delta_tracking(
-            scene.medium(),
-            &path.ray,
-            t_exit,
-            &mut path.rng,
-            &mut path.tracking_steps,
-            scene.settings().max_tracking_steps,
-        );
+        let t_exit = scene.shape().exit_distance(&path.ray);
+        let collision = if S::Medium::CHROMATIC {
+            let flight = spectral_delta_tracking(
+                scene.medium(),
+                &path.ray,
+                t_exit,
+                &mut path.rng,
+                path.hero,
+                &mut path.r_u,
+                &mut path.tracking_steps,
+                scene.settings().max_tracking_steps,
+            );
+            if path.r_u == Spectrum::ZERO {
+                // No channel's density is left: the path weighs nothing (`chromatic::rescale`).
+                path.alive = false;
+                return None;
+            }
+            flight
+        } else {
+            delta_tracking(
+                scene.medium(),
+                &path.ray,
+                t_exit,
+                &mut path.rng,
+                &mut path.tracking_steps,
+                scene.settings().max_tracking_steps,
+            )
+        };
         match collision {
             FreeFlight::Collision(t) => {
                 let p = path.ray.at(t);
@@ -298,16 +348,16 @@ fn advance<S: Scene, const DEFER_SCATTER: bool>(scene: &S, path: &mut PathState)
                 scatter(scene, path, p, None);
             }
             FreeFlight::Escaped => {
-                let exit = scene.bounds().exit(&path.ray);
+                let exit = scene.shape().exit(&path.ray);
                 interact_with_boundary(scene, path, exit)
             }
             FreeFlight::OutOfSteps => path.truncate(Truncation::TrackingSteps),
         }
     } else {
-        match scene.bounds().entry(&path.ray) {
+        match scene.shape().entry(&path.ray) {
             Some(hit) => interact_with_boundary(scene, path, hit),
             None => {
-                let mut light = path.throughput * scene.background(path.ray.dir);
+                let mut light = path.weight::<S>() * scene.background(path.ray.dir);
                 let weighted =
                     PathState::uses_next_event(scene) || PathState::uses_boundary_next_event(scene);
                 if weighted && path.mis_pdf > 0.0 {
@@ -384,7 +434,7 @@ pub fn scatter<S: Scene>(scene: &S, path: &mut PathState, p: Vec3, albedo: Optio
     if next_event {
         path.mis_pdf = sample.pdf;
     }
-    path.russian_roulette(settings);
+    path.russian_roulette::<S>(settings);
 }
 
 /// Next-event estimation at a scattering event at `p` (Veach 1997, ch. 9; pbrt-v4 section 14.2.2):
@@ -402,20 +452,93 @@ fn next_event_estimate<S: Scene>(scene: &S, path: &mut PathState, p: Vec3) -> bo
     };
     let phase = scene.phase().eval(path.ray.dir, light.dir);
     let shadow = Ray::new(p, light.dir);
-    let Some(transmittance) = ratio_tracking(
-        scene.medium(),
-        &shadow,
-        scene.bounds().exit_distance(&shadow),
-        &mut path.rng,
-        &mut path.tracking_steps,
-        scene.settings().max_tracking_steps,
-    ) else {
+    if S::Medium::CHROMATIC {
+        // Each channel's transmittance, estimated at once; the path's weight carries the MIS.
+        let Some(transmittance) = spectral_shadow_transmittance(scene, path, shadow) else {
+            path.truncate(Truncation::TrackingSteps);
+            return false;
+        };
+        let weight = power_heuristic(light.pdf, phase) * phase / light.pdf;
+        path.radiance += path.weight::<S>() * transmittance * light.radiance * weight;
+        return true;
+    }
+    let Some(transmittance) = shadow_transmittance(scene, path, shadow) else {
         path.truncate(Truncation::TrackingSteps);
         return false;
     };
     let weight = power_heuristic(light.pdf, phase) * phase * transmittance / light.pdf;
     path.radiance += path.throughput * light.radiance * weight;
     true
+}
+
+/// The transmittance along `shadow` to the environment, estimated by ratio tracking over each
+/// chord through the medium: one for a convex shape (the box's code is the single call); a ray
+/// that leaves a non-convex one (a torus) may enter it again. `None` when tracking runs out of
+/// steps.
+#[inline(always)]
+fn shadow_transmittance<S: Scene>(scene: &S, path: &mut PathState, shadow: Ray) -> Option<f32> {
+    let mut transmittance = chord_transmittance(scene, path, &shadow)?;
+    if S::Shape::CONVEX {
+        return Some(transmittance);
+    }
+    let mut shadow = shadow;
+    while transmittance > 0.0 {
+        let exit = scene.shape().exit(&shadow);
+        match scene.shape().entry(&Ray::new(exit.point, shadow.dir)) {
+            Some(entry) => shadow.origin = entry.point,
+            None => break,
+        }
+        transmittance *= chord_transmittance(scene, path, &shadow)?;
+    }
+    Some(transmittance)
+}
+
+/// [`shadow_transmittance`] of a chromatic medium, per channel ([`spectral_ratio_tracking`]).
+#[inline(always)]
+fn spectral_shadow_transmittance<S: Scene>(
+    scene: &S,
+    path: &mut PathState,
+    shadow: Ray,
+) -> Option<Spectrum> {
+    let chord = |path: &mut PathState, ray: &Ray| {
+        spectral_ratio_tracking(
+            scene.medium(),
+            ray,
+            scene.shape().exit_distance(ray),
+            &mut path.rng,
+            &mut path.tracking_steps,
+            scene.settings().max_tracking_steps,
+        )
+    };
+    let mut transmittance = chord(path, &shadow)?;
+    if S::Shape::CONVEX {
+        return Some(transmittance);
+    }
+    let mut shadow = shadow;
+    while transmittance.max_element() > 0.0 {
+        let exit = scene.shape().exit(&shadow);
+        match scene.shape().entry(&Ray::new(exit.point, shadow.dir)) {
+            Some(entry) => shadow.origin = entry.point,
+            None => break,
+        }
+        transmittance *= chord(path, &shadow)?;
+    }
+    Some(transmittance)
+}
+
+/// Ratio tracking's estimate along `ray`, from inside the medium to where it leaves the shape.
+/// A function, not a closure: a closure called from two places may stay a function of its own,
+/// which on a GPU takes the scene into local memory.
+#[inline(always)]
+fn chord_transmittance<S: Scene>(scene: &S, path: &mut PathState, ray: &Ray) -> Option<f32> {
+    ratio_tracking(
+        scene.medium(),
+        ray,
+        scene.shape().exit_distance(ray),
+        &mut path.rng,
+        &mut path.tracking_steps,
+        scene.settings().max_tracking_steps,
+    )
 }
 
 /// Next-event estimation at a rough boundary hit at `hit` (Veach 1997, ch. 9; Mitsuba 3's `volpath`
@@ -427,7 +550,9 @@ fn next_event_estimate<S: Scene>(scene: &S, path: &mut PathState, p: Vec3) -> bo
 /// in its way and the transmittance is 1 (reflection for a path that arrives from outside,
 /// refraction out for one from inside); a direction into the box meets the medium and the boundary
 /// again, which a straight shadow ray cannot pass, so it adds nothing and the BSDF's sample of it
-/// keeps its full weight (`mis_pdf` 0).
+/// keeps its full weight (`mis_pdf` 0). A non-convex mesh may lie in the way out: a direction that
+/// meets it again adds nothing here, and the BSDF's sample of it meets the mesh before any light,
+/// where its weight is set anew.
 #[inline(always)]
 fn boundary_next_event_estimate<S: Scene>(scene: &S, path: &mut PathState, hit: &BoxHit) {
     let Some(light) = scene.environment().sample(path.rng.next_2d()) else {
@@ -436,12 +561,21 @@ fn boundary_next_event_estimate<S: Scene>(scene: &S, path: &mut PathState, hit: 
     if light.dir.dot(hit.normal) <= 0.0 {
         return;
     }
+    // A non-convex shape may stand in the way, which bends the shadow ray.
+    if !S::Shape::CONVEX
+        && scene
+            .shape()
+            .entry(&Ray::new(hit.point, light.dir))
+            .is_some()
+    {
+        return;
+    }
     let bsdf = scene.boundary().eval(hit.normal, path.ray.dir, light.dir);
     if bsdf.value <= 0.0 {
         return;
     }
     let weight = power_heuristic(light.pdf, bsdf.pdf) * bsdf.value / light.pdf;
-    path.radiance += path.throughput * light.radiance * weight;
+    path.radiance += path.weight::<S>() * light.radiance * weight;
 }
 
 /// Veach's power heuristic with exponent 2: the weight of a strategy of density `a` against one of
@@ -496,7 +630,7 @@ fn interact_with_boundary<S: Scene>(scene: &S, path: &mut PathState, hit: BoxHit
                 path.eta_scale *= sample.eta;
             }
             path.ray = Ray::new(hit.point, sample.wo);
-            path.russian_roulette(settings);
+            path.russian_roulette::<S>(settings);
         }
         None => path.alive = false,
     }

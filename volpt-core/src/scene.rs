@@ -6,9 +6,11 @@ use crate::environment::Environment;
 use crate::medium::Medium;
 use crate::path::PathSettings;
 use crate::phase::PhaseFunction;
+use crate::shape::Shape;
 use crate::{Aabb, Spectrum, Vec3};
 
-/// A solid participating medium inside a box boundary, lit by its environment.
+/// A solid participating medium inside a closed boundary (a box or a triangle mesh), lit by its
+/// environment.
 ///
 /// Backends are generic over `Scene`, so every combination of parts is monomorphised: a scene whose
 /// boundary is index-matched compiles no Fresnel code, and a constant albedo reads no grid.
@@ -17,9 +19,16 @@ pub trait Scene {
     type Bsdf: Bsdf;
     type Phase: PhaseFunction;
     type Environment: Environment;
+    type Shape: Shape;
 
     fn camera(&self) -> &PerspectiveCamera;
-    fn bounds(&self) -> Aabb;
+    /// The boundary's geometry.
+    fn shape(&self) -> &Self::Shape;
+    /// The boundary's bounding box (the box itself for a box).
+    #[inline]
+    fn bounds(&self) -> Aabb {
+        self.shape().bounds()
+    }
     fn medium(&self) -> &Self::Medium;
     fn boundary(&self) -> &Self::Bsdf;
     fn phase(&self) -> &Self::Phase;
@@ -32,10 +41,13 @@ pub trait Scene {
     }
 }
 
+/// The scene every backend renders. The boundary's shape `S` is a box unless named: the registry's
+/// variants, and so the GPU kernels, are box scenes.
 #[derive(Clone, Copy, Debug)]
-pub struct VolumeScene<M, B, P, E> {
+pub struct VolumeScene<M, B, P, E, S = Aabb> {
     pub camera: PerspectiveCamera,
-    pub bounds: Aabb,
+    /// The boundary's geometry: an [`Aabb`], or a [`crate::TriangleMesh`].
+    pub bounds: S,
     pub medium: M,
     pub boundary: B,
     pub phase: P,
@@ -43,19 +55,26 @@ pub struct VolumeScene<M, B, P, E> {
     pub settings: PathSettings,
 }
 
-impl<M: Medium, B: Bsdf, P: PhaseFunction, E: Environment> Scene for VolumeScene<M, B, P, E> {
+impl<M: Medium, B: Bsdf, P: PhaseFunction, E: Environment, S: Shape> Scene
+    for VolumeScene<M, B, P, E, S>
+{
     type Medium = M;
     type Bsdf = B;
     type Phase = P;
     type Environment = E;
+    type Shape = S;
 
     #[inline]
     fn camera(&self) -> &PerspectiveCamera {
         &self.camera
     }
     #[inline]
+    fn shape(&self) -> &S {
+        &self.bounds
+    }
+    #[inline]
     fn bounds(&self) -> Aabb {
-        self.bounds
+        self.bounds.bounds()
     }
     #[inline]
     fn medium(&self) -> &M {
@@ -76,5 +95,50 @@ impl<M: Medium, B: Bsdf, P: PhaseFunction, E: Environment> Scene for VolumeScene
     #[inline]
     fn settings(&self) -> &PathSettings {
         &self.settings
+    }
+}
+
+/// `scene` with its boundary's geometry replaced by `shape` (a closed mesh of the same box, say):
+/// every other part is the scene's own.
+#[derive(Clone, Copy, Debug)]
+pub struct WithShape<'s, S, Sh> {
+    pub scene: &'s S,
+    pub shape: Sh,
+}
+
+impl<S: Scene, Sh: Shape> Scene for WithShape<'_, S, Sh> {
+    type Medium = S::Medium;
+    type Bsdf = S::Bsdf;
+    type Phase = S::Phase;
+    type Environment = S::Environment;
+    type Shape = Sh;
+
+    #[inline]
+    fn camera(&self) -> &PerspectiveCamera {
+        self.scene.camera()
+    }
+    #[inline]
+    fn shape(&self) -> &Sh {
+        &self.shape
+    }
+    #[inline]
+    fn medium(&self) -> &S::Medium {
+        self.scene.medium()
+    }
+    #[inline]
+    fn boundary(&self) -> &S::Bsdf {
+        self.scene.boundary()
+    }
+    #[inline]
+    fn phase(&self) -> &S::Phase {
+        self.scene.phase()
+    }
+    #[inline]
+    fn environment(&self) -> &S::Environment {
+        self.scene.environment()
+    }
+    #[inline]
+    fn settings(&self) -> &PathSettings {
+        self.scene.settings()
     }
 }

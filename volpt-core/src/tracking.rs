@@ -1,11 +1,12 @@
 //! Free-flight sampling by delta (Woodcock) tracking and transmittance by ratio tracking, both over
 //! the medium's majorants: one global bound, or a majorant grid walked cell by cell.
 
+use crate::chromatic::rescale;
 use crate::majorant::Dda;
 use crate::math::{exp, ln};
 use crate::medium::Medium;
 use crate::rng::{unit_f32, Rng};
-use crate::Ray;
+use crate::{Ray, Spectrum};
 
 /// How a free flight ends.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -257,5 +258,117 @@ impl<M: Medium> TentativeCollision for &mut RatioProduct<'_, M> {
             }
         }
         self.transmittance <= 0.0
+    }
+}
+
+/// Delta tracking of a chromatic medium ([`crate::chromatic`]): the tentative collisions of
+/// [`walk_majorants`] (one majorant for every channel), each real with probability `w_hero`, where
+/// `w = sigma_t(x) / majorant` per channel; each real or null collision rescales the path densities
+/// `r_u` by `w` or `1 - w` ([`rescale`]), the single-sample spectral MIS of Miller et al. 2019. A
+/// path whose `r_u` becomes zero stops at the collision (the caller ends it).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub fn spectral_delta_tracking<M: Medium>(
+    medium: &M,
+    ray: &Ray,
+    t_max: f32,
+    rng: &mut Rng,
+    hero: u8,
+    r_u: &mut Spectrum,
+    steps: &mut u32,
+    max_steps: u32,
+) -> FreeFlight {
+    walk_majorants(
+        medium,
+        ray,
+        t_max,
+        rng,
+        steps,
+        max_steps,
+        SpectralAcceptance {
+            medium,
+            ray,
+            hero: hero as usize,
+            r_u,
+        },
+    )
+}
+
+/// Spectral delta tracking's test and its rescaling of the path densities.
+struct SpectralAcceptance<'a, M> {
+    medium: &'a M,
+    ray: &'a Ray,
+    hero: usize,
+    r_u: &'a mut Spectrum,
+}
+
+impl<M: Medium> TentativeCollision for SpectralAcceptance<'_, M> {
+    #[inline(always)]
+    fn stop_at(&mut self, rng: &mut Rng, t: f32, majorant: f32, _bits: u64) -> bool {
+        let w = collision_probabilities(self.medium, self.ray.at(t), majorant);
+        let real = rng.next_f32() < w[self.hero];
+        rescale(self.r_u, if real { w } else { Spectrum::ONE - w });
+        real || *self.r_u == Spectrum::ZERO
+    }
+}
+
+/// `sigma_t(p) / majorant` per channel, clamped to `[0, 1]`: each channel's probability that a
+/// tentative collision at `p` is real.
+#[inline(always)]
+fn collision_probabilities<M: Medium>(medium: &M, p: crate::Vec3, majorant: f32) -> Spectrum {
+    (medium.sigma_t_rgb(p) / majorant).clamp(Spectrum::ZERO, Spectrum::ONE)
+}
+
+/// [`ratio_tracking`] in every channel of a chromatic medium: the product of `1 - sigma_t,c /
+/// majorant` over the tentative collisions under one majorant for all channels is an unbiased
+/// estimate of each channel's transmittance (no hero is needed); the roulette watches the largest
+/// channel. A uniform extinction needs no estimate: `exp(-sigma_t t_max)` per channel. Every
+/// factor is in `[0, 1]`, so the estimate is finite.
+#[inline(always)]
+pub fn spectral_ratio_tracking<M: Medium>(
+    medium: &M,
+    ray: &Ray,
+    t_max: f32,
+    rng: &mut Rng,
+    steps: &mut u32,
+    max_steps: u32,
+) -> Option<Spectrum> {
+    if let Some(sigma_t) = medium.uniform_sigma_t_rgb() {
+        let tau = sigma_t * t_max;
+        return Some(Spectrum::new(exp(-tau.x), exp(-tau.y), exp(-tau.z)));
+    }
+    let mut ratio = SpectralRatioProduct {
+        medium,
+        ray,
+        transmittance: Spectrum::ONE,
+    };
+    let flight = walk_majorants(medium, ray, t_max, rng, steps, max_steps, &mut ratio);
+    match flight {
+        FreeFlight::OutOfSteps => None,
+        FreeFlight::Collision(_) => Some(Spectrum::ZERO),
+        FreeFlight::Escaped => Some(ratio.transmittance),
+    }
+}
+
+/// Spectral ratio tracking's running product, with its roulette; it stops the walk once it is zero.
+struct SpectralRatioProduct<'a, M> {
+    medium: &'a M,
+    ray: &'a Ray,
+    transmittance: Spectrum,
+}
+
+impl<M: Medium> TentativeCollision for &mut SpectralRatioProduct<'_, M> {
+    #[inline(always)]
+    fn stop_at(&mut self, rng: &mut Rng, t: f32, majorant: f32, _bits: u64) -> bool {
+        let w = collision_probabilities(self.medium, self.ray.at(t), majorant);
+        self.transmittance *= Spectrum::ONE - w;
+        if self.transmittance.max_element() < 0.125 {
+            if rng.next_f32() < 0.5 {
+                self.transmittance *= 2.0;
+            } else {
+                self.transmittance = Spectrum::ZERO;
+            }
+        }
+        self.transmittance.max_element() <= 0.0
     }
 }

@@ -53,6 +53,7 @@ macro_rules! variants {
                         grid_density__grid_albedo__texture_trilinear,
                         $crate::GridMedium<$lt, $crate::GridAlbedo<$lt, $crate::TextureTrilinear>,
                         $crate::TextureTrilinear>)
+                    (Chromatic, chromatic, $crate::ChromaticMedium<$lt>)
                 ]
                 boundary [
                     (IndexMatched, index_matched, $crate::NullBoundary)

@@ -67,7 +67,8 @@ pub fn render_samples<S: Scene + Sync>(
         let mut counters = PathCounters::default();
         let mut first = samples.start;
         while first < samples.end {
-            let pass_samples = first..(first + SAMPLES_PER_PASS).min(samples.end);
+            // Saturating: a range ending at u32::MAX must not wrap its last pass's end to 0.
+            let pass_samples = first..first.saturating_add(SAMPLES_PER_PASS).min(samples.end);
             let pass = film
                 .sums
                 .par_chunks_mut(width as usize)

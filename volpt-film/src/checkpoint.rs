@@ -9,7 +9,7 @@
 //! (`u64`) of everything before it. The size is checked against the header before anything is
 //! allocated, and the checksum before the sums are used.
 
-use std::io::Write;
+use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
 use thiserror::Error;
@@ -130,12 +130,14 @@ impl Checkpoint {
     }
 
     /// Reads the checkpoint at `path` and checks that it belongs to a render of `fingerprint` and
-    /// `seed` on a `width` x `height` film.
+    /// `seed` on a `width` x `height` film; a film whose sums would take more than `limit` bytes
+    /// is refused before anything is read (the size may come from the file's own header).
     pub fn read(
         path: &Path,
         fingerprint: u64,
         (width, height): (u32, u32),
         seed: u32,
+        limit: u64,
     ) -> Result<Self, CheckpointError> {
         let corrupt = |problem: String| CheckpointError::Corrupt {
             path: path.to_owned(),
@@ -151,20 +153,31 @@ impl Checkpoint {
             path: path.to_owned(),
             source,
         };
-        let meta = std::fs::metadata(path).map_err(io)?;
-        if !meta.is_file() {
-            return Err(corrupt("not a regular file".into()));
-        }
-        // Only a checkpoint of this film's size can be this render's: anything else is refused
-        // before it is read, whatever its header claims.
-        let expected_len = (HEADER + width as usize * height as usize * 24 + 8) as u64;
-        if meta.len() != expected_len {
+        let sum_bytes = u64::from(width) * u64::from(height) * 24;
+        if sum_bytes > limit {
             return Err(corrupt(format!(
-                "{} bytes, a {width}x{height} film's checkpoint has {expected_len}",
-                meta.len()
+                "a {width}x{height} film takes {sum_bytes} bytes, more than the memory limit of \
+                 {limit} bytes (raise it with --memory-limit)"
             )));
         }
-        let bytes = std::fs::read(path).map_err(io)?;
+        let (file, length) = crate::regular::open_regular(path).map_err(io)?;
+        // Only a checkpoint of this film's size can be this render's: anything else is refused
+        // before it is read, whatever its header claims.
+        let expected_len = HEADER as u64 + sum_bytes + 8;
+        if length != expected_len {
+            return Err(corrupt(format!(
+                "{length} bytes, a {width}x{height} film's checkpoint has {expected_len}"
+            )));
+        }
+        let mut bytes = Vec::with_capacity(length as usize);
+        // `take`: a file that grows while it is read stops at the length checked above.
+        file.take(length).read_to_end(&mut bytes).map_err(io)?;
+        if bytes.len() as u64 != length {
+            return Err(corrupt(format!(
+                "{} bytes read of {length} (the file changed while read)",
+                bytes.len()
+            )));
+        }
         let (payload, checksum) = bytes.split_at(bytes.len() - 8);
         let mut fnv = Fnv::default();
         fnv.write(payload);

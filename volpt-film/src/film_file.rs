@@ -21,7 +21,7 @@
 //! memory limit); then the checksum; then the ranges. Checkpoints (`VOLPTCK1`, samples `0..n`) read
 //! as films of the one range `0..n`.
 
-use std::io::Read;
+use std::io::{BufReader, Read};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
@@ -36,6 +36,12 @@ pub const MAGIC: &[u8; 8] = b"VOLPTFL1";
 const CHECKPOINT_MAGIC: &[u8; 8] = b"VOLPTCK1";
 /// Magic, fingerprint, width, height, seed, and the range count or (checkpoint) sample count.
 const HEADER: u64 = 8 + 8 + 4 * 4;
+/// Bytes of one sample range (`start`, `end`), in the file and in memory.
+const RANGE_BYTES: u64 = 8;
+/// Bytes of one pixel's sums (r, g, b as `f64`), in the file and in memory.
+const SUM_BYTES: u64 = 24;
+/// How much of a film file is read at once: the reader holds no more than this besides the film.
+const CHUNK_BYTES: u64 = 1 << 20;
 
 /// A film of the sample ranges `ranges` of the render of `fingerprint` with `seed`.
 #[derive(Clone, Debug, PartialEq)]
@@ -66,16 +72,18 @@ pub enum FilmFileError {
         expected: String,
         found: String,
     },
-    /// A film larger than the caller's memory limit (`--memory-limit`).
+    /// A film (its sums and its list of sample ranges) larger than the caller's memory limit
+    /// (`--memory-limit`).
     #[error(
-        "{}: the film is {width}x{height}, {bytes} bytes of sums, more than the memory limit of \
-         {limit} bytes (raise it with --memory-limit)",
+        "{}: the film is {width}x{height} with {ranges} sample ranges listed, {bytes} bytes, more \
+         than the memory limit of {limit} bytes (raise it with --memory-limit)",
         path.display()
     )]
     TooLarge {
         path: PathBuf,
         width: u32,
         height: u32,
+        ranges: u32,
         bytes: u64,
         limit: u64,
     },
@@ -199,8 +207,11 @@ impl FilmFile {
         write_sums_atomically(bytes, &self.film.sums, path).map_err(io)
     }
 
-    /// Reads the film file (or checkpoint) at `path`, refusing one whose sums would take more than
-    /// `limit` bytes before reading them.
+    /// Reads the film file (or checkpoint) at `path`, refusing one whose sample ranges and sums
+    /// would take more than `limit` bytes before reading them.
+    ///
+    /// The file is read as a stream (its checksum computed as it goes), so that nothing but the
+    /// film itself is allocated, and a list of ranges is refused at its first bad range.
     pub fn read(path: &Path, limit: u64) -> Result<Self, FilmFileError> {
         let corrupt = |field, expected: String, found: String| FilmFileError::Corrupt {
             path: path.to_owned(),
@@ -212,16 +223,7 @@ impl FilmFile {
             path: path.to_owned(),
             source,
         };
-        let mut file = std::fs::File::open(path).map_err(io)?;
-        let meta = file.metadata().map_err(io)?;
-        if !meta.is_file() {
-            return Err(corrupt(
-                "kind",
-                "a regular file".into(),
-                "not a regular file".into(),
-            ));
-        }
-        let length = meta.len();
+        let (file, length) = crate::regular::open_regular(path).map_err(io)?;
         let mut header = [0u8; HEADER as usize];
         if length < HEADER + 8 {
             return Err(corrupt(
@@ -230,6 +232,8 @@ impl FilmFile {
                 format!("{length} bytes"),
             ));
         }
+        // `take`: a file that grows while it is read stops at the length checked here.
+        let mut file = BufReader::with_capacity(1 << 16, file.take(length));
         file.read_exact(&mut header).map_err(io)?;
         let magic = &header[..8];
         let checkpoint = magic == CHECKPOINT_MAGIC;
@@ -247,11 +251,11 @@ impl FilmFile {
             u32_at(&header, 28),
         );
         // A checkpoint has no range list: its last header field is its sample count.
-        let range_bytes = if checkpoint { 0 } else { 8 * u64::from(count) };
+        let range_count = if checkpoint { 0 } else { count };
+        let range_bytes = RANGE_BYTES * u64::from(range_count);
         // width * height fits a u64 for any u32 header; 24 times it may not, hence checked.
-        let expected = (u64::from(width) * u64::from(height))
-            .checked_mul(24)
-            .and_then(|s| s.checked_add(HEADER + range_bytes + 8));
+        let sum_bytes = (u64::from(width) * u64::from(height)).checked_mul(SUM_BYTES);
+        let expected = sum_bytes.and_then(|s| s.checked_add(HEADER + range_bytes + 8));
         match expected {
             Some(e) if e == length => {}
             _ => {
@@ -272,51 +276,49 @@ impl FilmFile {
                 ))
             }
         }
-        // The length matched, so this product did not overflow.
-        let sum_bytes = u64::from(width) * u64::from(height) * 24;
-        if sum_bytes > limit {
+        // The length matched, so neither sum overflows: what the film takes in memory (a range
+        // is 8 bytes there too, a pixel 24) is the file's length less its header and checksum.
+        let sum_bytes = u64::from(width) * u64::from(height) * SUM_BYTES;
+        let bytes = sum_bytes + range_bytes;
+        if bytes > limit {
             return Err(FilmFileError::TooLarge {
                 path: path.to_owned(),
                 width,
                 height,
-                bytes: sum_bytes,
+                ranges: range_count,
+                bytes,
                 limit,
             });
         }
-        // The file is as long as its header says, and that is within the limit: read it.
-        let mut bytes = header.to_vec();
-        bytes.reserve_exact((length - HEADER) as usize);
-        file.read_to_end(&mut bytes).map_err(io)?;
-        if bytes.len() as u64 != length {
-            return Err(corrupt(
-                "length",
-                format!("{length} bytes"),
-                format!("{} bytes read (the file changed while read)", bytes.len()),
-            ));
-        }
-        let (payload, checksum) = bytes.split_at(bytes.len() - 8);
         let mut fnv = Fnv::default();
-        fnv.write(payload);
-        let stored = u64::from_le_bytes(checksum.try_into().expect("8 bytes"));
-        if fnv.finish() != stored {
-            return Err(corrupt(
-                "checksum",
-                format!("{:016x}, the FNV-1a of its contents", fnv.finish()),
-                format!("{stored:016x}"),
-            ));
+        fnv.write(&header);
+        let fingerprint = u64::from_le_bytes(header[8..16].try_into().expect("8 bytes"));
+        let seed = u32_at(&header, 24);
+        let mut chunk = Vec::new();
+        let mut ranges: Vec<Range<u32>> = Vec::new();
+        if checkpoint {
+            ranges.push(0..count);
         }
-        let fingerprint = u64::from_le_bytes(payload[8..16].try_into().expect("8 bytes"));
-        let seed = u32_at(payload, 24);
-        // A list of sample ranges that holds one (not the range's samples).
-        #[allow(clippy::single_range_in_vec_init)]
-        let ranges: Vec<Range<u32>> = if checkpoint {
-            vec![0..count]
-        } else {
-            payload[HEADER as usize..HEADER as usize + range_bytes as usize]
-                .chunks_exact(8)
-                .map(|r| u32_at(r, 0)..u32_at(r, 4))
-                .collect()
-        };
+        // Ranges in chunks, each checked as it comes: a claimed list of a billion ranges is
+        // refused at its first bad one, not allocated first.
+        let mut left = range_bytes;
+        while left > 0 {
+            let n = left.min(CHUNK_BYTES);
+            read_chunk(&mut file, &mut chunk, n, &mut fnv).map_err(io)?;
+            for r in chunk.chunks_exact(RANGE_BYTES as usize) {
+                ranges.push(u32_at(r, 0)..u32_at(r, 4));
+                // This range and the one before it: the list so far was in order.
+                let last = &ranges[ranges.len().saturating_sub(2)..];
+                if let Some(problem) = ranges_problem(last) {
+                    return Err(corrupt(
+                        "sample ranges",
+                        "sorted, non-empty ranges that neither overlap nor touch".into(),
+                        format!("... {} ({problem})", format_ranges(last)),
+                    ));
+                }
+            }
+            left -= n;
+        }
         if let Some(problem) = ranges_problem(&ranges) {
             return Err(corrupt(
                 "sample ranges",
@@ -324,10 +326,27 @@ impl FilmFile {
                 format!("{} ({problem})", format_ranges(&ranges)),
             ));
         }
-        let sums = payload[(HEADER + range_bytes) as usize..]
-            .chunks_exact(24)
-            .map(|p| [0, 8, 16].map(|i| f64::from_le_bytes(p[i..i + 8].try_into().expect("8"))))
-            .collect();
+        // Within the limit, and the file holds the bytes: the sums may be allocated.
+        let mut sums = Vec::with_capacity((sum_bytes / SUM_BYTES) as usize);
+        let mut left = sum_bytes;
+        while left > 0 {
+            let n = left.min(CHUNK_BYTES / SUM_BYTES * SUM_BYTES);
+            read_chunk(&mut file, &mut chunk, n, &mut fnv).map_err(io)?;
+            sums.extend(chunk.chunks_exact(SUM_BYTES as usize).map(|p| {
+                [0, 8, 16].map(|i| f64::from_le_bytes(p[i..i + 8].try_into().expect("8")))
+            }));
+            left -= n;
+        }
+        let mut checksum = [0u8; 8];
+        file.read_exact(&mut checksum).map_err(io)?;
+        let stored = u64::from_le_bytes(checksum);
+        if fnv.finish() != stored {
+            return Err(corrupt(
+                "checksum",
+                format!("{:016x}, the FNV-1a of its contents", fnv.finish()),
+                format!("{stored:016x}"),
+            ));
+        }
         Ok(Self {
             fingerprint,
             seed,
@@ -341,6 +360,20 @@ impl FilmFile {
             },
         })
     }
+}
+
+/// Reads the next `n` bytes of `file` into `chunk` and adds them to the checksum; a file that
+/// ends early (shortened while read) is an [`std::io::ErrorKind::UnexpectedEof`] error.
+fn read_chunk(
+    file: &mut impl Read,
+    chunk: &mut Vec<u8>,
+    n: u64,
+    fnv: &mut Fnv,
+) -> std::io::Result<()> {
+    chunk.resize(n as usize, 0);
+    file.read_exact(chunk)?;
+    fnv.write(chunk);
+    Ok(())
 }
 
 #[cfg(test)]
@@ -448,11 +481,69 @@ mod tests {
         assert_eq!(corrupt_field(FilmFile::read(&path, u64::MAX)), "length");
 
         std::fs::write(&path, &bytes).unwrap();
-        match FilmFile::read(&path, 5 * 3 * 24 - 1) {
-            Err(FilmFileError::TooLarge { bytes, .. }) => assert_eq!(bytes, 5 * 3 * 24),
+        // The film in memory: 24 bytes a pixel, 8 a range (two ranges).
+        let film_bytes = 5 * 3 * 24 + 2 * 8;
+        match FilmFile::read(&path, film_bytes - 1) {
+            Err(FilmFileError::TooLarge { bytes, .. }) => assert_eq!(bytes, film_bytes),
             other => panic!("expected TooLarge, got {other:?}"),
         }
-        FilmFile::read(&path, 5 * 3 * 24).unwrap();
+        FilmFile::read(&path, film_bytes).unwrap();
+    }
+
+    /// A header claiming 2^27 sample ranges, in a (sparse) file of exactly the length that
+    /// claims: the list's 1 GiB counts against the memory limit, and without a limit the list is
+    /// refused at its first range (zeros: empty), before the rest is read or allocated.
+    #[test]
+    fn a_claimed_list_of_ranges_counts_against_the_limit_and_is_refused_at_its_first_bad_range() {
+        let dir = tempfile::tempdir().unwrap();
+        let (path, bytes) = written(dir.path());
+        let count: u32 = 1 << 27;
+        let mut header = bytes[..HEADER as usize].to_vec();
+        header[28..32].copy_from_slice(&count.to_le_bytes());
+        let length = HEADER + 8 * u64::from(count) + 5 * 3 * 24 + 8;
+        let file = std::fs::File::create(&path).unwrap();
+        std::io::Write::write_all(&mut &file, &header).unwrap();
+        file.set_len(length).unwrap();
+        match FilmFile::read(&path, 1 << 30) {
+            Err(FilmFileError::TooLarge { bytes, ranges, .. }) => {
+                assert_eq!((bytes, ranges), (8 * u64::from(count) + 5 * 3 * 24, count))
+            }
+            other => panic!("expected TooLarge, got {other:?}"),
+        }
+        let started = std::time::Instant::now();
+        assert_eq!(
+            corrupt_field(FilmFile::read(&path, u64::MAX)),
+            "sample ranges"
+        );
+        assert!(
+            started.elapsed().as_secs_f64() < 1.0,
+            "{:?}",
+            started.elapsed()
+        );
+    }
+
+    /// A FIFO named as a film file is refused, not opened (opening it blocks until a writer
+    /// comes: for ever).
+    #[cfg(unix)]
+    #[test]
+    fn a_fifo_is_refused_not_waited_on() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("film.vfilm");
+        assert!(std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap()
+            .success());
+        let (send, receive) = std::sync::mpsc::channel();
+        let read = fifo.clone();
+        std::thread::spawn(move || send.send(FilmFile::read(&read, u64::MAX).map(|_| ())));
+        let result = receive
+            .recv_timeout(std::time::Duration::from_secs(10))
+            .expect("reading a FIFO returns");
+        let err = result.unwrap_err();
+        assert!(err.to_string().contains("FIFO"), "{err}");
+        let checkpoint = Checkpoint::read(&fifo, 0, (1, 1), 0, u64::MAX).unwrap_err();
+        assert!(checkpoint.to_string().contains("FIFO"), "{checkpoint}");
     }
 
     #[test]

@@ -6,10 +6,12 @@
 //! - [`RenderOptions`]: how many samples, with which seed.
 //! - [`checkpoint`]: a render's sums saved to a file, to resume it bit for bit.
 //! - [`film_file`]: the sums of any sample ranges of a render, to merge with the other ranges'.
+//! - [`regular`]: opening only regular files (a FIFO would block a reader for ever).
 
 pub mod checkpoint;
 pub mod film_file;
 pub mod image;
+pub mod regular;
 
 use std::ops::Range;
 use std::time::Duration;

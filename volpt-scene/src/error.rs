@@ -73,6 +73,14 @@ pub enum SceneError {
     #[error("{}: {problem}", path.display())]
     Grid { path: PathBuf, problem: GridProblem },
 
+    /// A triangle-mesh file is malformed, or its mesh is not a closed, consistently oriented
+    /// surface.
+    #[error("{}: {problem}", path.display())]
+    Mesh {
+        path: PathBuf,
+        problem: crate::mesh::MeshProblem,
+    },
+
     /// An environment map image is unreadable or holds values volpt cannot use.
     #[error("{}: {problem}", path.display())]
     Envmap {

@@ -42,6 +42,7 @@ pub mod from_description;
 pub mod generate;
 pub mod limits;
 pub mod medium;
+pub mod mesh;
 pub mod metaimage;
 pub mod mitsuba;
 pub mod normalise;

@@ -16,7 +16,10 @@ use volpt_core::grid::{
     AnyLayout, DenseTrilinear, Grid, GridLookup as CoreLookup, GridMapping, GridReads, TexelFormat,
     TextureTrilinear,
 };
-use volpt_core::{Aabb, ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium, Spectrum, Vec3};
+use volpt_core::{
+    Aabb, ChromaticMedium, ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium, Spectrum,
+    Vec3,
+};
 
 use crate::description::{Bounds, GridConvention, GridDesc, SampleLayout, SceneDescription};
 use crate::error::SceneError;
@@ -79,6 +82,9 @@ pub enum GridLookup {
 pub enum DensityDesc {
     Constant(f32),
     Grid(GridDesc),
+    /// A constant density per channel: a chromatic extinction, `scale * rgb` (milk, skin, a
+    /// print's resin; [`volpt_core::ChromaticMedium`]). Equal channels render as `Constant`.
+    Rgb([f32; 3]),
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -95,8 +101,7 @@ const DEFAULT_ALBEDO: f32 = 0.75;
 impl MediumDesc {
     /// Mitsuba's interior `<medium>`: `homogeneous` or `heterogeneous`, with its phase function.
     ///
-    /// volpt tracks a grey extinction with an RGB albedo, so extinction must be equal in R, G and
-    /// B; the albedo may vary. Parameter names differ between generations (Mitsuba 0.6 `sigmaA`,
+    /// A constant extinction may differ between R, G and B (a chromatic medium); a grid's is grey. Parameter names differ between generations (Mitsuba 0.6 `sigmaA`,
     /// `sigmaS`, `density`; Mitsuba 3 `sigma_t`, `albedo`) and both are accepted in either. Where
     /// a parameter is absent, Mitsuba 3's defaults apply (extinction 1, albedo 0.75); Mitsuba 0.6
     /// has material-preset defaults volpt does not carry, so there it must be given.
@@ -172,38 +177,26 @@ fn homogeneous(p: &Plugin<'_>) -> Result<(DensityDesc, AlbedoDesc), SceneError> 
             let a = non_negative(&a_arg, constant(p, &a_arg)?)?;
             let s = non_negative(&s_arg, constant(p, &s_arg)?)?;
             let t = [a[0] + s[0], a[1] + s[1], a[2] + s[2]];
-            let grey_t = grey(
-                &a_arg,
-                "sigmaA + sigmaS equal in R, G and B (volpt's extinction is grey)",
-                t,
-            )?;
-            let albedo = s.map(|s| if grey_t > 0.0 { s / grey_t } else { 0.0 });
-            Ok((DensityDesc::Constant(grey_t), AlbedoDesc::Constant(albedo)))
+            let albedo = [0, 1, 2].map(|c| if t[c] > 0.0 { s[c] / t[c] } else { 0.0 });
+            Ok((extinction(t), AlbedoDesc::Constant(albedo)))
         }
         (Some(one), None) | (None, Some(one)) => {
             Err(one.invalid("sigmaA and sigmaS given together", "only one of them"))
         }
         (None, None) => {
             let sigma_t = match sigma_t {
-                Some(arg) => {
-                    let v = non_negative(&arg, constant(p, &arg)?)?;
-                    grey(
-                        &arg,
-                        "an extinction equal in R, G and B (volpt's extinction is grey)",
-                        v,
-                    )?
-                }
-                None => default_for(
+                Some(arg) => extinction(non_negative(&arg, constant(p, &arg)?)?),
+                None => DensityDesc::Constant(default_for(
                     p,
                     DEFAULT_SIGMA_T,
                     "<float name=\"sigma_t\"> (or sigmaA and sigmaS)",
-                )?,
+                )?),
             };
             let albedo = match albedo {
                 Some(arg) => in_unit_range(&arg, constant(p, &arg)?)?,
                 None => [default_for(p, DEFAULT_ALBEDO, "<rgb name=\"albedo\">")?; 3],
             };
-            Ok((DensityDesc::Constant(sigma_t), AlbedoDesc::Constant(albedo)))
+            Ok((sigma_t, AlbedoDesc::Constant(albedo)))
         }
     }
 }
@@ -217,14 +210,7 @@ fn heterogeneous(p: &Plugin<'_>) -> Result<(DensityDesc, AlbedoDesc), SceneError
         )?),
         Some(arg) => match volume(&arg, p.ctx, Role::Density)? {
             VolumeValue::Grid(grid) => DensityDesc::Grid(grid),
-            VolumeValue::Constant(v) => {
-                let v = non_negative(&arg, v)?;
-                DensityDesc::Constant(grey(
-                    &arg,
-                    "an extinction equal in R, G and B (volpt's extinction is grey)",
-                    v,
-                )?)
-            }
+            VolumeValue::Constant(v) => extinction(non_negative(&arg, v)?),
         },
     };
     let albedo = match p.find(&["albedo"])? {
@@ -267,12 +253,13 @@ fn default_for(p: &Plugin<'_>, value: f32, what: &str) -> Result<f32, SceneError
     }
 }
 
-fn grey(arg: &Arg<'_>, expected: &str, v: [f32; 3]) -> Result<f32, SceneError> {
+/// A constant extinction: grey where R, G and B agree (to rounding), else chromatic.
+fn extinction(v: [f32; 3]) -> DensityDesc {
     let max = v.iter().fold(0.0f32, |m, c| m.max(c.abs()));
     if v.iter().all(|c| (c - v[0]).abs() <= 1e-6 * max) {
-        Ok(v[0])
+        DensityDesc::Constant(v[0])
     } else {
-        Err(constant_error(arg, expected, v))
+        DensityDesc::Rgb(v)
     }
 }
 
@@ -366,13 +353,23 @@ impl MediumDesc {
                 }
                 *d
             }
+            DensityDesc::Rgb(rgb) => {
+                if !rgb.iter().all(|d| d.is_finite() && *d >= 0.0) {
+                    return Err(invalid(
+                        "medium density",
+                        "three finite numbers >= 0",
+                        format!("{rgb:?}"),
+                    ));
+                }
+                rgb.iter().copied().fold(0.0, f32::max)
+            }
             DensityDesc::Grid(grid) => match checked {
                 Some(data) => data.largest_density,
                 None => check_grid(grid, "density grid", f32::MAX, invalid)?,
             },
         };
         let largest_density = match &self.density {
-            DensityDesc::Constant(_) => 0.0,
+            DensityDesc::Constant(_) | DensityDesc::Rgb(_) => 0.0,
             DensityDesc::Grid(_) => max_density,
         };
         let mut largest_albedo = 0.0;
@@ -394,6 +391,17 @@ impl MediumDesc {
             }
         }
         let sparse = self.grids().any(|(_, g)| g.layout == SampleLayout::Sparse);
+        let plain_reads =
+            self.lookup == GridLookup::Trilinear && self.storage == GridStorage::Dense;
+        let chromatic_grids =
+            matches!(self.density, DensityDesc::Rgb(_)) && self.grids().next().is_some();
+        if chromatic_grids && (sparse || !plain_reads) {
+            return Err(invalid(
+                "grid lookup",
+                "trilinear lookups of dense grids beside a chromatic extinction",
+                format!("{:?} lookups, {:?} storage", self.lookup, self.storage),
+            ));
+        }
         if sparse && matches!(self.lookup, GridLookup::Texture | GridLookup::TextureHalf) {
             return Err(invalid(
                 "grid lookup",
@@ -415,6 +423,7 @@ impl MediumDesc {
     pub fn max_extinction(&self) -> f32 {
         match &self.density {
             DensityDesc::Constant(density) => self.scale * density,
+            DensityDesc::Rgb(rgb) => self.scale * rgb.iter().copied().fold(0.0, f32::max),
             DensityDesc::Grid(grid) => self.scale * grid.max_value(),
         }
     }
@@ -427,6 +436,7 @@ impl MediumDesc {
                 "density",
                 match &self.density {
                     DensityDesc::Constant(v) => *v,
+                    DensityDesc::Rgb(rgb) => rgb.iter().copied().fold(0.0, f32::max),
                     DensityDesc::Grid(_) => checked.largest_density,
                 },
             ),
@@ -444,7 +454,7 @@ impl MediumDesc {
     pub fn grids(&self) -> impl Iterator<Item = (&'static str, &GridDesc)> {
         let density = match &self.density {
             DensityDesc::Grid(g) => Some(("density", g)),
-            DensityDesc::Constant(_) => None,
+            DensityDesc::Constant(_) | DensityDesc::Rgb(_) => None,
         };
         let albedo = match &self.albedo {
             AlbedoDesc::Grid(g) => Some(("albedo", g)),
@@ -459,13 +469,30 @@ impl MediumDesc {
     pub fn unserialised_values(&self) -> [&[f32]; 2] {
         let density = match &self.density {
             DensityDesc::Grid(g) => &g.data[..],
-            DensityDesc::Constant(_) => &[],
+            DensityDesc::Constant(_) | DensityDesc::Rgb(_) => &[],
         };
         let albedo = match &self.albedo {
             AlbedoDesc::Grid(g) => &g.data[..],
             AlbedoDesc::Constant(_) => &[],
         };
         [density, albedo]
+    }
+
+    /// The `scale` of the medium's Mitsuba 3 `<medium>`: an RGB extinction's largest channel
+    /// travels in it.
+    pub(crate) fn mitsuba3_scale(&self) -> f32 {
+        match &self.density {
+            DensityDesc::Rgb(rgb) if rgb.iter().any(|&c| c > 0.0) => {
+                self.scale * rgb.iter().copied().fold(0.0, f32::max)
+            }
+            _ => self.scale,
+        }
+    }
+
+    /// Whether the extinction differs between channels (the medium renders as
+    /// [`volpt_core::ChromaticMedium`]; Mitsuba 3's peer integrator is `volpathmis`).
+    pub fn is_chromatic(&self) -> bool {
+        matches!(&self.density, DensityDesc::Rgb(rgb) if !rgb.iter().all(|&c| c == rgb[0]))
     }
 
     /// The `<medium>`'s type, its extinction and its albedo elements in a Mitsuba 3 scene; `grid`
@@ -480,6 +507,17 @@ impl MediumDesc {
                 "homogeneous",
                 format!("<float name=\"sigma_t\" value=\"{d}\"/>"),
             ),
+            // An RGB value is a reflectance in [0, 1] to Mitsuba 3's parser: the largest channel
+            // goes into `scale` ([`MediumDesc::mitsuba3_scale`]), the rest into the RGB.
+            DensityDesc::Rgb(rgb) => {
+                let max = rgb.iter().copied().fold(0.0, f32::max);
+                let unit = if max > 0.0 {
+                    rgb.map(|c| c / max)
+                } else {
+                    *rgb
+                };
+                ("homogeneous", rgb_element("sigma_t", &unit))
+            }
             DensityDesc::Grid(g) => ("heterogeneous", grid(g, "density", "sigma_t")?),
         };
         let albedo = match &self.albedo {
@@ -579,6 +617,11 @@ impl MediumDesc {
                 GridLookup::Trilinear,
             ),
             (
+                DensityDesc::Rgb([1.0, 2.5, 5.0]),
+                AlbedoDesc::Constant([0.95, 0.9, 0.85]),
+                GridLookup::Trilinear,
+            ),
+            (
                 DensityDesc::Grid(grid(1, vertex)),
                 AlbedoDesc::Constant([0.8, 0.9, 0.6]),
                 GridLookup::Trilinear,
@@ -653,6 +696,7 @@ impl fmt::Display for DensityDesc {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             DensityDesc::Constant(d) => write!(f, "constant {d}"),
+            DensityDesc::Rgb(rgb) => write!(f, "constant RGB {rgb:?} (chromatic)"),
             DensityDesc::Grid(g) => write!(f, "{}", InfoGrid(g)),
         }
     }
@@ -729,6 +773,8 @@ pub type IsUniform<'u> = dyn Fn(&[f32], usize) -> bool + 'u;
 enum Density<'a> {
     Constant(&'a f32),
     Grid(&'a GridDesc),
+    /// Channels that differ (equal ones are `Constant`).
+    Rgb(&'a [f32; 3]),
 }
 
 enum Albedo<'a> {
@@ -759,6 +805,11 @@ impl<'a> MediumInput<'a> {
                 None => Density::Grid(grid),
             },
             DensityDesc::Constant(sigma) => Density::Constant(sigma),
+            DensityDesc::Rgb(rgb) if is_uniform.is_some() && rgb.iter().all(|&c| c == rgb[0]) => {
+                fired(Simplification::GreyExtinction);
+                Density::Constant(&rgb[0])
+            }
+            DensityDesc::Rgb(rgb) => Density::Rgb(rgb),
         };
         let albedo = match &medium.albedo {
             AlbedoDesc::Grid(grid) => match uniform(grid) {
@@ -817,6 +868,9 @@ impl<'a, R: ReadsRule> FromDescription<'a> for GridMedium<'a, ConstantAlbedo, R>
     type Input = MediumInput<'a>;
 
     fn specialised(input: &MediumInput<'a>, _: &mut dyn FnMut(Simplification)) -> Option<Self> {
+        if matches!(input.density, Density::Rgb(_)) {
+            return None;
+        }
         match input.albedo {
             Albedo::Constant(albedo) if R::asked_by(input.medium) => Some(grid_medium(
                 input,
@@ -841,7 +895,7 @@ impl<'a, R: ReadsRule> FromDescription<'a> for GridMedium<'a, GridAlbedo<'a, R>,
     }
 
     fn general(input: &MediumInput<'a>) -> Option<Self> {
-        if !R::asked_by(input.medium) {
+        if !R::asked_by(input.medium) || matches!(input.density, Density::Rgb(_)) {
             return None;
         }
         let albedo = match input.albedo {
@@ -852,12 +906,35 @@ impl<'a, R: ReadsRule> FromDescription<'a> for GridMedium<'a, GridAlbedo<'a, R>,
     }
 }
 
+/// A chromatic extinction, which only this part renders (read trilinearly from dense grids: an
+/// albedo grid of other lookups or storage is refused when the scene is checked).
+impl<'a> FromDescription<'a> for ChromaticMedium<'a> {
+    type Input = MediumInput<'a>;
+
+    fn specialised(input: &MediumInput<'a>, _: &mut dyn FnMut(Simplification)) -> Option<Self> {
+        Self::general(input)
+    }
+
+    fn general(input: &MediumInput<'a>) -> Option<Self> {
+        let Density::Rgb(rgb) = input.density else {
+            return None;
+        };
+        let (albedo, albedo_grid) = match input.albedo {
+            Albedo::Constant(a) => (Spectrum::new(a[0], a[1], a[2]), None),
+            Albedo::Grid(g) => (Spectrum::ZERO, Some(grid::<3>(g, input.medium.lookup))),
+        };
+        let extinction = input.medium.scale * Spectrum::from_array(*rgb);
+        Some(ChromaticMedium::new(extinction, None, albedo, albedo_grid))
+    }
+}
+
 /// A grid medium with `albedo`; a constant density becomes a one-voxel grid over the medium's box.
 fn grid_medium<'a, A, R: GridReads>(input: &MediumInput<'a>, albedo: A) -> GridMedium<'a, A, R> {
     let medium = input.medium;
     let density = match input.density {
         Density::Grid(density) => grid::<1>(density, medium.lookup),
         Density::Constant(sigma) => one_voxel(input, std::slice::from_ref(sigma)),
+        Density::Rgb(_) => unreachable!("a chromatic extinction is ChromaticMedium's"),
     };
     let max_density = density.samples().iter().copied().fold(0.0, f32::max);
     GridMedium {

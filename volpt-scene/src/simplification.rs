@@ -11,6 +11,8 @@ pub enum Simplification {
     ConstantDensityGrid,
     /// An albedo grid with one value everywhere, covering the medium's box, is a constant albedo.
     ConstantAlbedoGrid,
+    /// An RGB extinction whose channels are equal is grey: today's grey media, no spectral MIS.
+    GreyExtinction,
     /// Henyey-Greenstein with g = 0 is isotropic.
     ZeroAsymmetry,
     /// A smooth dielectric with relative IOR exactly 1 neither reflects nor bends: index-matched.
@@ -27,6 +29,9 @@ impl fmt::Display for Simplification {
             }
             Simplification::ConstantAlbedoGrid => {
                 "the albedo grid has one value over the whole box: constant albedo"
+            }
+            Simplification::GreyExtinction => {
+                "the extinction is equal in R, G and B: grey medium, no spectral MIS"
             }
             Simplification::ZeroAsymmetry => "Henyey-Greenstein with g = 0: isotropic phase",
             Simplification::UnitIorRatio => {

@@ -644,7 +644,25 @@ fn read_volume(cx: &Cx<'_>, file: &Path, v: &VolumeSpec) -> Result<(GridDesc, Bo
     Ok((grid, file_box))
 }
 
-/// Mitsuba's `lookat`: camera +z towards the target, +y up, +x to the left of the image.
+/// The smallest sine of the angle between a camera's up and its viewing direction: below it the
+/// camera's left (their cross product, normalised) is mostly `f32` rounding (an error of about
+/// 2.4e-7 / sine), so the up counts as parallel. Relative: the vectors' lengths do not matter.
+pub const MIN_UP_SINE: f64 = 1e-4;
+
+/// Whether `up` and `dir` are parallel within [`MIN_UP_SINE`] (or either is zero or not finite).
+pub fn parallel(up: [f64; 3], dir: [f64; 3]) -> bool {
+    let cross = [
+        up[1] * dir[2] - up[2] * dir[1],
+        up[2] * dir[0] - up[0] * dir[2],
+        up[0] * dir[1] - up[1] * dir[0],
+    ];
+    let len = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let scale = len(up) * len(dir);
+    !(scale > 0.0 && scale.is_finite() && len(cross) > MIN_UP_SINE * scale)
+}
+
+/// Mitsuba's `lookat`: camera +z towards the target, +y up, +x to the left of the image. `None`
+/// where the target is the origin or the up is [`parallel`] to the direction.
 pub fn look_at(origin: [f32; 3], target: [f32; 3], up: [f32; 3]) -> Option<Matrix4> {
     let sub = |a: [f32; 3], b: [f32; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
     let cross = |a: [f32; 3], b: [f32; 3]| {
@@ -656,9 +674,12 @@ pub fn look_at(origin: [f32; 3], target: [f32; 3], up: [f32; 3]) -> Option<Matri
     };
     let normalize = |v: [f32; 3]| {
         let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-        (len > 1e-12 && len.is_finite()).then(|| v.map(|c| c / len))
+        (len > 0.0 && len.is_finite()).then(|| v.map(|c| c / len))
     };
     let dir = normalize(sub(target, origin))?;
+    if parallel(up.map(f64::from), dir.map(f64::from)) {
+        return None;
+    }
     let left = normalize(cross(normalize(up)?, dir))?;
     let new_up = cross(dir, left);
     Some([

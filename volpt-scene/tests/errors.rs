@@ -6,7 +6,7 @@ mod common;
 use std::path::Path;
 
 use common::*;
-use volpt_scene::{load_mitsuba, SceneError, VolGrid};
+use volpt_scene::{load_mitsuba, AlbedoDesc, DensityDesc, SceneError, VolGrid};
 
 /// The 1-based line of the first occurrence of `needle` in `text`.
 fn line_of(text: &str, needle: &str) -> usize {
@@ -314,15 +314,37 @@ fn non_number_is_named() {
     );
 }
 
+/// A coloured extinction is a chromatic medium (Mitsuba 3's spelling: an RGB in [0, 1] times
+/// `scale`; Mitsuba 0.6's: `sigmaA` + `sigmaS`), and a negative channel is an error.
 #[test]
-fn coloured_extinction_is_an_error() {
+fn coloured_extinction_is_chromatic_and_a_negative_channel_an_error() {
     let text = medium_scene(
         r#"<medium type="homogeneous" name="interior">
-            <rgb name="sigma_t" value="1, 2, 3"/>
+            <rgb name="sigma_t" value="0.2, 0.5, 1"/>
+            <float name="scale" value="10"/>
+        </medium>"#,
+    );
+    let (_dir, path) = scene_file(&text);
+    let desc = load_mitsuba(&path).unwrap();
+    assert_eq!(desc.medium.density, DensityDesc::Rgb([0.2, 0.5, 1.0]));
+    assert_eq!(desc.medium.scale, 10.0);
+    let text = medium_scene(
+        r#"<medium type="homogeneous" name="interior">
+            <rgb name="sigmaA" value="1, 0, 0"/>
+            <rgb name="sigmaS" value="1, 2, 3"/>
+        </medium>"#,
+    );
+    let (_dir, path) = scene_file(&text);
+    let desc = load_mitsuba(&path).unwrap();
+    assert_eq!(desc.medium.density, DensityDesc::Rgb([2.0, 2.0, 3.0]));
+    assert_eq!(desc.medium.albedo, AlbedoDesc::Constant([0.5, 1.0, 1.0]));
+    let text = medium_scene(
+        r#"<medium type="homogeneous" name="interior">
+            <rgb name="sigma_t" value="1, -2, 3"/>
         </medium>"#,
     );
     let err = error_at(&text, "sigma_t");
-    message_of(&err, &["<rgb name=\"sigma_t\">", "grey", "(1, 2, 3)"]);
+    message_of(&err, &["<rgb name=\"sigma_t\">", ">= 0", "(1, -2, 3)"]);
 }
 
 #[test]

@@ -42,7 +42,13 @@ pub fn render_checkpointed(
     let fingerprint = scene.fingerprint();
     let state = match &checkpointing.resume {
         Some(path) => {
-            let state = Checkpoint::read(path, fingerprint, scene.resolution(), scene.seed())?;
+            let state = Checkpoint::read(
+                path,
+                fingerprint,
+                scene.resolution(),
+                scene.seed(),
+                volpt_scene::limits::memory_limit(),
+            )?;
             if state.samples > spp {
                 return Err(Error::Settings(format!(
                     "{}: the checkpoint holds {} samples per pixel, more than the {spp} asked for",

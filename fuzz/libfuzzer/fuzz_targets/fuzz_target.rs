@@ -1,4 +1,4 @@
-//! One libFuzzer binary for every target, picked by `VOLPT_FUZZ_TARGET` (one build, eight runs).
+//! One libFuzzer binary for every target, picked by `VOLPT_FUZZ_TARGET` (one build, a run per target).
 
 #![no_main]
 

@@ -110,7 +110,7 @@ pub fn write_mitsuba3(
         r#"<?xml version="1.0" encoding="utf-8"?>
 <!-- Written by volpt (`volpt scene export`): the scene volpt renders, in Mitsuba 3 spelling. -->
 <scene version="3.0.0">
-    <integrator type="volpath">
+    <integrator type="{integrator}">
         <integer name="max_depth" value="{max_depth}"/>
         <integer name="rr_depth" value="{rr_depth}"/>
     </integrator>
@@ -151,7 +151,13 @@ pub fn write_mitsuba3(
         width = desc.film.width,
         height = desc.film.height,
         cube = matrix_transform(&cube_to_world, "        "),
-        scale = medium.scale,
+        scale = medium.mitsuba3_scale(),
+        // Mitsuba 3's `volpath` samples one channel without MIS: very noisy on chromatic media.
+        integrator = if medium.is_chromatic() {
+            "volpathmis"
+        } else {
+            "volpath"
+        },
     );
     std::fs::write(&xml_path, xml).map_err(|error| SceneError::Io {
         path: xml_path,

@@ -13,7 +13,11 @@ pub(crate) const DEFAULT_INTEGRATOR: IntegratorDesc = IntegratorDesc {
 
 pub(crate) fn integrator(el: &Element, ctx: &Ctx<'_>) -> Result<IntegratorDesc, SceneError> {
     let p = Plugin::new(el, ctx);
-    if !matches!(p.kind()?, "volpath" | "volpath_simple" | "volpathsimple") {
+    // `volpathmis` (spectral MIS, which volpt always uses on chromatic media) is the same family.
+    if !matches!(
+        p.kind()?,
+        "volpath" | "volpathmis" | "volpath_simple" | "volpathsimple"
+    ) {
         return Err(p.unsupported("volpt implements Mitsuba's volumetric path tracer: use volpath"));
     }
     let max_depth = match p.find(&["maxDepth", "max_depth"])? {

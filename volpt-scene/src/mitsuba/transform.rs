@@ -205,14 +205,17 @@ fn lookat(step: &Element) -> Result<Transform, SceneError> {
             quoted(step.attr("target").unwrap_or("")),
         )
     })?;
-    let left = normalize(cross(up, dir)).ok_or_else(|| {
-        invalid(
-            step,
-            "<lookat up>",
-            "an up vector not parallel to the viewing direction",
-            quoted(step.attr("up").unwrap_or("")),
-        )
-    })?;
+    let parallel = crate::toml_scene::parallel(up, dir);
+    let left = normalize(cross(up, dir))
+        .filter(|_| !parallel)
+        .ok_or_else(|| {
+            invalid(
+                step,
+                "<lookat up>",
+                "an up vector not parallel to the viewing direction",
+                quoted(step.attr("up").unwrap_or("")),
+            )
+        })?;
     let new_up = cross(dir, left);
     Ok([
         [left[0], new_up[0], dir[0], origin[0]],
@@ -236,7 +239,7 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 
 fn normalize(v: [f64; 3]) -> Option<[f64; 3]> {
     let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    (len > 1e-12 && len.is_finite()).then(|| v.map(|c| c / len))
+    (len > 0.0 && len.is_finite()).then(|| v.map(|c| c / len))
 }
 
 #[cfg(test)]
@@ -264,5 +267,36 @@ mod tests {
     fn later_steps_apply_after_earlier_ones() {
         let m = mul(&translate([1.0, 0.0, 0.0]), &scale([2.0, 2.0, 2.0]));
         assert!(close(apply_point(&m, [1.0, 1.0, 1.0]), [3.0, 2.0, 2.0]));
+    }
+
+    fn lookat_of(target: &str, up: &str) -> Result<Transform, SceneError> {
+        lookat(&Element {
+            tag: "lookat".into(),
+            attrs: vec![
+                ("origin".into(), "0, 0, 0".into()),
+                ("target".into(), target.into()),
+                ("up".into(), up.into()),
+            ],
+            children: vec![],
+            file: std::rc::Rc::from(std::path::Path::new("t.xml")),
+            line: 1,
+        })
+    }
+
+    /// Parallel means parallel relative to the vectors' lengths: a look direction within float
+    /// rounding of the up is refused (its left would be rounding noise), a tiny up at right
+    /// angles to the view is accepted, in Mitsuba's `lookat` and in the facade's `look_at` alike.
+    #[test]
+    fn an_up_parallel_to_the_view_within_rounding_is_refused_whatever_its_length() {
+        for (target, up) in [("1e-7, 1, 0", "0, 1, 0"), ("0, 3, 0", "1e-6, -2, 0")] {
+            assert!(lookat_of(target, up).is_err(), "target {target}, up {up}");
+        }
+        for (target, up) in [("1, 0, 0", "0, 1e-13, 1e-13"), ("0.01, 1, 0", "0, 1, 0")] {
+            assert!(lookat_of(target, up).is_ok(), "target {target}, up {up}");
+        }
+        use crate::toml_scene::look_at;
+        assert!(look_at([0.0; 3], [1e-7, 1.0, 0.0], [0.0, 1.0, 0.0]).is_none());
+        assert!(look_at([1e4, 0.0, 0.0], [1e4, 1.0, 1e-5], [0.0, 1.0, 0.0]).is_none());
+        assert!(look_at([0.0; 3], [1.0, 0.0, 0.0], [0.0, 1e-13, 0.0]).is_some());
     }
 }

@@ -1,0 +1,64 @@
+//! The boundary's geometry: the closed surface that bounds the medium. The path step asks a shape
+//! four questions: its bounding box, whether a point is inside, where a ray from outside enters and
+//! where a ray from inside leaves.
+//!
+//! An axis-aligned box ([`Aabb`]) is the special case: one slab test answers each question. A
+//! closed triangle mesh ([`crate::mesh::TriangleMesh`]) answers them with a ray cast through its
+//! BVH. Every answer's normal is the surface's outward geometric normal.
+
+use crate::geometry::{Aabb, BoxHit, Ray};
+
+/// A closed surface bounding the medium.
+///
+/// `entry` only reports surface a ray crosses from outside to inside, `exit` only surface it
+/// crosses from inside to outside: a path that has just crossed the surface at a point on it asks
+/// the other question next, so the surface element it stands on is never its next hit (no
+/// self-intersection epsilon).
+pub trait Shape {
+    /// Whether every ray leaves the shape once and never meets it again: a path's light that
+    /// leaves it reaches the environment, and a shadow ray needs one exit.
+    const CONVEX: bool;
+
+    fn bounds(&self) -> Aabb;
+
+    /// Whether `p` is inside (or on) the shape.
+    fn contains(&self, p: crate::Vec3) -> bool;
+
+    /// The first point where `ray`, from outside, enters the shape, if it does.
+    fn entry(&self, ray: &Ray) -> Option<BoxHit>;
+
+    /// Where `ray`, from inside (or on) the shape, leaves it.
+    fn exit(&self, ray: &Ray) -> BoxHit;
+
+    /// `exit(ray).t`, the same bits, for a free flight that needs only the distance.
+    fn exit_distance(&self, ray: &Ray) -> f32;
+}
+
+impl Shape for Aabb {
+    const CONVEX: bool = true;
+
+    #[inline(always)]
+    fn bounds(&self) -> Aabb {
+        *self
+    }
+
+    #[inline(always)]
+    fn contains(&self, p: crate::Vec3) -> bool {
+        Aabb::contains(self, p)
+    }
+
+    #[inline(always)]
+    fn entry(&self, ray: &Ray) -> Option<BoxHit> {
+        Aabb::entry(self, ray)
+    }
+
+    #[inline(always)]
+    fn exit(&self, ray: &Ray) -> BoxHit {
+        Aabb::exit(self, ray)
+    }
+
+    #[inline(always)]
+    fn exit_distance(&self, ray: &Ray) -> f32 {
+        Aabb::exit_distance(self, ray)
+    }
+}

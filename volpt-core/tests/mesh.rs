@@ -1,0 +1,494 @@
+//! Triangle-mesh boundaries: the BVH's ray casts against an independent f64 brute force, the
+//! 12-triangle cube against the box (bit for bit), watertightness at shared edges and vertices,
+//! the closedness checks, and the analytic absorber: an albedo-0 medium inside an index-matched
+//! sphere and torus transmits exactly `exp(-sigma_t * chord)`.
+
+mod common;
+
+use common::{TestRng, Z_MAX};
+use volpt_core::mesh::build::{build, check_closed, BuildError, MeshBuffers};
+use volpt_core::mesh::primitives::{cuboid, sphere, torus, IndexedMesh};
+use volpt_core::microfacet::Ggx;
+use volpt_core::path::{sample_pixel, trace};
+use volpt_core::shape::Shape;
+use volpt_core::{
+    Aabb, ConstantEnvironment, Estimator, HenyeyGreenstein, HomogeneousMedium, NullBoundary,
+    PathCounters, PathSettings, PathState, PerspectiveCamera, Ray, Rng, RoughDielectric,
+    SmoothDielectric, Spectrum, Vec2, Vec3, VolumeScene,
+};
+
+fn built((vertices, triangles): &IndexedMesh) -> MeshBuffers {
+    build(vertices, triangles).expect("a closed mesh builds")
+}
+
+fn unit_box() -> Aabb {
+    Aabb::new(Vec3::new(-1.0, -0.75, -0.5), Vec3::new(1.0, 0.75, 0.5))
+}
+
+/// The torus of the tests: not convex, and a ray through its hole crosses it twice.
+fn test_torus() -> IndexedMesh {
+    torus([0.1, -0.05, 0.0], 0.7, 0.3, 48, 24)
+}
+
+fn test_sphere() -> IndexedMesh {
+    sphere([0.05, 0.0, -0.1], 0.8, 24, 48)
+}
+
+/// `6 * volume` of the mesh: positive when its triangles face outwards.
+fn six_volume((vertices, triangles): &IndexedMesh) -> f64 {
+    triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| Vec3::from(vertices[i as usize]).as_dvec3());
+            a.dot(b.cross(c))
+        })
+        .sum()
+}
+
+#[test]
+fn primitives_are_closed_and_face_outwards() {
+    let b = unit_box();
+    let cases = [
+        (
+            "cube",
+            cuboid(b),
+            f64::from(b.extent().x * b.extent().y * b.extent().z),
+            1e-9,
+        ),
+        (
+            "sphere",
+            test_sphere(),
+            4.0 / 3.0 * std::f64::consts::PI * 0.512,
+            0.02,
+        ),
+        (
+            "torus",
+            test_torus(),
+            2.0 * std::f64::consts::PI.powi(2) * 0.7 * 0.09,
+            0.02,
+        ),
+    ];
+    for (what, mesh, volume, tolerance) in cases {
+        check_closed(&mesh.1).unwrap_or_else(|e| panic!("{what}: {e}"));
+        let v = six_volume(&mesh) / 6.0;
+        assert!(
+            (v / volume - 1.0).abs() < tolerance,
+            "{what}: volume {v}, expected {volume}"
+        );
+    }
+    assert_eq!(cuboid(b).1.len(), 12);
+}
+
+#[test]
+fn broken_meshes_are_refused_naming_the_fault() {
+    let (vertices, triangles) = cuboid(unit_box());
+    let refuse = |vertices: &[[f32; 3]], triangles: &[[u32; 3]]| {
+        build(vertices, triangles).expect_err("refused")
+    };
+
+    let mut open = triangles.clone();
+    let removed = open.remove(5);
+    match refuse(&vertices, &open) {
+        BuildError::OpenEdge { from, to, .. } => {
+            assert!(removed.contains(&from) && removed.contains(&to))
+        }
+        e => panic!("{e}"),
+    }
+
+    let mut flipped = triangles.clone();
+    flipped[3].swap(1, 2);
+    match refuse(&vertices, &flipped) {
+        BuildError::InconsistentOrientation { first, second, .. } => {
+            assert!(first == 3 || second == 3)
+        }
+        e => panic!("{e}"),
+    }
+
+    let mut doubled = triangles.clone();
+    doubled.extend_from_slice(&triangles[..2]);
+    doubled.extend(triangles[..2].iter().map(|&[a, b, c]| [a, c, b]));
+    assert!(matches!(
+        refuse(&vertices, &doubled),
+        BuildError::NonManifoldEdge { triangles: 4, .. }
+    ));
+
+    let mut nan = vertices.clone();
+    nan[6][1] = f32::NAN;
+    assert!(matches!(
+        refuse(&nan, &triangles),
+        BuildError::NonFiniteVertex { vertex: 6, .. }
+    ));
+
+    let mut out_of_range = triangles.clone();
+    out_of_range[7][2] = 8;
+    assert_eq!(
+        refuse(&vertices, &out_of_range),
+        BuildError::IndexOutOfRange {
+            triangle: 7,
+            index: 8,
+            vertices: 8
+        }
+    );
+
+    // A sliver: two coincident vertices make a closed but degenerate mesh.
+    let mut squashed = vertices.clone();
+    squashed[1] = squashed[0];
+    assert!(matches!(
+        refuse(&squashed, &triangles),
+        BuildError::Degenerate { .. }
+    ));
+    assert_eq!(refuse(&vertices, &[]), BuildError::NoTriangles);
+    let message = refuse(&vertices, &open).to_string();
+    assert!(
+        message.contains("not closed") && message.contains("triangle"),
+        "{message}"
+    );
+}
+
+/// A point on a sphere of radius 3 around the box and a direction at it roughly inwards.
+fn ray_from_outside(rng: &mut TestRng) -> Ray {
+    let origin = rng.unit_vector() * 3.0;
+    let target = Vec3::new(
+        rng.range(-1.2, 1.2) as f32,
+        rng.range(-1.0, 1.0) as f32,
+        rng.range(-0.7, 0.7) as f32,
+    );
+    Ray::new(origin, (target - origin).normalize())
+}
+
+#[test]
+fn the_cube_mesh_crosses_where_the_box_does_bit_for_bit() {
+    let b = unit_box();
+    let buffers = built(&cuboid(b));
+    let mesh = buffers.mesh();
+    assert_eq!(mesh.bounds, b);
+    let mut rng = TestRng::new(39);
+    let mut entered = 0;
+    for _ in 0..20_000 {
+        let ray = ray_from_outside(&mut rng);
+        let (want, got) = (Shape::entry(&b, &ray), mesh.entry(&ray));
+        assert_eq!(want, got, "{ray:?}");
+        let Some(hit) = got else { continue };
+        entered += 1;
+        // Onwards from the entry point, in any direction into the box.
+        let mut dir = rng.unit_vector();
+        if dir.dot(hit.normal) > 0.0 {
+            dir = -dir;
+        }
+        for ray in [Ray::new(hit.point, ray.dir), Ray::new(hit.point, dir)] {
+            assert_eq!(Shape::exit(&b, &ray), mesh.exit(&ray), "{ray:?}");
+            assert_eq!(
+                b.exit_distance(&ray).to_bits(),
+                mesh.exit_distance(&ray).to_bits()
+            );
+        }
+        // From a point inside.
+        let inside = Ray::new(b.min + b.extent() * rng.unit_vector().abs(), dir);
+        assert!(mesh.contains(inside.origin) && Shape::contains(&b, inside.origin));
+        assert_eq!(Shape::exit(&b, &inside), mesh.exit(&inside), "{inside:?}");
+    }
+    assert!(entered > 10_000, "{entered}");
+    assert!(!mesh.contains(Vec3::splat(2.0)));
+}
+
+/// Every distance along `ray` at which it crosses a triangle, in f64 by Möller and Trumbore's
+/// test over all triangles (no BVH), with +1 for a crossing into the mesh and -1 out of it.
+fn crossings_f64((vertices, triangles): &IndexedMesh, ray: &Ray) -> Vec<(f64, i32)> {
+    let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
+    let mut hits = Vec::new();
+    for t in triangles {
+        let [a, b, c] = t.map(|i| Vec3::from(vertices[i as usize]).as_dvec3());
+        let (e1, e2) = (b - a, c - a);
+        let p = d.cross(e2);
+        let det = e1.dot(p);
+        if det == 0.0 {
+            continue;
+        }
+        let s = o - a;
+        let u = s.dot(p) / det;
+        let q = s.cross(e1);
+        let v = d.dot(q) / det;
+        let t = e2.dot(q) / det;
+        if u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0 {
+            // det = -d . (e1 x e2): positive when the ray runs against the outward normal.
+            hits.push((t, if det > 0.0 { 1 } else { -1 }));
+        }
+    }
+    hits.sort_by(|a, b| a.0.total_cmp(&b.0));
+    hits
+}
+
+/// The total length of `ray` inside the mesh, in f64: the sum over the spans between a crossing
+/// in and the next crossing out.
+fn chord_f64(mesh: &IndexedMesh, ray: &Ray) -> Option<f64> {
+    let hits = crossings_f64(mesh, ray);
+    let mut total = 0.0;
+    let mut depth = 0;
+    let mut start = 0.0;
+    for (t, sign) in hits {
+        if depth == 0 && sign == 1 {
+            start = t;
+        }
+        depth += sign;
+        if depth < 0 {
+            return None;
+        }
+        if depth == 0 {
+            total += t - start;
+        }
+    }
+    (depth == 0).then_some(total)
+}
+
+/// The length of `ray` inside `shape` as a path walks it: entry, exit, entry again...
+fn chord_walked<S: Shape>(shape: &S, ray: &Ray) -> (f64, u32) {
+    let mut ray = *ray;
+    let (mut total, mut chords) = (0.0, 0);
+    while let Some(entry) = shape.entry(&ray) {
+        let inside = Ray::new(entry.point, ray.dir);
+        let exit = shape.exit(&inside);
+        total += f64::from(exit.point.distance(entry.point));
+        chords += 1;
+        ray = Ray::new(exit.point, ray.dir);
+    }
+    (total, chords)
+}
+
+/// The rays of the chord tests: from outside at the mesh, and through the torus's hole.
+fn chord_rays(rng: &mut TestRng, n: usize) -> Vec<Ray> {
+    let mut rays: Vec<Ray> = (0..n).map(|_| ray_from_outside(rng)).collect();
+    rays.extend((0..n / 4).map(|_| {
+        let origin = Vec3::new(
+            -3.0,
+            rng.range(-0.1, 0.1) as f32,
+            rng.range(-0.2, 0.2) as f32,
+        );
+        let target = Vec3::new(
+            3.0,
+            rng.range(-0.1, 0.1) as f32,
+            rng.range(-0.2, 0.2) as f32,
+        );
+        Ray::new(origin, (target - origin).normalize())
+    }));
+    rays
+}
+
+#[test]
+fn walked_chords_through_sphere_and_torus_are_the_f64_chords() {
+    let mut rng = TestRng::new(7);
+    for (what, mesh) in [("sphere", test_sphere()), ("torus", test_torus())] {
+        let buffers = built(&mesh);
+        let shape = buffers.mesh();
+        let mut two_chords = 0;
+        for ray in chord_rays(&mut rng, 4000) {
+            let want = chord_f64(&mesh, &ray).expect("a closed mesh");
+            let (got, chords) = chord_walked(&shape, &ray);
+            assert!((got - want).abs() < 1e-4, "{what} {ray:?}: {got} vs {want}");
+            two_chords += (chords == 2) as u32;
+        }
+        if what == "torus" {
+            assert!(two_chords > 1000, "{two_chords} rays cross the torus twice");
+        }
+    }
+}
+
+/// Rays from inside through every vertex and every edge's midpoint of the sphere (where two or
+/// more triangles meet): each finds its way out, and from outside back in (no leak).
+#[test]
+fn rays_through_shared_edges_and_vertices_cross() {
+    let mesh = test_sphere();
+    let buffers = built(&mesh);
+    let shape = buffers.mesh();
+    let centre = Vec3::new(0.05, 0.0, -0.1);
+    let mut targets: Vec<Vec3> = mesh.0.iter().map(|&v| Vec3::from(v)).collect();
+    for t in &mesh.1 {
+        for k in 0..3 {
+            let (a, b) = (mesh.0[t[k] as usize], mesh.0[t[(k + 1) % 3] as usize]);
+            targets.push((Vec3::from(a) + Vec3::from(b)) * 0.5);
+        }
+    }
+    for target in targets {
+        let dir = (target - centre).normalize();
+        let out = Ray::new(centre, dir);
+        let t = shape.nearest(&out, volpt_core::mesh::Crossing::Leaving);
+        assert!(t.is_some(), "leaked out through {target:?}");
+        let back = Ray::new(centre + dir * 2.0, -dir);
+        assert!(shape.entry(&back).is_some(), "leaked in through {target:?}");
+    }
+}
+
+type Absorber<S> =
+    VolumeScene<HomogeneousMedium, NullBoundary, HenyeyGreenstein, ConstantEnvironment, S>;
+
+/// An albedo-0 medium behind an index-matched boundary: a path survives only if it crosses every
+/// chord without a collision, so a ray's expected radiance is `exp(-sigma_t * chord)` of the
+/// chord computed in f64 above (the environment's radiance is 1).
+#[test]
+fn an_absorber_in_a_sphere_and_a_torus_transmits_exp_minus_sigma_chord() {
+    const SIGMA_T: f32 = 1.3;
+    const SAMPLES: u32 = 8000;
+    let mut rng = TestRng::new(11);
+    for (what, mesh) in [("sphere", test_sphere()), ("torus", test_torus())] {
+        let buffers = built(&mesh);
+        let scene: Absorber<_> = VolumeScene {
+            camera: camera(),
+            bounds: buffers.mesh(),
+            medium: HomogeneousMedium {
+                sigma_t: SIGMA_T,
+                albedo: Spectrum::ZERO,
+            },
+            boundary: NullBoundary,
+            phase: HenyeyGreenstein { g: 0.0 },
+            environment: ConstantEnvironment(Spectrum::ONE),
+            settings: PathSettings::default(),
+        };
+        let mut worst: f64 = 0.0;
+        // Over all rays: a small bias common to every ray shows here before in any one.
+        let (mut total_error, mut total_variance) = (0.0, 0.0);
+        for (i, ray) in chord_rays(&mut rng, 40).into_iter().enumerate() {
+            let chord = chord_f64(&mesh, &ray).expect("a closed mesh");
+            let expected = (-f64::from(SIGMA_T) * chord).exp();
+            let mut sum = 0.0;
+            for sample in 0..SAMPLES {
+                let mut path = PathState::from_camera(&scene, 0, 0, sample, 0);
+                path.ray = ray;
+                path.rng = Rng::new(5, i as u32, sample);
+                path.inside = false;
+                trace(&scene, &mut path);
+                sum += f64::from(path.radiance.x);
+            }
+            let mean = sum / f64::from(SAMPLES);
+            let sd = (expected * (1.0 - expected) / f64::from(SAMPLES))
+                .sqrt()
+                .max(1e-9);
+            let z = (mean - expected).abs() / sd;
+            worst = worst.max(z);
+            total_error += mean - expected;
+            total_variance += sd * sd;
+            assert!(
+                z < Z_MAX,
+                "{what} {ray:?}: {mean} vs exp(-sigma chord) = {expected}"
+            );
+        }
+        let z = total_error / total_variance.sqrt();
+        eprintln!("{what}: worst |z| of a ray {worst:.2}, z over all rays {z:.2}");
+        assert!(z.abs() < Z_MAX, "{what}: z over all rays {z}");
+    }
+}
+
+fn camera() -> PerspectiveCamera {
+    PerspectiveCamera {
+        origin: Vec3::new(0.3, 0.2, -4.0),
+        axis_x: Vec3::new(-1.0, 0.0, 0.0),
+        axis_y: Vec3::Y,
+        axis_z: Vec3::Z,
+        tan_half_fov: Vec2::new(0.35, 0.3),
+        width: 24,
+        height: 20,
+    }
+}
+
+/// Every pixel's sums of `spp` samples by the CPU's per-pixel loop.
+fn image<S: volpt_core::Scene>(scene: &S, spp: u32) -> (Vec<[f64; 3]>, PathCounters) {
+    let camera = scene.camera();
+    let mut counters = PathCounters::default();
+    let mut pixels = Vec::new();
+    for py in 0..camera.height {
+        for px in 0..camera.width {
+            let mut sum = [0.0; 3];
+            sample_pixel(scene, (px, py), 0..spp, 3, &mut sum, &mut counters);
+            pixels.push(sum);
+        }
+    }
+    (pixels, counters)
+}
+
+fn box_and_mesh<B: volpt_core::Bsdf + Copy>(boundary: B, estimator: Estimator) {
+    let b = unit_box();
+    let buffers = built(&cuboid(b));
+    let settings = PathSettings {
+        estimator,
+        ..PathSettings::default()
+    };
+    let boxed = VolumeScene {
+        camera: camera(),
+        bounds: b,
+        medium: HomogeneousMedium {
+            sigma_t: 2.0,
+            albedo: Spectrum::new(0.95, 0.8, 0.6),
+        },
+        boundary,
+        phase: HenyeyGreenstein { g: 0.3 },
+        environment: ConstantEnvironment(Spectrum::ONE),
+        settings,
+    };
+    let meshed = VolumeScene {
+        bounds: buffers.mesh(),
+        camera: boxed.camera,
+        medium: boxed.medium,
+        boundary,
+        phase: boxed.phase,
+        environment: boxed.environment,
+        settings,
+    };
+    let (want, want_counters) = image(&boxed, 8);
+    let (got, got_counters) = image(&meshed, 8);
+    let differ = want.iter().zip(&got).filter(|(a, b)| a != b).count();
+    assert_eq!(differ, 0, "{differ} of {} pixels differ", want.len());
+    assert_eq!(want_counters, got_counters);
+}
+
+/// The 12-triangle cube traces the box's paths: the same images and counters, bit for bit, behind
+/// every boundary kind and with next-event estimation.
+#[test]
+fn the_cube_mesh_renders_the_box_image_bit_for_bit() {
+    for estimator in [Estimator::PathTracing, Estimator::NextEvent] {
+        box_and_mesh(NullBoundary, estimator);
+        box_and_mesh(SmoothDielectric { eta: 1.5 }, estimator);
+        box_and_mesh(
+            RoughDielectric {
+                eta: 1.33,
+                distribution: Ggx { alpha: 0.3 },
+            },
+            estimator,
+        );
+    }
+}
+
+/// The white furnace inside the torus: albedo 1 behind an index-matched boundary under a constant
+/// environment of radiance 1 returns exactly 1 on average, with path tracing and with next-event
+/// estimation, whose shadow rays must cross every chord of the torus (one through the hole meets
+/// the medium again).
+#[test]
+fn the_furnace_in_a_torus_returns_the_light_with_and_without_next_event_estimation() {
+    const SPP: u32 = 256;
+    let mesh = test_torus();
+    let buffers = built(&mesh);
+    for estimator in [Estimator::PathTracing, Estimator::NextEvent] {
+        let scene: Absorber<_> = VolumeScene {
+            camera: camera(),
+            bounds: buffers.mesh(),
+            medium: HomogeneousMedium {
+                sigma_t: 2.0,
+                albedo: Spectrum::ONE,
+            },
+            boundary: NullBoundary,
+            phase: HenyeyGreenstein { g: 0.3 },
+            environment: ConstantEnvironment(Spectrum::ONE),
+            settings: PathSettings {
+                estimator,
+                ..PathSettings::default()
+            },
+        };
+        let (pixels, counters) = image(&scene, SPP);
+        let n = counters.paths as f64;
+        assert_eq!(counters.truncated, 0);
+        let samples: Vec<f64> = pixels.iter().map(|p| p[1] / f64::from(SPP)).collect();
+        let mean = samples.iter().sum::<f64>() / samples.len() as f64;
+        let var =
+            samples.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (samples.len() - 1) as f64;
+        let z = (mean - 1.0) / (var / samples.len() as f64).sqrt();
+        eprintln!("{estimator:?}: mean {mean} over {n} paths, z {z:.2}");
+        assert!(z.abs() < Z_MAX, "{estimator:?}: mean {mean}, z {z}");
+    }
+}
