@@ -47,6 +47,13 @@ pub enum Target {
     ExrEnvmap,
     /// A bare OpenVDB `.vdb` grid, as `volpt render cloud.vdb` loads it.
     Vdb,
+    /// NRRD: one `.nrrd`, or a `.nhdr` header and its data file `d.raw`.
+    Nrrd,
+    /// A TIFF stack: one multi-page `.tif`, or a folder of TIFFs (one per part), as
+    /// `volpt render stack.tif` or `volpt render FOLDER` loads it.
+    TiffStack,
+    /// A folder of DICOM slices (one per part), as `volpt render FOLDER` loads it.
+    DicomSeries,
     /// A film file (or checkpoint), read and merged as `volpt merge` does.
     FilmFile,
     /// One text message of the viewer's WebSocket protocol, parsed and applied to a scene as the
@@ -55,7 +62,7 @@ pub enum Target {
 }
 
 impl Target {
-    pub const ALL: [Target; 11] = [
+    pub const ALL: [Target; 14] = [
         Self::MitsubaXml,
         Self::Vol,
         Self::MetaImage,
@@ -65,6 +72,9 @@ impl Target {
         Self::TransferFunction,
         Self::ExrEnvmap,
         Self::Vdb,
+        Self::Nrrd,
+        Self::TiffStack,
+        Self::DicomSeries,
         Self::FilmFile,
         Self::ViewerMessage,
     ];
@@ -81,6 +91,9 @@ impl Target {
             Self::TransferFunction => "transfer_function",
             Self::ExrEnvmap => "exr_envmap",
             Self::Vdb => "vdb",
+            Self::Nrrd => "nrrd",
+            Self::TiffStack => "tiff_stack",
+            Self::DicomSeries => "dicom_series",
             Self::FilmFile => "film_file",
             Self::ViewerMessage => "viewer_message",
         }
@@ -120,6 +133,19 @@ impl Target {
                 };
                 let _ = volpt_scene::read_metaimage(&path);
             }
+            Self::Nrrd => {
+                let path = if parts.len() > 1 {
+                    write(dir, "d.raw", part(1));
+                    write(dir, "g.nhdr", part(0))
+                } else {
+                    let _ = std::fs::remove_file(dir.join("d.raw"));
+                    write(dir, "g.nrrd", data)
+                };
+                assemble(&path, Vec::new());
+            }
+            Self::TiffStack if parts.len() == 1 => assemble(&write(dir, "g.tif", data), Vec::new()),
+            Self::TiffStack => assemble(&folder(dir, "stack", "tif", &parts), Vec::new()),
+            Self::DicomSeries => assemble(&folder(dir, "series", "dcm", &parts), Vec::new()),
             Self::VtkLegacy => {
                 let _ = volpt_scene::read_vtk(&write(dir, "g.vtk", data), None);
             }
@@ -238,6 +264,17 @@ fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
     let path = dir.join(name);
     std::fs::write(&path, bytes).expect("write a fuzz input file");
     path
+}
+
+/// A fresh folder `name` of `dir` holding each part as a file `0.EXT`, `1.EXT`, ...
+fn folder(dir: &Path, name: &str, extension: &str, parts: &[&[u8]]) -> PathBuf {
+    let folder = dir.join(name);
+    let _ = std::fs::remove_dir_all(&folder);
+    std::fs::create_dir(&folder).expect("a fuzz input folder");
+    for (i, part) in parts.iter().enumerate() {
+        write(&folder, &format!("{i}.{extension}"), part);
+    }
+    folder
 }
 
 fn assemble(path: &Path, params: Vec<(String, String)>) {
@@ -425,6 +462,54 @@ pub fn seeds(target: Target) -> Vec<Vec<u8>> {
             fixture("volpt-cli/tests/fixtures/toml/tiny.tf"),
             fixture("scenes/bucky/bucky.tf"),
         ],
+        // Files written by pynrrd, tifffile and pydicom (scenes/scanners/make_fixtures.py).
+        Target::Nrrd => {
+            let scanned = |f: &str| fixture(&format!("scenes/scanners/fixtures/{f}"));
+            let mut seeds: Vec<Vec<u8>> = [
+                "raw.nrrd",
+                "gzip.nrrd",
+                "mirrored-x.nrrd",
+                "permuted-xy.nrrd",
+            ]
+            .iter()
+            .map(|f| scanned(f))
+            .collect();
+            let header = scanned("detached.nhdr").replace_ascii("detached.raw.gz", "d.raw");
+            seeds.push(join(&[&header, &scanned("detached.raw.gz")]));
+            seeds
+        }
+        Target::TiffStack => {
+            let scanned = |f: &str| fixture(&format!("scenes/scanners/fixtures/{f}"));
+            let slices: Vec<Vec<u8>> = (8..12)
+                .map(|k| scanned(&format!("tiff-folder/slice_{k}.tif")))
+                .collect();
+            let slices: Vec<&[u8]> = slices.iter().map(Vec::as_slice).collect();
+            vec![
+                scanned("stack-u16.tif"),
+                scanned("stack-u8-deflate.tif"),
+                scanned("stack-f32.tif"),
+                join(&slices),
+            ]
+        }
+        Target::DicomSeries => {
+            let series = |dir: &str, names: &[&str]| {
+                let files: Vec<Vec<u8>> = names
+                    .iter()
+                    .map(|n| fixture(&format!("scenes/scanners/fixtures/{dir}/{n}")))
+                    .collect();
+                let files: Vec<&[u8]> = files.iter().map(Vec::as_slice).collect();
+                join(&files)
+            };
+            vec![
+                series("dicom-axial", &["IM0001", "IM0002", "IM0003", "IM0004"]),
+                series(
+                    "dicom-mirrored",
+                    &["slice0.dcm", "slice1.dcm", "slice2.dcm", "slice3.dcm"],
+                ),
+                series("dicom-coronal", &["c0.dcm", "c1.dcm", "c2.dcm"]),
+                series("dicom-jpeg", &["jpeg.dcm"]),
+            ]
+        }
         Target::ExrEnvmap => vec![
             written("rgb.exr", &|p| {
                 exr::prelude::write_rgb_file(p, 8, 4, |x, y| (x as f32, y as f32, 0.5f32))

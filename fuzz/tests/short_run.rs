@@ -7,7 +7,15 @@ use volpt_fuzz::{seeds, Mutator, Target};
 /// Mutated inputs per target: about a second each on the 2-core CI machine.
 const MUTATIONS: usize = 20_000;
 
+/// A DICOM series input is a folder of several files, each parsed twice: a tenth of the inputs
+/// keeps its short run within the same time as the others'.
+const SERIES_MUTATIONS: usize = MUTATIONS / 10;
+
 fn short_run(target: Target) {
+    let mutations = match target {
+        Target::DicomSeries => SERIES_MUTATIONS,
+        _ => MUTATIONS,
+    };
     let seeds = seeds(target);
     assert!(!seeds.is_empty(), "{} has no seeds", target.name());
     for seed in &seeds {
@@ -15,7 +23,7 @@ fn short_run(target: Target) {
     }
     let mut mutator = Mutator::new(target as u64 + 1);
     let mut input = seeds[0].clone();
-    for i in 0..MUTATIONS {
+    for i in 0..mutations {
         // Mostly mutate a seed afresh; sometimes keep mutating the last input (deeper changes).
         if i % 4 != 3 {
             input = seeds[i % seeds.len()].clone();
@@ -68,6 +76,21 @@ fn exr_envmap() {
 #[test]
 fn vdb() {
     short_run(Target::Vdb);
+}
+
+#[test]
+fn nrrd() {
+    short_run(Target::Nrrd);
+}
+
+#[test]
+fn tiff_stack() {
+    short_run(Target::TiffStack);
+}
+
+#[test]
+fn dicom_series() {
+    short_run(Target::DicomSeries);
 }
 
 #[test]

@@ -107,7 +107,8 @@ enum SceneCommand {
 
 #[derive(Args)]
 struct SceneArgs {
-    /// Scene file: Mitsuba XML, a volpt TOML scene, or a grid file (.mha, .mhd, .vtk, .vti, .vol, .vdb).
+    /// Scene file: Mitsuba XML, a volpt TOML scene, a grid file (.mha, .mhd, .vtk, .vti, .vol, .vdb,
+    /// .nrrd, .nhdr, .tif, .tiff, .dcm), or a folder (a TIFF stack or a DICOM series).
     scene: PathBuf,
     /// Scene parameter, as Mitsuba's `-D name=value` (fills `$name` and overrides `<default>`).
     #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_param)]

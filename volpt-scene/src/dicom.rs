@@ -32,7 +32,6 @@
 //!   against [`crate::raw::MAX_VALUES`] and the memory limit before it is allocated, from the
 //!   headers alone (read without their pixel data).
 
-use std::io::{Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
 use dicom_object::file::ReadPreamble;
@@ -257,24 +256,146 @@ struct Slice {
     intercept: f64,
 }
 
-/// Opens a DICOM file, the reader left at its `DICM` magic; `None` if it has none.
-fn open_dicom(path: &Path) -> Result<Option<(std::fs::File, u64)>, SceneError> {
-    let (mut file, len) = crate::limits::open_regular(path)?;
-    let io = |error| SceneError::Io {
-        path: path.to_path_buf(),
-        error,
-    };
-    let mut head = [0u8; 132];
-    let got = crate::raw::read_full(&mut file, &mut head).map_err(io)?;
-    let start = if got == 132 && &head[128..132] == b"DICM" {
+/// Reads a DICOM file (within the memory limit) from its `DICM` magic on, with every element's
+/// declared length checked against the bytes that follow it; `None` if it has no magic.
+fn open_dicom(path: &Path) -> Result<Option<Vec<u8>>, SceneError> {
+    let mut bytes = crate::limits::read_file(path)?;
+    let start = if bytes.len() >= 132 && &bytes[128..132] == b"DICM" {
         128
-    } else if got >= 4 && &head[..4] == b"DICM" {
+    } else if bytes.starts_with(b"DICM") {
         0
     } else {
         return Ok(None);
     };
-    file.seek(SeekFrom::Start(start)).map_err(io)?;
-    Ok(Some((file, len - start)))
+    bytes.drain(..start);
+    check_lengths(path, &bytes[4..])?;
+    Ok(Some(bytes))
+}
+
+/// Refuses a data set whose element (or item) declares more bytes than follow it: dicom-object
+/// allocates a value's declared length before reading it, so a corrupt or hostile length (up to
+/// 4 GiB) must not reach it. Walks the file meta group (explicit VR little endian) and the data set
+/// in its transfer syntax's encoding, into sequences and items; stops at encapsulated pixel data
+/// (not decoded) and at a deflated data set (whose syntax is refused below before its pixels).
+fn check_lengths(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
+    const EXPLICIT_LE: (bool, bool) = (true, false);
+    let mut at = 0usize;
+    let mut encoding = EXPLICIT_LE; // (explicit VR, big endian)
+    let mut in_meta = true;
+    while at + 8 <= bytes.len() {
+        let u16_at = |i: usize, big: bool| {
+            let b = [bytes[i], bytes[i + 1]];
+            if big {
+                u16::from_be_bytes(b)
+            } else {
+                u16::from_le_bytes(b)
+            }
+        };
+        let u32_at = |i: usize, big: bool| {
+            let b = [bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]];
+            if big {
+                u32::from_be_bytes(b)
+            } else {
+                u32::from_le_bytes(b)
+            }
+        };
+        if in_meta && u16_at(at, false) != 0x0002 {
+            in_meta = false;
+            let syntax = transfer_syntax_of(bytes, at);
+            if syntax.as_deref() == Some("1.2.840.10008.1.2.1.99") {
+                return Ok(());
+            }
+            encoding = match syntax.as_deref() {
+                Some("1.2.840.10008.1.2") => (false, false),
+                Some("1.2.840.10008.1.2.2") => (true, true),
+                _ => EXPLICIT_LE,
+            };
+        }
+        let (explicit, big) = encoding;
+        let (group, element) = (u16_at(at, big), u16_at(at + 2, big));
+        let (header, length) = if group == 0xFFFE || !explicit {
+            (8, u32_at(at + 4, big))
+        } else {
+            let vr = [bytes[at + 4], bytes[at + 5]];
+            let long = matches!(
+                &vr,
+                b"OB"
+                    | b"OD"
+                    | b"OF"
+                    | b"OL"
+                    | b"OV"
+                    | b"OW"
+                    | b"SQ"
+                    | b"SV"
+                    | b"UC"
+                    | b"UN"
+                    | b"UR"
+                    | b"UT"
+                    | b"UV"
+            );
+            if long {
+                if at + 12 > bytes.len() {
+                    break;
+                }
+                (12, u32_at(at + 8, big))
+            } else {
+                (8, u32::from(u16_at(at + 6, big)))
+            }
+        };
+        at += header;
+        let undefined = length == u32::MAX;
+        if (group, element) == (0x7FE0, 0x0010) && undefined {
+            return Ok(()); // encapsulated pixel data: fragments, not elements
+        }
+        // Items and sequences (and undefined lengths) are entered: their contents are elements.
+        let entered = group == 0xFFFE || undefined || is_sequence(bytes, at, header, explicit);
+        if entered {
+            continue;
+        }
+        let length = length as usize;
+        if length > bytes.len() - at {
+            return Err(grid_error(
+                path,
+                GridProblem::SizeMismatch {
+                    what: format!("element ({group:04X},{element:04X})'s value"),
+                    expected_bytes: length as u64,
+                    actual_bytes: (bytes.len() - at) as u64,
+                },
+            ));
+        }
+        at += length;
+    }
+    Ok(())
+}
+
+/// Whether the explicit-VR element whose value starts at `at` is a sequence (`SQ`).
+fn is_sequence(bytes: &[u8], at: usize, header: usize, explicit: bool) -> bool {
+    explicit && header == 12 && &bytes[at - 8..at - 6] == b"SQ"
+}
+
+/// The file meta group's transfer syntax UID (0002,0010), from the meta bytes before `end`.
+fn transfer_syntax_of(bytes: &[u8], end: usize) -> Option<String> {
+    let mut at = 0;
+    while at + 8 <= end {
+        let tag = [bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]];
+        let vr = [bytes[at + 4], bytes[at + 5]];
+        let (header, length) = if matches!(&vr, b"OB" | b"OW" | b"UN" | b"SQ" | b"UT") {
+            let b = bytes.get(at + 8..at + 12)?;
+            (12, u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
+        } else {
+            (
+                8,
+                usize::from(u16::from_le_bytes([bytes[at + 6], bytes[at + 7]])),
+            )
+        };
+        let value = bytes.get(at + header..(at + header).checked_add(length)?)?;
+        if tag == [0x02, 0x00, 0x10, 0x00] {
+            let text = String::from_utf8_lossy(value);
+            return Some(text.trim_end_matches(['\0', ' ']).to_string());
+        }
+        at += header + length;
+    }
+    None
 }
 
 fn decode_error(path: &Path, what: &str, e: impl std::fmt::Display) -> SceneError {
@@ -288,13 +409,13 @@ fn decode_error(path: &Path, what: &str, e: impl std::fmt::Display) -> SceneErro
 }
 
 fn read_slice_header(path: &Path) -> Result<Option<Slice>, SceneError> {
-    let Some((file, len)) = open_dicom(path)? else {
+    let Some(bytes) = open_dicom(path)? else {
         return Ok(None);
     };
     let obj = OpenFileOptions::new()
         .read_preamble(ReadPreamble::Never)
         .read_until(PIXEL_DATA)
-        .from_reader(std::io::BufReader::new(file.take(len)))
+        .from_reader(bytes.as_slice())
         .map_err(|e| decode_error(path, "the DICOM header", e))?;
     check_syntax(path, &obj)?;
     let f = Fields { path, obj: &obj };
@@ -496,17 +617,16 @@ impl Slice {
         out: &mut Vec<f32>,
     ) -> Result<(), SceneError> {
         let path = &self.path;
-        let Some((file, len)) = open_dicom(path)? else {
+        let Some(bytes) = open_dicom(path)? else {
             return Err(decode_error(
                 path,
                 "the DICOM file",
                 "its DICM magic is gone",
             ));
         };
-        crate::limits::check_memory(path, "the DICOM file", Some(len))?;
         let obj = OpenFileOptions::new()
             .read_preamble(ReadPreamble::Never)
-            .from_reader(std::io::BufReader::new(file.take(len)))
+            .from_reader(bytes.as_slice())
             .map_err(|e| decode_error(path, "the DICOM file", e))?;
         let element = obj
             .element_opt(PIXEL_DATA)

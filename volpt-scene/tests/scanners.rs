@@ -205,3 +205,17 @@ fn a_tiff_stack_whose_pages_differ_in_size_is_refused() {
     let (path, problem) = problem(volpt_scene::read_tiff_stack(dir.path()));
     assert!(path.ends_with("c.tif"), "{path:?}: {problem}");
 }
+
+/// dicom-object allocates a value's declared length before reading it: a length beyond the file
+/// (here PixelData claiming almost 4 GiB) is refused before the file reaches it.
+#[test]
+fn a_dicom_element_longer_than_its_file_is_refused_before_parsing() {
+    let mut bytes = std::fs::read(fixture("dicom-axial/IM0001")).unwrap();
+    let tag = b"\xe0\x7f\x10\x00OW\x00\x00";
+    let at = bytes.windows(tag.len()).position(|w| w == tag).unwrap() + tag.len();
+    bytes[at..at + 4].copy_from_slice(&0xFFFF_FFF0u32.to_le_bytes());
+    let dir = tempfile::TempDir::new().unwrap();
+    std::fs::write(dir.path().join("IM0001"), bytes).unwrap();
+    let (_, problem) = problem(volpt_scene::read_dicom_series(dir.path()));
+    assert!(problem.to_string().contains("(7FE0,0010)"), "{problem}");
+}
