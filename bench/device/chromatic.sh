@@ -57,7 +57,7 @@ EOF
 mkdir -p "$OUT/scenes"
 CHROMATIC='<rgb name="sigma_t" value="0.2, 0.5, 1"/><float name="scale" value="5"/><rgb name="albedo" value="0.95, 0.9, 0.85"/>'
 BSDFS=("null:<bsdf type=\"null\"/>" "smooth:<bsdf type=\"dielectric\"><float name=\"int_ior\" value=\"1.33\"/></bsdf>"
-    "rough:<bsdf type=\"roughdielectric\"><float name=\"alpha\" value=\"0.3\"/><float name=\"int_ior\" value=\"1.5\"/></bsdf>")
+    "rough:<bsdf type=\"roughdielectric\"><string name=\"distribution\" value=\"ggx\"/><float name=\"alpha\" value=\"0.3\"/><float name=\"int_ior\" value=\"1.5\"/></bsdf>")
 STRATEGIES=(${STRATEGIES:-naive-sk regeneration-sk regeneration-warp-sk regeneration-block-sk regeneration-2p-sk streaming-sk streaming-sorted-sk sorting-sk naive-mk streaming-mk})
 for entry in "${BSDFS[@]}"; do
     name=${entry%%:*}; bsdf=${entry#*:}
