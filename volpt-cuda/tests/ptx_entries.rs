@@ -132,36 +132,6 @@ fn a_damaged_pack_says_so() {
     }
 }
 
-/// Local memory this test lets through today, pinned at the sizes measured when it came (both
-/// builds, 2026-11-28), so that any growth still fails; each is a regression to remove, not a
-/// design:
-/// - the chromatic index-matched kernels keep the scene in local memory (up to 672 bytes more,
-///   576-776 in all): the spectral next-event shadow ray calls its tracking closure at two sites
-///   (`spectral_shadow_transmittance`), which takes the scene by address;
-/// - the strategies that park paths (streaming, sorting, multi-kernel, regeneration-2p) hold
-///   16-32 more bytes since the path state gained its spectral fields (`hero`, `r_u`); the
-///   strategies that keep a path in registers (naive, regeneration, -warp, -block) hold none.
-fn known_debt(entry: &str) -> usize {
-    const CHROMATIC_NEXT_EVENT_BYTES: usize = 672;
-    const PARKED_SPECTRAL_STATE_BYTES: usize = 32;
-    let parks_paths = [
-        "streaming_sk__",
-        "streaming_sorted_sk__",
-        "sorting_sk__",
-        "multi_kernel__",
-        "regeneration_2p_sk__",
-    ]
-    .iter()
-    .any(|s| entry.starts_with(s));
-    if entry.contains("__chromatic__index_matched__") {
-        CHROMATIC_NEXT_EVENT_BYTES
-    } else if parks_paths {
-        PARKED_SPECTRAL_STATE_BYTES
-    } else {
-        0
-    }
-}
-
 /// No kernel keeps per-thread state in local memory beyond the 64 bytes of the path counters'
 /// final warp reduction (an array walked once, at the kernel's end). A larger local depot means
 /// LLVM left a scene part behind a pointer: a call it did not inline takes the scene by address,
@@ -193,8 +163,7 @@ fn no_kernel_keeps_the_scene_in_local_memory() {
             } else {
                 COUNTER_FLUSH_BYTES
             };
-            let allowed = base + known_debt(&entry);
-            if depot > allowed {
+            if depot > base {
                 heavy.push(format!("{entry}: {depot} bytes"));
             }
         }
