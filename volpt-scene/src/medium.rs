@@ -24,7 +24,7 @@ use volpt_core::{
 use crate::description::{Bounds, GridConvention, GridDesc, SampleLayout, SceneDescription};
 use crate::error::SceneError;
 use crate::from_description::FromDescription;
-use crate::material::{IndexedDesc, InfoTable};
+use crate::material::{IndexedDesc, InfoTable, MaterialDesc};
 use crate::mitsuba::export::rgb_element;
 use crate::mitsuba::plugin::{quoted, Arg, Ctx, Plugin};
 use crate::mitsuba::preprocess::Dialect;
@@ -287,7 +287,8 @@ fn default_for(p: &Plugin<'_>, value: f32, what: &str) -> Result<f32, SceneError
     match p.ctx.dialect {
         Dialect::Mitsuba3 => Ok(value),
         Dialect::Mitsuba06 => Err(p.missing(format!(
-            "{what} (Mitsuba 0.6 would fall back to a material preset, which volpt does not have)"
+            "{what} (Mitsuba 0.6 would fall back to a material preset, which volpt reads for \
+             homogeneous media only)"
         ))),
     }
 }
@@ -614,9 +615,39 @@ impl MediumDesc {
         ),
     ];
 
-    /// The value of parameter `key`, if it is one of [`MediumDesc::PARAMS`] (the phase's are
-    /// [`PhaseDesc::param`]'s); `Some(Err(why))` where this medium has no such value.
+    /// The keys of a material-indexed volume's coefficients, `materials.<k>.sigma_s` and
+    /// `.sigma_a` (RGB per world unit, before `medium.scale`) and `.g` (a number in (-1, 1)) for
+    /// every material `k` of its table (none for another medium): [`MediumDesc::param`] and
+    /// [`MediumDesc::set_param`] take them beside [`MediumDesc::PARAMS`].
+    pub fn material_params(&self) -> Vec<String> {
+        let DensityDesc::Indexed(indexed) = &self.density else {
+            return Vec::new();
+        };
+        (0..indexed.materials().len())
+            .flat_map(|k| MATERIAL_FIELDS.map(|field| format!("materials.{k}.{field}")))
+            .collect()
+    }
+
+    /// The value of parameter `key`, if it is one of [`MediumDesc::PARAMS`] or
+    /// [`MediumDesc::material_params`] (the phase's are [`PhaseDesc::param`]'s); `Some(Err(why))`
+    /// where this medium has no such value.
     pub fn param(&self, key: &str) -> Option<Result<MediumParam, ParamRefused>> {
+        if let Some((k, field)) = material_key(key) {
+            let DensityDesc::Indexed(indexed) = &self.density else {
+                return Some(Err(NOT_INDEXED));
+            };
+            let Some(m) = indexed.materials().get(k) else {
+                return Some(Err(ParamRefused::NotHere {
+                    needs: "a material of the table",
+                    found: "an index past its end",
+                }));
+            };
+            return Some(Ok(match field {
+                "sigma_s" => MediumParam::Rgb(m.sigma_s),
+                "sigma_a" => MediumParam::Rgb(m.sigma_a),
+                _ => MediumParam::Float(m.g),
+            }));
+        }
         Some(match key {
             "medium.scale" => Ok(MediumParam::Float(self.scale)),
             "medium.albedo" => match &self.albedo {
@@ -630,6 +661,9 @@ impl MediumDesc {
     /// Sets parameter `key` to `value`, if it is one of [`MediumDesc::PARAMS`] (`None`: the
     /// medium is left alone). `Some(Err(why))` refuses the value, leaving the medium as it was.
     pub fn set_param(&mut self, key: &str, value: MediumParam) -> Option<Result<(), ParamRefused>> {
+        if let Some((k, field)) = material_key(key) {
+            return Some(self.set_material_param(k, field, value));
+        }
         Some(match key {
             "medium.scale" => match value {
                 MediumParam::Float(v) if v.is_finite() && v >= 0.0 => {
@@ -663,8 +697,10 @@ impl MediumDesc {
     /// nearest-sample lookups select the any-layout grid media (with a constant albedo and with an
     /// albedo grid); a grid decoded with the other lookup renders a different image, so both
     /// lookups cross the device ABI. The sixth reads textures of half-precision texels: decoded as
-    /// f32 texels, its samples would differ. The last reads one texel per lookup (stochastic):
-    /// decoded as trilinear, it would read eight.
+    /// f32 texels, its samples would differ. The eighth reads one texel per lookup (stochastic):
+    /// decoded as trilinear, it would read eight. The last is material-indexed: three materials
+    /// over a 3 x 2 x 2 index grid a little off the unit cube, every voxel's index differing from
+    /// its neighbours', so that a swapped axis or table row shows.
     pub fn examples() -> Vec<Self> {
         let bounds = Bounds {
             min: [-0.6, -0.45, -0.5],
@@ -736,7 +772,94 @@ impl MediumDesc {
                 lookup,
                 storage: GridStorage::Dense,
             })
+            .chain(std::iter::once(Self::indexed_example(bounds)))
             .collect()
+    }
+
+    /// [`MediumDesc::examples`]'s material-indexed medium over `bounds`.
+    fn indexed_example(bounds: Bounds) -> Self {
+        let materials = [
+            ("cyan", [0.6, 1.2, 1.5], [2.5, 0.6, 0.1], 0.4),
+            ("magenta", [1.1, 0.5, 1.0], [0.2, 2.0, 0.3], -0.3),
+            ("white", [2.0, 2.0, 2.0], [0.05, 0.05, 0.05], 0.0),
+        ]
+        .map(|(name, sigma_s, sigma_a, g)| MaterialDesc {
+            name: name.into(),
+            sigma_s,
+            sigma_a,
+            g,
+            colour: None,
+        });
+        let indices = [0, 1, 2, 1, 2, 0, 2, 0, 1, 0, 2, 1];
+        let indexed = IndexedDesc::new(
+            std::path::Path::new("example"),
+            materials.to_vec(),
+            [3, 2, 2],
+            bounds,
+            &indices,
+        )
+        .expect("a valid example");
+        MediumDesc {
+            density: DensityDesc::Indexed(indexed),
+            scale: 3.0,
+            albedo: AlbedoDesc::Constant([0.0; 3]),
+            phase: PhaseDesc::HenyeyGreenstein { g: 0.0 },
+            lookup: GridLookup::Trilinear,
+            storage: GridStorage::Dense,
+        }
+    }
+}
+
+/// The fields of a material's parameters ([`MediumDesc::material_params`]).
+const MATERIAL_FIELDS: [&str; 3] = ["sigma_s", "sigma_a", "g"];
+
+/// `(k, field)` of a key `materials.<k>.<field>`.
+fn material_key(key: &str) -> Option<(usize, &str)> {
+    let rest = key.strip_prefix("materials.")?;
+    let (k, field) = rest.split_once('.')?;
+    let field = MATERIAL_FIELDS.into_iter().find(|&f| f == field)?;
+    Some((k.parse().ok()?, field))
+}
+
+/// A material parameter of a medium that is not material-indexed.
+const NOT_INDEXED: ParamRefused = ParamRefused::NotHere {
+    needs: "a material-indexed volume",
+    found: "another medium",
+};
+
+impl MediumDesc {
+    /// Sets `field` of material `k`; its phase variant follows the materials' asymmetries.
+    fn set_material_param(
+        &mut self,
+        k: usize,
+        field: &str,
+        value: MediumParam,
+    ) -> Result<(), ParamRefused> {
+        let DensityDesc::Indexed(indexed) = &mut self.density else {
+            return Err(NOT_INDEXED);
+        };
+        let Some(mut m) = indexed.materials().get(k).cloned() else {
+            return Err(ParamRefused::NotHere {
+                needs: "a material of the table",
+                found: "an index past its end",
+            });
+        };
+        match (field, value) {
+            ("sigma_s", MediumParam::Rgb(v)) => m.sigma_s = v,
+            ("sigma_a", MediumParam::Rgb(v)) => m.sigma_a = v,
+            ("g", MediumParam::Float(g)) => m.g = g,
+            ("g", _) => return Err(ParamRefused::Value("a number in (-1, 1)")),
+            _ => return Err(ParamRefused::Value("three finite numbers >= 0")),
+        }
+        indexed
+            .set_material(k, m)
+            .map_err(|(_, expected, _)| ParamRefused::Value(expected))?;
+        self.phase = if indexed.anisotropic() {
+            PhaseDesc::HenyeyGreenstein { g: 0.0 }
+        } else {
+            PhaseDesc::Isotropic
+        };
+        Ok(())
     }
 }
 

@@ -12,7 +12,7 @@ use volpt_scene::{builder_for, AlbedoDesc, Config, DensityDesc, SceneAssembler, 
 /// The memory limit is global: the test that lowers it runs alone.
 static LIMIT: Mutex<()> = Mutex::new(());
 
-const MATERIALS: &str = r#"
+const MATERIALS: &str = r##"
 [[materials]]
 name = "cyan"
 sigma_s = [4.0, 6.0, 7.0]
@@ -24,7 +24,7 @@ name = "white"
 sigma_t = 12.0
 albedo = [0.99, 0.98, 0.97]
 colour = "#ffffff"
-"#;
+"##;
 
 fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
     let path = dir.join(name);
@@ -56,7 +56,10 @@ fn a_raw_index_grid_and_its_table_load_as_an_indexed_medium() {
     let (_dir, path) = raw_scene(&PRINT, "scale = 2.0", MATERIALS);
     let desc = load(&path).unwrap();
     let DensityDesc::Indexed(indexed) = &desc.medium.density else {
-        panic!("an indexed medium expected, found {:?}", desc.medium.density)
+        panic!(
+            "an indexed medium expected, found {:?}",
+            desc.medium.density
+        )
     };
     assert_eq!(indexed.resolution, [3, 2, 2]);
     assert_eq!((0..12).map(|i| indexed.index(i)).collect::<Vec<_>>(), PRINT);
@@ -100,7 +103,10 @@ fn an_index_outside_the_table_is_refused_with_its_voxel() {
         "{err:?}"
     );
     let message = err.to_string();
-    assert!(message.contains("print.raw") && message.contains("below 2"), "{message}");
+    assert!(
+        message.contains("print.raw") && message.contains("below 2"),
+        "{message}"
+    );
 }
 
 #[test]
@@ -121,7 +127,10 @@ fn a_value_that_is_no_index_is_refused() {
         matches!(
             &err,
             SceneError::Material {
-                problem: MaterialProblem::NotAnIndex { voxel: [0, 1, 0], .. },
+                problem: MaterialProblem::NotAnIndex {
+                    voxel: [0, 1, 0],
+                    ..
+                },
                 ..
             }
         ),
@@ -151,11 +160,26 @@ fn a_table_of_more_than_256_materials_is_refused() {
 #[test]
 fn bad_coefficients_name_their_material_and_field() {
     for (materials, field) in [
-        ("[[materials]]\nname = \"a\"\nsigma_s = -1.0\nsigma_a = 0.5\n", "materials[0].sigma_s"),
-        ("[[materials]]\nname = \"a\"\nsigma_s = 1.0\nsigma_a = nan\n", "materials[0].sigma_a"),
-        ("[[materials]]\nname = \"a\"\nsigma_s = 1.0\nsigma_a = 1.0\ng = 1.0\n", "materials[0].g"),
-        ("[[materials]]\nname = \"a\"\nsigma_t = 1.0\nalbedo = 1.5\n", "materials[0].albedo"),
-        ("[[materials]]\nname = \"a\"\nsigma_s = 1.0\n", "materials[0]"),
+        (
+            "[[materials]]\nname = \"a\"\nsigma_s = -1.0\nsigma_a = 0.5\n",
+            "materials[0].sigma_s",
+        ),
+        (
+            "[[materials]]\nname = \"a\"\nsigma_s = 1.0\nsigma_a = nan\n",
+            "materials[0].sigma_a",
+        ),
+        (
+            "[[materials]]\nname = \"a\"\nsigma_s = 1.0\nsigma_a = 1.0\ng = 1.0\n",
+            "materials[0].g",
+        ),
+        (
+            "[[materials]]\nname = \"a\"\nsigma_t = 1.0\nalbedo = 1.5\n",
+            "materials[0].albedo",
+        ),
+        (
+            "[[materials]]\nname = \"a\"\nsigma_s = 1.0\n",
+            "materials[0]",
+        ),
     ] {
         let (_dir, path) = raw_scene(&[0; 12], "", materials);
         let err = load(&path).unwrap_err();
@@ -184,10 +208,8 @@ fn png(path: &Path, w: u32, h: u32, colour: impl Fn(u32, u32) -> [u8; 3]) {
     encoder.set_depth(png::BitDepth::Eight);
     let mut writer = encoder.write_header().unwrap();
     let data: Vec<u8> = (0..h)
-        .flat_map(|y| (0..w).flat_map(move |x| (x, y)).collect::<Vec<_>>())
-        .collect::<Vec<_>>()
-        .chunks(2)
-        .flat_map(|p| colour(p[0], p[1]))
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .flat_map(|(x, y)| colour(x, y))
         .collect();
     writer.write_image_data(&data).unwrap();
 }
@@ -201,12 +223,15 @@ fn slices_scene(volume: &str) -> (tempfile::TempDir, PathBuf) {
     let slices = dir.path().join("layers");
     std::fs::create_dir(&slices).unwrap();
     for z in 0..2u32 {
-        png(&slices.join(format!("layer{z}.png")), 3, 2, |x, y| {
-            match PRINT[(z * 6 + y * 3 + x) as usize] {
+        png(
+            &slices.join(format!("layer{z}.png")),
+            3,
+            2,
+            |x, y| match PRINT[(z * 6 + y * 3 + x) as usize] {
                 0 => CYAN,
                 _ => WHITE,
-            }
-        });
+            },
+        );
     }
     let text = format!("[volume]\nfile = \"layers\"\n{volume}\n{MATERIALS}");
     let path = write(dir.path(), "scene.toml", text.as_bytes());
@@ -298,8 +323,8 @@ fn a_slice_stack_over_the_memory_limit_is_refused_before_decoding() {
     let before = volpt_scene::limits::memory_limit();
     // The scene file (under 1 KB) fits; the 12 indices do not.
     volpt_scene::limits::set_memory_limit(11);
-    let result = SceneAssembler::new(Config::default())
-        .assemble(builder_for(&path).unwrap().as_ref());
+    let result =
+        SceneAssembler::new(Config::default()).assemble(builder_for(&path).unwrap().as_ref());
     volpt_scene::limits::set_memory_limit(before);
     let err = result.unwrap_err();
     assert!(matches!(err, SceneError::OverMemoryLimit { .. }), "{err:?}");
@@ -328,14 +353,16 @@ fn mitsuba(medium: &str) -> (tempfile::TempDir, PathBuf) {
 
 #[test]
 fn mitsuba_presets_give_the_tables_coefficients_times_100_and_the_scale() {
-    let (_dir, path) = mitsuba(
-        r#"<string name="material" value="ketchup"/><float name="scale" value="0.01"/>"#,
-    );
+    let (_dir, path) =
+        mitsuba(r#"<string name="material" value="ketchup"/><float name="scale" value="0.01"/>"#);
     let desc = load(&path).unwrap();
     // Ketchup: sigmaS (0.18, 0.07, 0.03), sigmaA (0.061, 0.97, 1.45) per mm, x 100.
     let t = [0.18f32 * 100.0 + 0.061 * 100.0, 7.0 + 97.0, 3.0 + 145.0];
     let DensityDesc::Rgb(rgb) = desc.medium.density else {
-        panic!("a chromatic extinction expected, found {:?}", desc.medium.density)
+        panic!(
+            "a chromatic extinction expected, found {:?}",
+            desc.medium.density
+        )
     };
     for c in 0..3 {
         assert!((rgb[c] - t[c]).abs() <= 1e-4 * t[c], "{rgb:?} vs {t:?}");
@@ -355,10 +382,12 @@ fn mitsuba_presets_give_the_tables_coefficients_times_100_and_the_scale() {
 fn an_unknown_preset_or_a_preset_with_coefficients_is_refused() {
     let (_dir, path) = mitsuba(r#"<string name="material" value="jam"/>"#);
     let message = load(&path).unwrap_err().to_string();
-    assert!(message.contains("Skin1") && message.contains("jam"), "{message}");
-    let (_dir, path) = mitsuba(
-        r#"<string name="material" value="skin1"/><rgb name="sigmaA" value="1, 1, 1"/>"#,
+    assert!(
+        message.contains("Skin1") && message.contains("jam"),
+        "{message}"
     );
+    let (_dir, path) =
+        mitsuba(r#"<string name="material" value="skin1"/><rgb name="sigmaA" value="1, 1, 1"/>"#);
     let message = load(&path).unwrap_err().to_string();
     assert!(message.contains("preset"), "{message}");
 }
