@@ -723,10 +723,9 @@ impl WithChoices for PathSettings {
 
 fn unknown(key: &str) -> Error {
     let keys: Vec<_> = PARAMS.iter().map(|(k, _)| *k).collect();
-    Error::Param {
+    Error::UnknownParam {
         key: key.to_owned(),
         expected: format!("one of {}", keys.join(", ")),
-        found: "no such parameter".into(),
     }
 }
 
