@@ -159,7 +159,7 @@ fn percentile_95_is_the_nearest_rank() {
 }
 
 #[test]
-fn backtracking_never_builds_on_a_worse_iteration() {
+fn every_update_starts_from_the_best_iteration_and_halves_the_step_after_a_miss() {
     let setup = setup();
     let target = bars();
     let options = Options {
@@ -168,23 +168,38 @@ fn backtracking_never_builds_on_a_worse_iteration() {
         ..Options::default()
     };
     let result = compensate(&target, SIZE, &setup, &options, &mut model(), |_| {}).unwrap();
-    let means: Vec<f64> = result.iterations.iter().map(|i| i.mean).collect();
-    eprintln!("means with backtracking: {means:?}");
-    // The best so far never rises, and ends below the loop without backtracking's.
-    let without = compensate(
-        &target,
-        SIZE,
-        &setup,
-        &Options {
-            backtracks: 0,
-            ..options
-        },
-        &mut model(),
-        |_| {},
-    )
-    .unwrap();
-    assert!(
-        means[result.best] <= without.iterations[without.best].mean,
-        "{means:?}"
+    let its = &result.iterations;
+    let (mut best, mut step, mut misses) = (0usize, options.step, 0);
+    for j in 1..its.len() {
+        let k = j - 1;
+        if k > 0 {
+            let best_mean = its[best].mean;
+            if its[k].mean < best_mean {
+                best = k;
+            }
+            if its[k].mean >= best_mean * (1.0 - options.min_improvement) {
+                step *= 0.5;
+                misses += 1;
+            }
+        }
+        let expected: Vec<LinearRgb> = its[best]
+            .aims
+            .iter()
+            .zip(target.iter().zip(&its[best].prediction))
+            .map(|(a, (t, p))| {
+                LinearRgb([0, 1, 2].map(|c| (a.0[c] + step * (t.0[c] - p.0[c])).clamp(0.0, 1.0)))
+            })
+            .collect();
+        assert!(
+            its[j].aims == expected,
+            "iteration {j}: not the update of iteration {best} at step {step}"
+        );
+    }
+    assert!(misses >= 1, "the case should backtrack");
+    assert_eq!(
+        result.best,
+        (0..its.len())
+            .min_by(|&a, &b| its[a].mean.total_cmp(&its[b].mean))
+            .unwrap()
     );
 }

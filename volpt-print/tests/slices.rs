@@ -106,6 +106,12 @@ fn a_slice_of_another_size_is_refused_before_any_pixel_is_decoded() {
         "{e:?}"
     );
     assert!(message(e).contains("expected a slice of 5 x 4 pixels"));
+    write_png(&slice, [5, 3], &[7u8; 5 * 3 * 3]);
+    let e = read_slices(dir.path()).unwrap_err();
+    assert!(
+        matches!(&e, PrintError::SliceSize { found: [5, 3], .. }),
+        "{e:?}"
+    );
 }
 
 #[test]
