@@ -16,7 +16,7 @@ use std::time::Duration;
 
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use pyo3::types::{PyByteArray, PyDict, PyList, PyRange, PyTuple, PyType};
+use pyo3::types::{IntoPyDict, PyByteArray, PyDict, PyList, PyRange, PyTuple, PyType};
 use volpt::film::checkpoint::Checkpoint;
 use volpt::{
     Backend, BackendKind, BackendOptions, Effects, Error, Estimator, GpuOptions, GridLookup, Image,
@@ -45,6 +45,7 @@ fn to_py(error: Error) -> PyErr {
         Error::Settings(_) => "SettingsError",
         Error::Param { found, .. } if found == "no such parameter" => "UnknownParamError",
         Error::Param { .. } => "ParamError",
+        Error::Grid { .. } => "GridError",
         Error::Cpu(_) | Error::Cuda(_) => "RenderError",
         Error::Checkpoint(_) | Error::FilmFile(_) => "CheckpointError",
         Error::Films(_) => "MergeError",
@@ -388,6 +389,61 @@ impl Scene {
         self.inner.source().to_owned()
     }
 
+    /// The names of the medium's grids (`"density"`, `"albedo"`), which `grid` and `set_grid`
+    /// take.
+    #[getter]
+    fn grids(&self) -> Vec<&'static str> {
+        self.inner.grid_names()
+    }
+
+    /// Grid `name`'s values: a float32 array of shape (z, y, x), or (z, y, x, channels) for an
+    /// RGB grid.
+    fn grid<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+        let grid = self.inner.grid(name).map_err(to_py)?;
+        let bytes: Vec<u8> = grid.data.iter().flat_map(|v| v.to_ne_bytes()).collect();
+        let buffer = PyByteArray::new(py, &bytes);
+        py.import("numpy")?
+            .call_method1("frombuffer", (buffer, "float32"))?
+            .call_method1("reshape", (grid_shape(grid),))
+    }
+
+    /// Replaces grid `name`'s values with `values` (an array of its shape, or flat in its order),
+    /// as `volpt::Scene::set_grid`: the next render renders the scene as loaded with them.
+    fn set_grid(&mut self, py: Python<'_>, name: &str, values: Bound<'_, PyAny>) -> PyResult<()> {
+        let grid = self.inner.grid(name).map_err(to_py)?;
+        let shape = grid_shape(grid);
+        let wrong = |expected: String, found: String| {
+            to_py(Error::Grid {
+                grid: name.to_owned(),
+                expected,
+                found,
+            })
+        };
+        let numpy = py.import("numpy")?;
+        let array = numpy
+            .call_method(
+                "ascontiguousarray",
+                (&values,),
+                Some(&[("dtype", "float32")].into_py_dict(py)?),
+            )
+            .map_err(|_| wrong("an array of numbers".into(), describe(&values)))?;
+        let found: Vec<usize> = array.getattr("shape")?.extract()?;
+        if found.len() > 1 && found != shape {
+            return Err(wrong(
+                format!("an array of shape {shape:?} (z, y, x[, channels]) or flat"),
+                format!("an array of shape {found:?}"),
+            ));
+        }
+        let bytes: Vec<u8> = array.call_method0("tobytes")?.extract()?;
+        let values: Vec<f32> = bytes
+            .chunks_exact(4)
+            .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
+        let scene = &mut self.inner;
+        py.allow_threads(|| scene.set_grid(name, values))
+            .map_err(to_py)
+    }
+
     fn __repr__(&self) -> String {
         let (w, h) = self.inner.resolution();
         format!(
@@ -503,6 +559,16 @@ impl Scene {
             notes: observer.notes.into_inner().expect("not poisoned"),
         })
     }
+}
+
+/// A grid's numpy shape: (z, y, x), with its channels last where it has several.
+fn grid_shape(grid: &volpt::scene_files::GridDesc) -> Vec<usize> {
+    let [x, y, z] = grid.resolution.map(|n| n as usize);
+    let mut shape = vec![z, y, x];
+    if grid.channels > 1 {
+        shape.push(grid.channels as usize);
+    }
+    shape
 }
 
 /// `samples=`: a `range` of step 1, or `(start, stop)`.

@@ -18,6 +18,14 @@ pub enum Error {
         expected: String,
         found: String,
     },
+    /// Grid values ([`crate::Scene::set_grid`]) for a grid the scene lacks, of the wrong size,
+    /// or out of range.
+    #[error("grid {grid}: expected {expected}, found {found}")]
+    Grid {
+        grid: String,
+        expected: String,
+        found: String,
+    },
     /// The CPU backend failed.
     #[error(transparent)]
     Cpu(#[from] volpt_cpu::RenderError),
