@@ -18,6 +18,7 @@ pub mod halftone;
 pub mod material;
 pub mod predict;
 pub mod print;
+pub mod record;
 pub mod slices;
 
 pub use error::PrintError;

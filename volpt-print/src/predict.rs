@@ -32,9 +32,9 @@
 
 use thiserror::Error;
 use volpt::scene_files::{
-    AlbedoDesc, BoundaryDesc, Bounds, BsdfDesc, CameraDesc, DensityDesc, EnvironmentDesc,
-    FilmDesc, FovAxis, GridConvention, GridDesc, GridLookup, GridStorage, IntegratorDesc,
-    MediumDesc, PhaseDesc, SampleLayout, SceneBuilder, SceneDescription, SceneError,
+    AlbedoDesc, BoundaryDesc, Bounds, BsdfDesc, CameraDesc, DensityDesc, EnvironmentDesc, FilmDesc,
+    FovAxis, GridConvention, GridDesc, GridLookup, GridStorage, IntegratorDesc, MediumDesc,
+    PhaseDesc, SampleLayout, SceneBuilder, SceneDescription, SceneError,
 };
 use volpt::{Backend, Quiet, RenderRequest, RenderSettings, Scene};
 
@@ -210,9 +210,7 @@ impl SceneBuilder for PrintScene<'_> {
                 phase: if self.geometry.g == 0.0 {
                     PhaseDesc::Isotropic
                 } else {
-                    PhaseDesc::HenyeyGreenstein {
-                        g: self.geometry.g,
-                    }
+                    PhaseDesc::HenyeyGreenstein { g: self.geometry.g }
                 },
                 lookup: GridLookup::Nearest,
                 storage: GridStorage::Dense,

@@ -35,7 +35,8 @@ fn an_absorbing_print_transmits_exp_minus_sigma_a_thickness_per_texel_and_channe
         .map(|i| material_of(i % w, (i / w) % h))
         .collect();
     let voxel = 0.1;
-    let print = VoxelPrint::new(materials.clone(), [voxel, voxel, 0.2], [w, h, d], indices).unwrap();
+    let print =
+        VoxelPrint::new(materials.clone(), [voxel, voxel, 0.2], [w, h, d], indices).unwrap();
     let thickness = f64::from(d) * 0.2;
     let spp = 4096;
     let mut predictor = RenderPredictor::new(Backend::cpu(), spp);
@@ -54,10 +55,15 @@ fn an_absorbing_print_transmits_exp_minus_sigma_a_thickness_per_texel_and_channe
                 let expected = (-f64::from(m.sigma_a[c]) * thickness).exp();
                 let found = texels[(x + w * y) as usize].0[c];
                 // Each sample is in [0, 1] with mean p: its variance is at most p (1 - p).
-                let sigma = (expected * (1.0 - expected) / f64::from(spp)).sqrt().max(1e-6);
+                let sigma = (expected * (1.0 - expected) / f64::from(spp))
+                    .sqrt()
+                    .max(1e-6);
                 let z = ((found - expected).abs() - parallax).max(0.0) / sigma;
                 worst = worst.max(z);
-                assert!(z < 5.0, "texel ({x}, {y}) channel {c}: {found} vs {expected} ({z:.1} sigma)");
+                assert!(
+                    z < 5.0,
+                    "texel ({x}, {y}) channel {c}: {found} vs {expected} ({z:.1} sigma)"
+                );
             }
         }
     }
@@ -80,7 +86,11 @@ fn the_loop_runs_on_rendered_predictions_and_keeps_its_best() {
     let [w, h] = [8u32, 6];
     let target: Vec<_> = (0..w * h)
         .map(|i| {
-            let v = if (i % w) < w / 2 { [200, 90, 90] } else { [90, 160, 220] };
+            let v = if (i % w) < w / 2 {
+                [200, 90, 90]
+            } else {
+                [90, 160, 220]
+            };
             volpt_print::colour::Srgb::from_u8(v).to_linear()
         })
         .collect();
