@@ -107,3 +107,52 @@ fn the_loop_runs_on_rendered_predictions_and_keeps_its_best() {
     let again = predictor.predict(&result.print).unwrap();
     assert_eq!(again, result.iterations[result.best].prediction);
 }
+
+#[test]
+fn compensation_lowers_the_error_of_rendered_predictions() {
+    // Scattering inks of the order of the thesis's resins (per mm), a 1 mm slab.
+    let ink = |name: &str, colour: [u8; 3], sigma_s: f32, sigma_a: [f32; 3]| Material {
+        name: name.into(),
+        colour,
+        sigma_s: [sigma_s; 3],
+        sigma_a,
+        g: 0.0,
+    };
+    let materials = vec![
+        ink("cyan", [0, 255, 255], 4.0, [6.0, 0.4, 0.1]),
+        ink("magenta", [255, 0, 255], 4.0, [0.3, 6.0, 0.4]),
+        ink("yellow", [255, 255, 0], 4.0, [0.1, 0.3, 6.0]),
+        ink("black", [0, 0, 0], 2.0, [20.0; 3]),
+        ink("white", [255, 255, 255], 20.0, [0.02; 3]),
+    ];
+    let setup = Setup {
+        halftone: Halftone {
+            layers: 16,
+            depth: 24,
+            inks: Inks::find(&materials).unwrap(),
+            seed: 1,
+        },
+        materials,
+        voxel_size: [0.05, 0.05, 0.04],
+    };
+    let [w, h] = [16u32, 16];
+    let target: Vec<_> = (0..w * h)
+        .map(|i| {
+            let v = if (i % w) % 4 < 2 {
+                [210, 110, 100]
+            } else {
+                [110, 170, 210]
+            };
+            volpt_print::colour::Srgb::from_u8(v).to_linear()
+        })
+        .collect();
+    let mut predictor = RenderPredictor::new(Backend::cpu(), 128);
+    let options = Options {
+        max_iterations: 4,
+        ..Options::default()
+    };
+    let result = compensate(&target, [w, h], &setup, &options, &mut predictor, |_| {}).unwrap();
+    let means: Vec<f64> = result.iterations.iter().map(|i| i.mean).collect();
+    eprintln!("mean dE00 per iteration: {means:?}");
+    assert!(means[result.best] < 0.8 * means[0], "{means:?}");
+}
