@@ -120,6 +120,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         result.iterations[result.best].mean,
         result.best
     );
+    // The last prediction's noise, as the CIEDE2000 between it and it moved by one standard error.
+    let last = &result.iterations[result.iterations.len() - 1].prediction;
+    let noise: f64 = last
+        .iter()
+        .zip(predictor.standard_error())
+        .map(|(p, e)| {
+            let moved = LinearRgb([0, 1, 2].map(|c| p.0[c] + e.0[c]));
+            volpt_print::colour::ciede2000(p.to_lab(), moved.to_lab())
+        })
+        .sum::<f64>()
+        / last.len() as f64;
+    println!("last prediction's noise: mean dE00 of one standard error {noise:.3}");
     write_record(&result, &target, [size, size], out.as_ref())?;
     Ok(())
 }

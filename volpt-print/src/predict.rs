@@ -26,9 +26,13 @@
 //! built once per print geometry; later predictions replace its grids ([`volpt::Scene::set_grid`]),
 //! so the backend re-uploads exactly what changed.
 //!
-//! **Noise.** Each prediction is an independent unbiased render of `spp` samples per texel and
-//! channel (`seed` + iteration-independent: the same seed each time, so two predictions of one
-//! print are equal and the loop compares prints, not noise draws).
+//! **Noise.** Each prediction is an unbiased render of `spp` samples per texel and channel, made
+//! as two independent halves (seeds `seed` and `seed + 1`, the same each time: one print always
+//! predicts the same image). The halves' difference estimates each texel's standard error,
+//! `|a - b| / 2` per channel (the mean of two equal-variance estimates has variance
+//! `E[(a - b)^2] / 4`), kept as [`RenderPredictor::standard_error`]: the update moves an aim by
+//! `step` times the prediction's error, so a standard error well below the error the loop is
+//! removing is what "enough samples" means.
 
 use thiserror::Error;
 use volpt::scene_files::{
@@ -67,6 +71,7 @@ pub struct RenderPredictor {
     pub boundary: BsdfDesc,
     /// The scene of the last print's geometry, whose grids the next prediction replaces.
     scene: Option<(Geometry, Scene)>,
+    standard_error: Vec<LinearRgb>,
 }
 
 /// What fixes a prediction's scene apart from its grids' values.
@@ -92,7 +97,14 @@ impl RenderPredictor {
                 ext_ior: 1.0,
             },
             scene: None,
+            standard_error: Vec::new(),
         }
+    }
+
+    /// The last prediction's standard error per texel and channel, estimated from its two
+    /// independent halves (see the module docs).
+    pub fn standard_error(&self) -> &[LinearRgb] {
+        &self.standard_error
     }
 
     fn geometry(&self, print: &VoxelPrint) -> Result<Geometry, PredictError> {
@@ -237,23 +249,40 @@ impl Predictor for RenderPredictor {
         let (_, scene) = self.scene.as_mut().expect("built above");
         let [w, h, _] = geometry.resolution;
         let mut texels = vec![LinearRgb([0.0; 3]); w as usize * h as usize];
+        let mut errors = texels.clone();
         for c in 0..3 {
             let (density, albedo) = channel_grids(print, c);
             scene.set_grid("density", density)?;
             scene.set_grid("albedo", albedo)?;
-            let mut film = scene.film();
-            let request = RenderRequest::samples(0..self.spp)
-                .with_seed(self.seed)
-                .with_lookup(GridLookup::Nearest);
-            self.backend.render(scene, &mut film, request, &Quiet)?;
-            let image = film.image(self.spp);
+            // Two independent halves (spp / 2 and the rest), averaged by their sample counts.
+            let halves = [self.spp / 2, self.spp - self.spp / 2];
+            let mut images = Vec::new();
+            for (k, &n) in halves.iter().enumerate() {
+                if n == 0 {
+                    continue;
+                }
+                let mut film = scene.film();
+                let request = RenderRequest::samples(0..n)
+                    .with_seed(self.seed.wrapping_add(k as u32))
+                    .with_lookup(GridLookup::Nearest);
+                self.backend.render(scene, &mut film, request, &Quiet)?;
+                images.push((f64::from(n), film.image(n)));
+            }
             // Image row 0 is the print's top edge, texel row h - 1.
             for y in 0..h {
                 for x in 0..w {
-                    texels[(x + w * y) as usize].0[c] = f64::from(image.pixel(x, h - 1 - y)[c]);
+                    let at = |image: &volpt::Image| f64::from(image.pixel(x, h - 1 - y)[c]);
+                    let i = (x + w * y) as usize;
+                    let total: f64 = images.iter().map(|(n, _)| n).sum();
+                    texels[i].0[c] = images.iter().map(|(n, im)| n * at(im)).sum::<f64>() / total;
+                    errors[i].0[c] = match images.as_slice() {
+                        [(_, a), (_, b)] => 0.5 * (at(a) - at(b)).abs(),
+                        _ => f64::INFINITY,
+                    };
                 }
             }
         }
+        self.standard_error = errors;
         Ok(texels)
     }
 }

@@ -68,6 +68,29 @@ fn an_absorbing_print_transmits_exp_minus_sigma_a_thickness_per_texel_and_channe
         }
     }
     eprintln!("worst deviation {worst:.2} sigma");
+    // The halves' standard error estimates the render's: its mean square over texels and channels
+    // is the mean variance of a texel's mean, at most the Bernoulli p (1 - p) / spp of a [0, 1]
+    // estimator (equal to it for delta tracking's all-or-nothing transmittance).
+    let (mut estimated, mut bound) = (0.0, 0.0);
+    for y in 0..h {
+        for x in 0..w {
+            let m = &materials[usize::from(material_of(x, y))];
+            for c in 0..3 {
+                let p = (-f64::from(m.sigma_a[c]) * thickness).exp();
+                bound += p * (1.0 - p) / f64::from(spp);
+                estimated += predictor.standard_error()[(x + w * y) as usize].0[c].powi(2);
+            }
+        }
+    }
+    eprintln!(
+        "mean square standard error {:.3e}, Bernoulli bound {:.3e}",
+        estimated / f64::from(3 * w * h),
+        bound / f64::from(3 * w * h)
+    );
+    assert!(
+        estimated > 0.2 * bound && estimated < 2.0 * bound,
+        "{estimated} vs {bound}"
+    );
 }
 
 #[test]
