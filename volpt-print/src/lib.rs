@@ -8,6 +8,7 @@
 //! - [`slices`]: slice stacks (one PNG per layer and `materials.toml`), written and read.
 //! - [`halftone`]: the printer's naive ink mix and its 3D ordered dithering into voxels.
 //! - [`compensate`]: the scattering compensation loop, against a [`compensate::Predictor`].
+//! - [`predict`]: the real predictor, a volpt render of the print from straight above.
 //! - [`error`]: what reading or writing a print can refuse ([`PrintError`]).
 
 pub mod colour;
@@ -15,7 +16,9 @@ pub mod compensate;
 pub mod error;
 pub mod halftone;
 pub mod material;
+pub mod predict;
 pub mod print;
+pub mod record;
 pub mod slices;
 
 pub use error::PrintError;

@@ -203,3 +203,35 @@ fn every_update_starts_from_the_best_iteration_and_halves_the_step_after_a_miss(
             .unwrap()
     );
 }
+
+#[test]
+fn the_record_holds_every_iteration_and_the_best_prints_slices() {
+    let setup = setup();
+    let target = bars();
+    let result = compensate(
+        &target,
+        SIZE,
+        &setup,
+        &Options::default(),
+        &mut model(),
+        |_| {},
+    )
+    .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    volpt_print::record::write_record(&result, &target, SIZE, dir.path()).unwrap();
+    let csv = std::fs::read_to_string(dir.path().join("iterations.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + result.iterations.len(), "{csv}");
+    let best_line = csv.lines().nth(1 + result.best).unwrap();
+    assert!(best_line.ends_with(",1"), "{csv}");
+    for k in 0..result.iterations.len() {
+        for file in ["prediction.png", "delta_e.png"] {
+            assert!(dir
+                .path()
+                .join(format!("iteration_{k:02}"))
+                .join(file)
+                .is_file());
+        }
+    }
+    let slices = volpt_print::slices::read_slices(&dir.path().join("slices")).unwrap();
+    assert_eq!(slices, result.print);
+}
