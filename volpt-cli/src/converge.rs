@@ -36,6 +36,8 @@ use volpt_render::path_settings;
 use volpt_scene::description::{AlbedoDesc, BsdfDesc, EnvironmentDesc};
 use volpt_scene::{GridLookup, SceneDescription};
 
+use volpt::metrics::{errors_of_halves, Reference};
+
 use crate::backend::BackendKind;
 use crate::plot::{log_log_png, log_log_svg, Series};
 use crate::{SamplingArgs, SceneArgs};
@@ -267,43 +269,6 @@ impl Row {
     }
 }
 
-/// What the estimate is compared with: per pixel channel.
-enum Reference {
-    Constant([f32; 3]),
-    /// An image, and the variance of its pixels as estimates (mean over pixel channels).
-    Image(Image, f64),
-}
-
-impl Reference {
-    fn variance(&self) -> f64 {
-        match self {
-            Reference::Constant(_) => 0.0,
-            Reference::Image(_, variance) => *variance,
-        }
-    }
-
-    /// The mean of two independent renders, and the variance of that mean.
-    fn from_halves(a: &Image, b: &Image) -> Self {
-        let mut mean = a.clone();
-        let mut variance = 0.0;
-        for (m, pb) in mean.pixels.iter_mut().zip(&b.pixels) {
-            for c in 0..3 {
-                variance += (0.5 * (m[c] as f64 - pb[c] as f64)).powi(2);
-                m[c] = 0.5 * (m[c] + pb[c]);
-            }
-        }
-        let count = 3.0 * a.pixels.len() as f64;
-        Reference::Image(mean, variance / count)
-    }
-
-    fn at(&self, pixel: usize, channel: usize) -> f64 {
-        match self {
-            Reference::Constant(rgb) => rgb[channel] as f64,
-            Reference::Image(image, _) => image.pixels[pixel][channel] as f64,
-        }
-    }
-}
-
 /// Both halves of the samples: two films that grow by a batch per round, in the configuration's
 /// precision, each from its own seed.
 struct Halves {
@@ -314,22 +279,9 @@ struct Halves {
 impl Halves {
     /// MSE, relative MSE and the variance of the estimate, over all pixel channels.
     fn errors(&self, reference: &Reference) -> (f64, f64, f64) {
-        let n = self.spp_each as f64;
-        let [a, b] = [&self.films[0].sums, &self.films[1].sums];
-        let (mut mse, mut rel, mut var) = (0.0, 0.0, 0.0);
-        for (i, (a, b)) in a.iter().zip(b).enumerate() {
-            for c in 0..3 {
-                let (ma, mb) = (a[c] / n, b[c] / n);
-                let estimate = 0.5 * (ma + mb);
-                let r = reference.at(i, c);
-                let e2 = (estimate - r).powi(2);
-                mse += e2;
-                rel += e2 / (r * r + 0.01);
-                var += (0.5 * (ma - mb)).powi(2);
-            }
-        }
-        let count = 3.0 * a.len() as f64;
-        (mse / count, rel / count, var / count)
+        let [a, b] = &self.films;
+        let e = errors_of_halves(a, b, self.spp_each, reference);
+        (e.mse, e.rel_mse, e.variance)
     }
 }
 
@@ -459,7 +411,10 @@ fn reference(args: &ConvergeArgs, scene: &Scene, backend: &Backend) -> Result<Re
                 image.height
             );
         }
-        return Ok(Reference::Image(image, 0.0));
+        return Ok(Reference::Image {
+            image,
+            variance: 0.0,
+        });
     }
     if let Some(rgb) = white_furnace(desc) {
         tracing::info!(

@@ -30,6 +30,8 @@
 //! - [`fingerprint`]: what makes two renders the same render, as one hash.
 //! - [`names`]: the words users type for every choice ([`Named`]: backend, strategy, math,
 //!   lookup, estimator, ...), one table each, which every front end lists and parses.
+//! - [`metrics`]: error metrics against a reference (MSE, bias, per-pixel error maps,
+//!   quantiles) and the z test of two estimates for one expectation (`volpt converge`, `compare`).
 //! - [`info`]: what a scene loads to, field by field (`volpt info`, Python's `Scene.info()`).
 //! - [`error`]: every way the above fails, as one [`Error`].
 //!
@@ -43,6 +45,7 @@ pub mod error;
 pub mod films;
 pub mod fingerprint;
 pub mod info;
+pub mod metrics;
 pub mod multi;
 pub mod names;
 pub mod observer;
