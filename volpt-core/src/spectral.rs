@@ -135,10 +135,13 @@ impl SpectralState for () {
 /// collisions, and the path's density under each channel over their mean (pbrt-v4's rescaled
 /// `r_u`; mean 1, each in `[0, 3]`): the light the path gathers is `throughput * r_u`
 /// ([`crate::chromatic`]).
+///
+/// The hero is a `u32`, not a `u8`: the state is then 16 bytes of 4-byte words without padding,
+/// which a parked path copies in registers.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HeroChannel {
-    pub hero: u8,
     pub r_u: Spectrum,
+    pub hero: u32,
 }
 
 impl SpectralState for HeroChannel {
@@ -147,8 +150,8 @@ impl SpectralState for HeroChannel {
     #[inline(always)]
     fn start(rng: &mut Rng) -> Self {
         Self {
-            hero: choose_hero(rng),
             r_u: Spectrum::ONE,
+            hero: choose_hero(rng) as u32,
         }
     }
 
@@ -172,7 +175,7 @@ impl SpectralState for HeroChannel {
             ray,
             t_max,
             rng,
-            self.hero,
+            self.hero as u8,
             &mut self.r_u,
             steps,
             max_steps,
