@@ -22,6 +22,7 @@ pub mod fresnel;
 pub mod geometry;
 pub mod grid;
 pub mod majorant;
+pub mod material;
 pub mod math;
 pub mod medium;
 pub mod mesh;
@@ -32,6 +33,7 @@ pub mod rng;
 pub mod sampling;
 pub mod scene;
 pub mod shape;
+pub mod spectral;
 pub mod tracking;
 pub mod variant;
 
@@ -48,16 +50,18 @@ pub use grid::{
     GridPlacement, GridReads, TexelFormat, TextureTrilinear,
 };
 pub use majorant::MajorantGrid;
+pub use material::{Material, MaterialGrid};
 pub use medium::{
     AlbedoField, ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium, Medium, ReadAs,
     TrackedMedium,
 };
 pub use mesh::{BvhNode, MeshTriangle, TriangleMesh};
-pub use path::{Estimator, PathCounters, PathSettings, PathState, Roulette};
+pub use path::{Estimator, PathCounters, PathOf, PathSettings, PathState, Roulette};
 pub use phase::{HenyeyGreenstein, Isotropic, PhaseFunction};
 pub use rng::Rng;
 pub use scene::{Scene, VolumeScene, WithShape};
 pub use shape::Shape;
+pub use spectral::{HeroChannel, SpectralState};
 
 /// Linear RGB radiance, throughput or albedo.
 pub type Spectrum = glam::Vec3;
