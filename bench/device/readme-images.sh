@@ -18,6 +18,7 @@
 #               bucky: scenes/bucky/Bucky.raw). The log's commands show which (-Ddata=...).
 #   STRATEGY    default regeneration-sk: no calibration renders, the same choice every run
 #   BACKEND     default cuda; cpu tries the script without a GPU
+#   ONLY        names of the scenes to render (default all), e.g. ONLY="chromatic-cube chromatic-slab"
 set -uo pipefail
 cd "$(dirname "$0")"
 OUT=${OUT:-$PWD/out}
@@ -52,11 +53,14 @@ SCENES=(
     "smoke:scenes/smoke/scene.xml:4096:$(data_param smoke.vol)"
     "bucky:scenes/bucky/scene.toml:4096:$(data_param Bucky.raw)"
     "envmap-cube:scenes/envmap-cube/scene.xml:16384:"
+    "chromatic-cube:scenes/chromatic/cube.xml:4096:"
+    "chromatic-slab:scenes/chromatic/slab.xml:4096:"
 )
 
 failures=0
 for entry in "${SCENES[@]}"; do
     IFS=: read -r name file spp params <<<"$entry"
+    [ -z "${ONLY:-}" ] || [[ " $ONLY " == *" $name "* ]] || continue
     spp=$((spp / SPP_DIV)); [ "$spp" -ge 1 ] || spp=1
     [ -f "$file" ] || { say "SKIP $name: $file not in this bundle"; continue; }
     cmd=("$VOLPT" render "$file" --backend "$BACKEND" --resolution "${SIZE}x${SIZE}" --spp "$spp"

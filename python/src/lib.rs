@@ -16,12 +16,11 @@ use std::time::Duration;
 
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use pyo3::types::{PyByteArray, PyDict, PyList, PyRange, PyTuple, PyType};
+use pyo3::types::{IntoPyDict, PyByteArray, PyDict, PyList, PyRange, PyTuple, PyType};
 use volpt::film::checkpoint::Checkpoint;
 use volpt::{
-    Backend, BackendKind, BackendOptions, Effects, Error, Estimator, GpuOptions, GridLookup, Image,
-    Math, Observer, ParamValue, Part, RenderRequest, RenderSettings, Roulette, StrategyChoice,
-    Tracking, PARAMS,
+    Backend, BackendKind, BackendOptions, Error, GpuOptions, Image, Math, Named, Observer,
+    ParamValue, Part, RenderRequest, RenderSettings, StrategyChoice, PARAMS,
 };
 
 /// How much CPU rendering passes between looks at Ctrl-C and the progress callback.
@@ -42,15 +41,26 @@ fn to_py(error: Error) -> PyErr {
             "SceneNotFoundError"
         }
         Error::Scene(_) => "SceneError",
-        Error::Settings(_) => "SettingsError",
-        Error::Param { found, .. } if found == "no such parameter" => "UnknownParamError",
+        Error::Settings(_) | Error::Setting { .. } => "SettingsError",
+        Error::UnknownParam { .. } => "UnknownParamError",
         Error::Param { .. } => "ParamError",
+        Error::Grid { .. } => "GridError",
         Error::Cpu(_) | Error::Cuda(_) => "RenderError",
         Error::Checkpoint(_) | Error::FilmFile(_) => "CheckpointError",
         Error::Films(_) => "MergeError",
         Error::Image(_) => "ImageError",
     };
-    raise(class, message(&error))
+    let text = match &error {
+        // The library's key is a keyword argument's or a settings key's name: spelled as
+        // Python's settings mapping takes it.
+        Error::Setting {
+            key,
+            expected,
+            found,
+        } => format!("settings[{key:?}]: expected {expected}, found {found}"),
+        _ => message(&error),
+    };
+    raise(class, text)
 }
 
 /// The error's message with the causes its own text does not already say.
@@ -124,20 +134,28 @@ fn describe(value: &Bound<'_, PyAny>) -> String {
     format!("{ty} {repr}")
 }
 
-/// One of `choices` (a string), or a `SettingsError` naming `what` and the choices.
-fn choice<T: Copy>(value: &Bound<'_, PyAny>, what: &str, choices: &[(&str, T)]) -> PyResult<T> {
-    let names: Vec<&str> = choices.iter().map(|(n, _)| *n).collect();
-    value
-        .extract::<String>()
-        .ok()
-        .and_then(|s| choices.iter().find(|(n, _)| *n == s).map(|(_, v)| *v))
+/// A name of one of the library's choices ([`Named`]), or a `SettingsError` naming `what` and
+/// the names (the library's words: `volpt::names`).
+fn choice<T: Named>(value: &Bound<'_, PyAny>, what: &str) -> PyResult<T> {
+    let name = value.extract::<String>().ok();
+    name.and_then(|s| volpt::names::parse::<T>(&s).ok())
         .ok_or_else(|| {
             settings_error(format!(
-                "{what}: expected one of {}, found {}",
-                names.join(", "),
+                "{what}: expected {}, found {}",
+                volpt::names::expected::<T>(),
                 describe(value)
             ))
         })
+}
+
+/// The choice `name` names ([`Named`]), or a `SettingsError` naming `what` and the names.
+fn named<T: Named>(name: &str, what: &str) -> PyResult<T> {
+    volpt::names::parse::<T>(name).map_err(|_| {
+        settings_error(format!(
+            "{what}: expected {}, found {name:?}",
+            volpt::names::expected::<T>()
+        ))
+    })
 }
 
 const SETTINGS: &[&str] = &[
@@ -198,59 +216,15 @@ fn render_settings(
             }
             "max_depth" => out.max_depth = Some(depth(int_in(&value, what, -1, u32_max)?)),
             "rr_depth" => out.rr_depth = Some(depth(int_in(&value, what, -1, u32_max)?)),
-            "tracking" => {
-                out.tracking = Some(choice(
-                    &value,
-                    what,
-                    &[("global", Tracking::Global), ("grid", Tracking::Grid)],
-                )?)
-            }
+            "tracking" => out.tracking = Some(choice(&value, what)?),
             "majorant_resolution" => {
-                out.majorant_resolution = Some(int_in(&value, what, 1, 1024)? as u32)
+                // Its range is the library's to check (volpt::MAJORANT_RESOLUTION).
+                out.majorant_resolution = Some(int_in(&value, what, 0, u32_max)? as u32)
             }
-            "estimator" => {
-                out.estimator = Some(choice(
-                    &value,
-                    what,
-                    &[
-                        ("pt", Estimator::PathTracing),
-                        ("nee", Estimator::NextEvent),
-                    ],
-                )?)
-            }
-            "lookup" => {
-                out.lookup = Some(choice(
-                    &value,
-                    what,
-                    &[
-                        ("trilinear", GridLookup::Trilinear),
-                        ("nearest", GridLookup::Nearest),
-                        ("texture", GridLookup::Texture),
-                        ("texture-f16", GridLookup::TextureHalf),
-                        ("stochastic", GridLookup::Stochastic),
-                    ],
-                )?)
-            }
-            "roulette" => {
-                out.roulette = Some(choice(
-                    &value,
-                    what,
-                    &[
-                        ("mitsuba", Roulette::Mitsuba),
-                        ("throughput", Roulette::Throughput),
-                    ],
-                )?)
-            }
-            "effects" => {
-                out.effects = choice(
-                    &value,
-                    what,
-                    &[
-                        ("specialised", Effects::Specialised),
-                        ("general", Effects::General),
-                    ],
-                )?
-            }
+            "estimator" => out.estimator = Some(choice(&value, what)?),
+            "lookup" => out.lookup = Some(choice(&value, what)?),
+            "roulette" => out.roulette = Some(choice(&value, what)?),
+            "effects" => out.effects = choice(&value, what)?,
             "threads" => out.threads = Some(int_in(&value, what, 1, u32_max)? as usize),
             _ => {
                 return Err(settings_error(format!(
@@ -388,6 +362,61 @@ impl Scene {
         self.inner.source().to_owned()
     }
 
+    /// The names of the medium's grids (`"density"`, `"albedo"`), which `grid` and `set_grid`
+    /// take.
+    #[getter]
+    fn grids(&self) -> Vec<&'static str> {
+        self.inner.grid_names()
+    }
+
+    /// Grid `name`'s values: a float32 array of shape (z, y, x), or (z, y, x, channels) for an
+    /// RGB grid.
+    fn grid<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+        let grid = self.inner.grid(name).map_err(to_py)?;
+        let bytes: Vec<u8> = grid.data.iter().flat_map(|v| v.to_ne_bytes()).collect();
+        let buffer = PyByteArray::new(py, &bytes);
+        py.import("numpy")?
+            .call_method1("frombuffer", (buffer, "float32"))?
+            .call_method1("reshape", (grid_shape(grid),))
+    }
+
+    /// Replaces grid `name`'s values with `values` (an array of its shape, or flat in its order),
+    /// as `volpt::Scene::set_grid`: the next render renders the scene as loaded with them.
+    fn set_grid(&mut self, py: Python<'_>, name: &str, values: Bound<'_, PyAny>) -> PyResult<()> {
+        let grid = self.inner.grid(name).map_err(to_py)?;
+        let shape = grid_shape(grid);
+        let wrong = |expected: String, found: String| {
+            to_py(Error::Grid {
+                grid: name.to_owned(),
+                expected,
+                found,
+            })
+        };
+        let numpy = py.import("numpy")?;
+        let array = numpy
+            .call_method(
+                "ascontiguousarray",
+                (&values,),
+                Some(&[("dtype", "float32")].into_py_dict(py)?),
+            )
+            .map_err(|_| wrong("an array of numbers".into(), describe(&values)))?;
+        let found: Vec<usize> = array.getattr("shape")?.extract()?;
+        if found.len() > 1 && found != shape {
+            return Err(wrong(
+                format!("an array of shape {shape:?} (z, y, x[, channels]) or flat"),
+                format!("an array of shape {found:?}"),
+            ));
+        }
+        let bytes: Vec<u8> = array.call_method0("tobytes")?.extract()?;
+        let values: Vec<f32> = bytes
+            .chunks_exact(4)
+            .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
+        let scene = &mut self.inner;
+        py.allow_threads(|| scene.set_grid(name, values))
+            .map_err(to_py)
+    }
+
     fn __repr__(&self) -> String {
         let (w, h) = self.inner.resolution();
         format!(
@@ -505,6 +534,16 @@ impl Scene {
     }
 }
 
+/// A grid's numpy shape: (z, y, x), with its channels last where it has several.
+fn grid_shape(grid: &volpt::scene_files::GridDesc) -> Vec<usize> {
+    let [x, y, z] = grid.resolution.map(|n| n as usize);
+    let mut shape = vec![z, y, x];
+    if grid.channels > 1 {
+        shape.push(grid.channels as usize);
+    }
+    shape
+}
+
 /// `samples=`: a `range` of step 1, or `(start, stop)`.
 fn sample_range(value: &Bound<'_, PyAny>) -> PyResult<Range<u32>> {
     let wrong = |why: &str| {
@@ -536,46 +575,11 @@ fn backend_options(
     strategy: Option<&str>,
     math: Option<&str>,
 ) -> PyResult<BackendOptions> {
-    let kind = match backend {
-        "cpu" => BackendKind::Cpu,
-        "cuda" => BackendKind::Cuda,
-        other => {
-            return Err(settings_error(format!(
-                "backend: expected cpu or cuda, found {other:?}"
-            )))
-        }
-    };
+    let kind = named::<BackendKind>(backend, "backend")?;
     let strategy = strategy
-        .map(|name| {
-            if name == "auto" {
-                return Ok(StrategyChoice::Auto);
-            }
-            volpt::Strategy::ALL
-                .iter()
-                .find(|s| s.name() == name)
-                .map(|&s| StrategyChoice::Fixed(s))
-                .ok_or_else(|| {
-                    let names: Vec<&str> = std::iter::once("auto")
-                        .chain(volpt::Strategy::ALL.iter().map(|s| s.name()))
-                        .collect();
-                    settings_error(format!(
-                        "strategy: expected one of {}, found {name:?}",
-                        names.join(", ")
-                    ))
-                })
-        })
+        .map(|name| named::<StrategyChoice>(name, "strategy"))
         .transpose()?;
-    let math = math
-        .map(|name| {
-            Math::ALL
-                .iter()
-                .find(|m| m.name() == name)
-                .copied()
-                .ok_or_else(|| {
-                    settings_error(format!("math: expected exact or fast, found {name:?}"))
-                })
-        })
-        .transpose()?;
+    let math = math.map(|name| named::<Math>(name, "math")).transpose()?;
     Ok(BackendOptions {
         kind,
         gpu: GpuOptions {
@@ -1141,12 +1145,10 @@ fn _volpt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     }
     m.add("PARAMS", params)?;
     m.add("SETTINGS", PyTuple::new(m.py(), SETTINGS)?)?;
-    m.add("STRATEGIES", {
-        let names: Vec<&str> = std::iter::once("auto")
-            .chain(volpt::Strategy::ALL.iter().map(|s| s.name()))
-            .collect();
-        PyTuple::new(m.py(), names)?
-    })?;
+    m.add(
+        "STRATEGIES",
+        PyTuple::new(m.py(), volpt::names::names::<StrategyChoice>())?,
+    )?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -46,6 +46,9 @@ def test_unknown_parameter_value_is_the_scene_files_error(tmp_path):
         ({"tracking": "fast"}, "settings[\"tracking\"]: expected one of global, grid, found str 'fast'"),
         ({"estimator": 1}, "settings[\"estimator\"]: expected one of pt, nee, found int 1"),
         ({"threads": 0}, "settings[\"threads\"]: expected an integer from 1 to"),
+        # The library's bound and words (volpt::MAJORANT_RESOLUTION), the key in Python's spelling.
+        ({"majorant_resolution": 0}, 'settings["majorant_resolution"]: expected 1 to 1024 cells, found 0'),
+        ({"majorant_resolution": 1025}, 'settings["majorant_resolution"]: expected 1 to 1024 cells, found 1025'),
         ({"tracking": "global", "majorant_resolution": 8}, "--tracking global uses one majorant; --majorant-resolution 8 asks for a grid"),
     ],
 )
@@ -69,11 +72,11 @@ def scene():
 @pytest.mark.parametrize(
     "kwargs,message",
     [
-        ({"backend": "gpu"}, "backend: expected cpu or cuda, found \"gpu\""),
+        ({"backend": "gpu"}, "backend: expected one of cpu, cuda, found \"gpu\""),
         ({"strategy": "regeneration-sk"}, "--strategy regeneration-sk schedules GPU work; the CPU backend has no strategies"),
         ({"math": "fast"}, "--math fast chooses the GPU's kernels; the CPU backend always computes exactly"),
         ({"backend": "cuda", "strategy": "quick"}, "strategy: expected one of auto, "),
-        ({"backend": "cuda", "math": "sloppy"}, "math: expected exact or fast, found \"sloppy\""),
+        ({"backend": "cuda", "math": "sloppy"}, "math: expected one of exact, fast, found \"sloppy\""),
         ({"spp": 0}, "spp: expected an integer from 1 to 4294967295, found int 0"),
         ({"seed": -1}, "seed: expected an integer from 0 to 4294967295, found int -1"),
         ({"spp": 2, "samples": range(2)}, "render: give spp (samples 0 to spp) or samples (a range), not both"),

@@ -21,6 +21,7 @@ from ._volpt import load as _load
 from ._volpt import merge, read_exr
 from .errors import (
     CheckpointError,
+    GridError,
     ImageError,
     MergeError,
     ParamError,

@@ -62,6 +62,21 @@ class Scene:
     @property
     def source(self) -> str:
         """The scene file."""
+    @property
+    def grids(self) -> List[str]:
+        """The names of the medium's grids (``"density"``, ``"albedo"``); empty for a medium of
+        constants."""
+    def grid(self, name: str) -> npt.NDArray[np.float32]:
+        """Grid ``name``'s values (a copy): float32 of shape (z, y, x), or (z, y, x, 3) for an RGB
+        albedo; x varies fastest, as in the grid files. Raises ``GridError`` for a grid the
+        scene lacks."""
+    def set_grid(self, name: str, values: npt.ArrayLike) -> None:
+        """Replaces grid ``name``'s values: an array of the grid's shape (``grid(name).shape``),
+        or flat in its order, converted to float32. The next render renders the scene as loaded
+        from a file of these values, bit for bit, with that scene's fingerprint; the grids a
+        GPU keeps are copied again. Values equal to the grid's own change nothing. Raises
+        ``GridError`` (a ``ValueError``) for a grid the scene lacks, a grid kept sparse (a VDB),
+        the wrong shape or count, or a value out of range, leaving the scene as it was."""
     def info(self) -> Dict[str, str]:
         """What ``volpt info`` prints, as a dict in its order: ``scene``, ``variant``, ``film``,
         ``camera``, ``integrator``, ``bounds``, ``boundary``, ``density``, ``majorant``,

@@ -7,6 +7,7 @@ the field or option, what was expected and what was found.
     ├── SettingsError        a bad keyword argument or load setting (also a ValueError)
     ├── ParamError           a scene parameter's bad value (also a ValueError)
     │   └── UnknownParamError    a key that is no parameter (also a KeyError)
+    ├── GridError            grid values of the wrong shape or range, or for no grid (also a ValueError)
     ├── RenderError          the CPU or GPU backend failed (no GPU, no kernels in this build)
     ├── CheckpointError      a film file that cannot be read or written, or of another render
     ├── MergeError           films that do not add up to one render (also a ValueError)
@@ -45,6 +46,11 @@ class UnknownParamError(ParamError, KeyError):
         return str(self.args[0]) if self.args else ""
 
 
+class GridError(VolptError, ValueError):
+    """Grid values (``scene.set_grid``) for a grid the scene lacks, of the wrong shape, or out of
+    range. The scene is left as it was."""
+
+
 class RenderError(VolptError):
     """The CPU or GPU backend failed (including: no GPU, no kernels in this build)."""
 
@@ -69,6 +75,7 @@ __all__ = [
     "SettingsError",
     "ParamError",
     "UnknownParamError",
+    "GridError",
     "RenderError",
     "CheckpointError",
     "MergeError",

@@ -241,7 +241,9 @@ impl RefMedium {
                 DensityDesc::Constant(d) => RefDensity::Constant(*d as f64),
                 DensityDesc::Grid(g) => RefDensity::Grid(RefGrid::new(g)),
                 // Each channel of a chromatic medium is the grey medium of its coefficients.
-                DensityDesc::Rgb(_) => panic!("reference media have a grey extinction"),
+                DensityDesc::Rgb(_) | DensityDesc::Indexed(_) => {
+                    panic!("reference media have a grey extinction")
+                }
             },
             scale: m.scale as f64,
             albedo: vec(albedo),

@@ -167,6 +167,7 @@ impl Slabs<'_> {
 }
 
 impl Medium for Slabs<'_> {
+    type Spectral = ();
     const HOMOGENEOUS: bool = false;
     fn majorant(&self) -> f32 {
         5.0

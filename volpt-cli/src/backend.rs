@@ -5,62 +5,12 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
 
-use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressStyle};
-use volpt::{GpuOptions, Math, Observer, Strategy, StrategyChoice};
+use volpt::{GpuOptions, Math, Observer, StrategyChoice};
 
 use crate::volume::VolumeArgs;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum BackendKind {
-    /// Every CPU core, through rayon.
-    Cpu,
-    /// An NVIDIA GPU through the CUDA driver.
-    Cuda,
-}
-
-impl From<BackendKind> for volpt::BackendKind {
-    fn from(kind: BackendKind) -> Self {
-        match kind {
-            BackendKind::Cpu => volpt::BackendKind::Cpu,
-            BackendKind::Cuda => volpt::BackendKind::Cuda,
-        }
-    }
-}
-
-/// `--strategy`: `auto` (chosen by measurement, see `auto`) or one of the GPU's strategies.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum StrategyArg {
-    Auto,
-    Fixed(Strategy),
-}
-
-impl ValueEnum for StrategyArg {
-    fn value_variants<'a>() -> &'a [Self] {
-        static VARIANTS: std::sync::LazyLock<Vec<StrategyArg>> = std::sync::LazyLock::new(|| {
-            std::iter::once(StrategyArg::Auto)
-                .chain(Strategy::ALL.iter().map(|&s| StrategyArg::Fixed(s)))
-                .collect()
-        });
-        &VARIANTS
-    }
-
-    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
-        Some(match self {
-            StrategyArg::Auto => clap::builder::PossibleValue::new("auto"),
-            StrategyArg::Fixed(s) => clap::builder::PossibleValue::new(s.name()),
-        })
-    }
-}
-
-impl From<StrategyArg> for StrategyChoice {
-    fn from(s: StrategyArg) -> Self {
-        match s {
-            StrategyArg::Auto => StrategyChoice::Auto,
-            StrategyArg::Fixed(s) => StrategyChoice::Fixed(s),
-        }
-    }
-}
+pub use volpt::BackendKind;
 
 /// The flags that only the GPU backend takes: how it schedules and computes.
 #[derive(Clone, Copy, Debug, Default, clap::Args)]
@@ -68,11 +18,11 @@ pub struct GpuArgs {
     /// GPU scheduling strategy; `auto` picks the fastest for the scene by calibration renders,
     /// cached per scene and GPU (default: auto's cached choice, a calibration for a render long
     /// enough to repay it, else regeneration-sk).
-    #[arg(long, value_enum)]
-    pub strategy: Option<StrategyArg>,
+    #[arg(long, value_parser = crate::named::<StrategyChoice>())]
+    pub strategy: Option<StrategyChoice>,
     /// GPU arithmetic: `fast` (default) uses the GPU's approximate instructions, statistically
     /// equal to `exact`, which is bit-identical to the CPU (with naive-sk).
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = crate::named::<Math>())]
     pub math: Option<Math>,
     /// Cap the GPU kernel's registers per thread (the JIT spills the rest): more threads resident
     /// per multiprocessor, at the price of spills.
@@ -120,7 +70,7 @@ impl GpuArgs {
     /// The library's GPU options: these flags and the volume flags.
     pub fn options(&self, volumes: &VolumeArgs) -> GpuOptions {
         GpuOptions {
-            strategy: self.strategy.map(Into::into),
+            strategy: self.strategy,
             math: self.math,
             max_registers: self.max_registers,
             refill_at: self.refill_at,

@@ -26,18 +26,21 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::{bail, Context, Result};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use volpt::{
-    Backend, Estimator, Film, Image, Math, PathSettings, Quiet, RenderRequest, Scene, Strategy,
+    Accumulation, Backend, Estimator, Film, Image, Math, Named, PathSettings, Quiet, RenderRequest,
+    Roulette, Scene, Strategy, StrategyChoice,
 };
 use volpt_render::path_settings;
 use volpt_scene::description::{AlbedoDesc, BsdfDesc, EnvironmentDesc};
 use volpt_scene::{GridLookup, SceneDescription};
 
-use crate::backend::{BackendKind, StrategyArg};
+use volpt::metrics::{errors_of_halves, Reference};
+
+use crate::backend::BackendKind;
 use crate::plot::{log_log_png, log_log_svg, Series};
-use crate::{AccumulationArg, LookupArg, SamplingArgs, SceneArgs};
+use crate::{SamplingArgs, SceneArgs};
 
 #[derive(Args)]
 pub struct ConvergeArgs {
@@ -89,15 +92,15 @@ pub enum Choice {
     /// Cells of the majorant grid along the longest axis; 1 is the global majorant.
     MajorantResolution(u32),
     /// Trilinear or nearest-sample reconstruction of the medium's grids.
-    Lookup(LookupArg),
+    Lookup(GridLookup),
     /// The precision the film adds samples in (the CPU backend's; the GPU film sums in f64).
-    Accumulation(AccumulationArg),
+    Accumulation(Accumulation),
     /// The GPU scheduling strategy.
     Strategy(Strategy),
     /// Exact or fast GPU kernels.
     Math(Math),
     /// Russian roulette's survival probability.
-    RouletteRule(crate::RouletteArg),
+    RouletteRule(Roulette),
 }
 
 impl Choice {
@@ -117,10 +120,10 @@ impl Choice {
             Choice::Lookup(lookup) => config.lookup = Some(lookup),
             Choice::Accumulation(accumulation) => config.accumulation = accumulation,
             Choice::Strategy(strategy) => {
-                config.sampling.gpu.strategy = Some(StrategyArg::Fixed(strategy))
+                config.sampling.gpu.strategy = Some(StrategyChoice::Fixed(strategy))
             }
             Choice::Math(math) => config.sampling.gpu.math = Some(math),
-            Choice::RouletteRule(rule) => settings.roulette = rule.into(),
+            Choice::RouletteRule(rule) => settings.roulette = rule,
         }
     }
 
@@ -130,8 +133,7 @@ impl Choice {
             Choice::Roulette(on) => format!("roulette={}", if on { "on" } else { "off" }),
             Choice::RrDepth(d) => format!("rr_depth={}", depth(d)),
             Choice::MaxDepth(d) => format!("max_depth={}", depth(d)),
-            Choice::Estimator(Estimator::PathTracing) => "estimator=pt".to_owned(),
-            Choice::Estimator(Estimator::NextEvent) => "estimator=nee".to_owned(),
+            Choice::Estimator(e) => format!("estimator={}", value_name(&e)),
             Choice::MajorantResolution(r) => format!("majorant_resolution={r}"),
             Choice::Lookup(lookup) => format!("lookup={}", value_name(&lookup)),
             Choice::Accumulation(a) => format!("accumulation={}", value_name(&a)),
@@ -142,19 +144,14 @@ impl Choice {
     }
 }
 
-/// A knob's value as the command line spells it.
-fn value_name<T: ValueEnum>(value: &T) -> String {
-    value
-        .to_possible_value()
-        .map_or_else(String::new, |v| v.get_name().to_owned())
+/// A knob's value as the command line spells it (the library's name).
+fn value_name<T: Named>(value: &T) -> &'static str {
+    value.name()
 }
 
-/// A value of an enumerated knob, or an error listing the values it takes.
-fn enum_value<T: ValueEnum>(name: &str, v: &str) -> Result<T, String> {
-    T::from_str(v, false).map_err(|_| {
-        let names: Vec<String> = T::value_variants().iter().map(value_name).collect();
-        format!("{name}: expected one of {}, found {v:?}", names.join(", "))
-    })
+/// A value of an enumerated knob, or the library's error listing the values it takes.
+fn enum_value<T: Named>(v: &str) -> Result<T, String> {
+    volpt::names::parse(v).map_err(|e| e.to_string())
 }
 
 fn parse_setting(s: &str) -> Result<Vec<Choice>, String> {
@@ -178,22 +175,17 @@ fn parse_setting(s: &str) -> Result<Vec<Choice>, String> {
             },
             "rr_depth" => depth(v).map(Choice::RrDepth),
             "max_depth" => depth(v).map(Choice::MaxDepth),
-            "estimator" => match v {
-                "pt" => Ok(Choice::Estimator(Estimator::PathTracing)),
-                "nee" => Ok(Choice::Estimator(Estimator::NextEvent)),
-                _ => Err(format!("estimator: expected pt or nee, found {v:?}")),
-            },
-            "majorant_resolution" => match v.parse::<u32>() {
-                Ok(r) if (1..=1024).contains(&r) => Ok(Choice::MajorantResolution(r)),
-                _ => Err(format!(
-                    "majorant_resolution: expected cells from 1 to 1024, found {v:?}"
-                )),
-            },
-            "lookup" => enum_value(name, v).map(Choice::Lookup),
-            "accumulation" => enum_value(name, v).map(Choice::Accumulation),
-            "strategy" => enum_value(name, v).map(Choice::Strategy),
-            "math" => enum_value(name, v).map(Choice::Math),
-            "roulette_rule" => enum_value(name, v).map(Choice::RouletteRule),
+            "estimator" => enum_value(v).map(Choice::Estimator),
+            "majorant_resolution" => v
+                .parse::<u32>()
+                .map_err(|_| format!("{name}: expected an integer, found {v:?}"))
+                .and_then(|r| volpt::check_majorant_resolution(r).map_err(|e| e.to_string()))
+                .map(Choice::MajorantResolution),
+            "lookup" => enum_value(v).map(Choice::Lookup),
+            "accumulation" => enum_value(v).map(Choice::Accumulation),
+            "strategy" => enum_value(v).map(Choice::Strategy),
+            "math" => enum_value(v).map(Choice::Math),
+            "roulette_rule" => enum_value(v).map(Choice::RouletteRule),
             _ => Err(format!(
                 "unknown setting {name:?}: expected roulette, roulette_rule, rr_depth, max_depth, \
                  estimator, majorant_resolution, lookup, accumulation, strategy or math"
@@ -208,8 +200,8 @@ struct Configuration {
     label: String,
     settings: PathSettings,
     /// The grid lookup; `None` keeps the scene's (or `--lookup`'s).
-    lookup: Option<LookupArg>,
-    accumulation: AccumulationArg,
+    lookup: Option<GridLookup>,
+    accumulation: Accumulation,
     /// Backend, GPU strategy: each configuration opens its own backend from these.
     sampling: SamplingArgs,
 }
@@ -225,7 +217,7 @@ fn configurations(
         label: String::new(),
         settings: scene,
         lookup: None,
-        accumulation: AccumulationArg::F64,
+        accumulation: Accumulation::F64,
         sampling: sampling.clone(),
     }];
     for values in settings {
@@ -277,43 +269,6 @@ impl Row {
     }
 }
 
-/// What the estimate is compared with: per pixel channel.
-enum Reference {
-    Constant([f32; 3]),
-    /// An image, and the variance of its pixels as estimates (mean over pixel channels).
-    Image(Image, f64),
-}
-
-impl Reference {
-    fn variance(&self) -> f64 {
-        match self {
-            Reference::Constant(_) => 0.0,
-            Reference::Image(_, variance) => *variance,
-        }
-    }
-
-    /// The mean of two independent renders, and the variance of that mean.
-    fn from_halves(a: &Image, b: &Image) -> Self {
-        let mut mean = a.clone();
-        let mut variance = 0.0;
-        for (m, pb) in mean.pixels.iter_mut().zip(&b.pixels) {
-            for c in 0..3 {
-                variance += (0.5 * (m[c] as f64 - pb[c] as f64)).powi(2);
-                m[c] = 0.5 * (m[c] + pb[c]);
-            }
-        }
-        let count = 3.0 * a.pixels.len() as f64;
-        Reference::Image(mean, variance / count)
-    }
-
-    fn at(&self, pixel: usize, channel: usize) -> f64 {
-        match self {
-            Reference::Constant(rgb) => rgb[channel] as f64,
-            Reference::Image(image, _) => image.pixels[pixel][channel] as f64,
-        }
-    }
-}
-
 /// Both halves of the samples: two films that grow by a batch per round, in the configuration's
 /// precision, each from its own seed.
 struct Halves {
@@ -324,22 +279,9 @@ struct Halves {
 impl Halves {
     /// MSE, relative MSE and the variance of the estimate, over all pixel channels.
     fn errors(&self, reference: &Reference) -> (f64, f64, f64) {
-        let n = self.spp_each as f64;
-        let [a, b] = [&self.films[0].sums, &self.films[1].sums];
-        let (mut mse, mut rel, mut var) = (0.0, 0.0, 0.0);
-        for (i, (a, b)) in a.iter().zip(b).enumerate() {
-            for c in 0..3 {
-                let (ma, mb) = (a[c] / n, b[c] / n);
-                let estimate = 0.5 * (ma + mb);
-                let r = reference.at(i, c);
-                let e2 = (estimate - r).powi(2);
-                mse += e2;
-                rel += e2 / (r * r + 0.01);
-                var += (0.5 * (ma - mb)).powi(2);
-            }
-        }
-        let count = 3.0 * a.len() as f64;
-        (mse / count, rel / count, var / count)
+        let [a, b] = &self.films;
+        let e = errors_of_halves(a, b, self.spp_each, reference);
+        (e.mse, e.rel_mse, e.variance)
     }
 }
 
@@ -367,7 +309,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     // Before the reference, so that a configuration a backend cannot render costs nothing.
     if let Some(c) = configurations
         .iter()
-        .find(|c| c.sampling.backend == BackendKind::Cuda && c.accumulation == AccumulationArg::F32)
+        .find(|c| c.sampling.backend == BackendKind::Cuda && c.accumulation == Accumulation::F32)
     {
         bail!(
             "{}: the GPU film sums in f64 only; compare accumulations with --backend cpu",
@@ -399,10 +341,10 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         // default.
         let request = RenderRequest {
             path: Some(config.settings),
-            lookup: config.lookup.map(Into::into),
+            lookup: config.lookup,
             ..RenderRequest::default()
         };
-        let film = Film::new(w, h).with_accumulation(config.accumulation.into());
+        let film = Film::new(w, h).with_accumulation(config.accumulation);
         let mut halves = Halves {
             films: [film.clone(), film],
             spp_each: 0,
@@ -469,7 +411,10 @@ fn reference(args: &ConvergeArgs, scene: &Scene, backend: &Backend) -> Result<Re
                 image.height
             );
         }
-        return Ok(Reference::Image(image, 0.0));
+        return Ok(Reference::Image {
+            image,
+            variance: 0.0,
+        });
     }
     if let Some(rgb) = white_furnace(desc) {
         tracing::info!(
@@ -725,13 +670,13 @@ mod tests {
         assert_eq!(
             parse_setting("lookup=trilinear,nearest").unwrap(),
             vec![
-                Choice::Lookup(LookupArg::Trilinear),
-                Choice::Lookup(LookupArg::Nearest)
+                Choice::Lookup(GridLookup::Trilinear),
+                Choice::Lookup(GridLookup::Nearest)
             ]
         );
         assert_eq!(
             parse_setting("accumulation=f32").unwrap(),
-            vec![Choice::Accumulation(AccumulationArg::F32)]
+            vec![Choice::Accumulation(Accumulation::F32)]
         );
         assert_eq!(
             parse_setting("strategy=naive-sk").unwrap(),
@@ -754,28 +699,28 @@ mod tests {
             label: String::new(),
             settings: scene,
             lookup: None,
-            accumulation: AccumulationArg::F64,
+            accumulation: Accumulation::F64,
             sampling,
         };
         for choice in [
             Choice::MaxDepth(Some(3)),
             Choice::Roulette(false),
-            Choice::Lookup(LookupArg::Nearest),
-            Choice::Accumulation(AccumulationArg::F32),
+            Choice::Lookup(GridLookup::Nearest),
+            Choice::Accumulation(Accumulation::F32),
             Choice::Strategy(Strategy::NaiveSk),
         ] {
             choice.apply(&mut config, &scene);
         }
         let s = config.settings;
         assert_eq!((s.max_depth, s.rr_depth), (3, PathSettings::UNLIMITED));
-        assert_eq!(config.lookup, Some(LookupArg::Nearest));
-        assert_eq!(config.accumulation, AccumulationArg::F32);
+        assert_eq!(config.lookup, Some(GridLookup::Nearest));
+        assert_eq!(config.accumulation, Accumulation::F32);
         assert_eq!(
             config.sampling.gpu.strategy,
-            Some(StrategyArg::Fixed(Strategy::NaiveSk))
+            Some(StrategyChoice::Fixed(Strategy::NaiveSk))
         );
         assert_eq!(
-            Choice::Accumulation(AccumulationArg::F32).label(),
+            Choice::Accumulation(Accumulation::F32).label(),
             "accumulation=f32"
         );
     }

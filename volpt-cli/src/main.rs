@@ -13,13 +13,12 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{Args, Parser, Subcommand};
 use tracing_subscriber::EnvFilter;
 use volpt::{
-    Backend, BackendOptions, Effects, Estimator, GridLookup, Image, RenderSettings, RenderStats,
-    Roulette, Scene, Variant,
+    Backend, BackendOptions, Effects, Estimator, GridLookup, Image, Named, RenderSettings,
+    RenderStats, Roulette, Scene, Tracking, Variant,
 };
-use volpt_film::Accumulation;
 use volpt_render::image::preview_path;
 
 use backend::{BackendKind, GpuArgs, Terminal};
@@ -133,122 +132,34 @@ struct SceneArgs {
     /// Delta and ratio tracking under one global majorant or a majorant grid (default: chosen per
     /// scene by the tracking work along camera rays, `volpt info` says which and why; `grid`
     /// without --majorant-resolution: the scene's grid, else 32 cells along the longest axis).
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = named::<Tracking>())]
     tracking: Option<Tracking>,
     /// Cells of the majorant grid along the box's longest axis (1 is the global majorant).
-    #[arg(long, value_name = "CELLS", value_parser = clap::value_parser!(u32).range(1..=1024))]
+    #[arg(long, value_name = "CELLS")]
     majorant_resolution: Option<u32>,
     /// How paths gather the environment's light (default: nee for a lat-long map behind an
     /// index-matched or around a rough boundary, pt elsewhere; a smooth dielectric rules nee out).
-    #[arg(long, value_enum)]
-    estimator: Option<EstimatorArg>,
+    #[arg(long, value_parser = named::<Estimator>())]
+    estimator: Option<Estimator>,
     /// How the medium's grids are reconstructed between samples (default: stochastic on a GPU
     /// with fast math where textures fit in its memory, else trilinear).
-    #[arg(long, value_enum)]
-    lookup: Option<LookupArg>,
+    #[arg(long, value_parser = named::<GridLookup>())]
+    lookup: Option<GridLookup>,
     /// Russian roulette's survival probability (default: mitsuba); where it starts is --rr-depth.
-    #[arg(long, value_enum)]
-    roulette: Option<RouletteArg>,
+    #[arg(long, value_parser = named::<Roulette>())]
+    roulette: Option<Roulette>,
 }
 
-/// `--roulette`: Russian roulette's survival probability (`volpt_core::Roulette`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-enum RouletteArg {
-    /// Mitsuba's: min(max(throughput) * eta^2, 0.95).
-    Mitsuba,
-    /// The thesis's: min(1, max(throughput) * eta^2) (its throughput leaves out the radiance's
-    /// 1/eta^2 inside a denser medium).
-    Throughput,
-}
-
-impl From<RouletteArg> for Roulette {
-    fn from(r: RouletteArg) -> Self {
-        match r {
-            RouletteArg::Mitsuba => Roulette::Mitsuba,
-            RouletteArg::Throughput => Roulette::Throughput,
-        }
-    }
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-enum Tracking {
-    /// One majorant, the densest voxel's extinction, everywhere.
-    Global,
-    /// A majorant per cell of a coarse grid, walked by a 3D DDA.
-    Grid,
-}
-
-impl From<Tracking> for volpt::Tracking {
-    fn from(t: Tracking) -> Self {
-        match t {
-            Tracking::Global => volpt::Tracking::Global,
-            Tracking::Grid => volpt::Tracking::Grid,
-        }
-    }
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-enum EstimatorArg {
-    /// Path tracing: light only where a path escapes.
-    Pt,
-    /// Next-event estimation of the environment at scattering events (index-matched boundary) or
-    /// at the boundary (rough dielectric), with MIS.
-    Nee,
-}
-
-impl From<EstimatorArg> for Estimator {
-    fn from(e: EstimatorArg) -> Self {
-        match e {
-            EstimatorArg::Pt => Estimator::PathTracing,
-            EstimatorArg::Nee => Estimator::NextEvent,
-        }
-    }
-}
-
-/// `--lookup`: a grid's reconstruction.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-enum LookupArg {
-    /// Trilinear interpolation of the eight samples around a point.
-    Trilinear,
-    /// The nearest sample's value: one read instead of eight.
-    Nearest,
-    /// Trilinear filtering by the GPU's texture unit (weights with 8 fractional bits; the CPU
-    /// computes the same filter): one instruction per lookup, an approximation of trilinear.
-    Texture,
-    /// texture, of samples held in half precision (rounded toward zero; at most 65504).
-    #[value(name = "texture-f16")]
-    TextureF16,
-    /// One of the eight samples, chosen with probability its trilinear weight: an unbiased
-    /// estimate of trilinear for one read (on the GPU one unfiltered texel).
-    Stochastic,
-}
-
-impl From<LookupArg> for GridLookup {
-    fn from(lookup: LookupArg) -> Self {
-        match lookup {
-            LookupArg::Trilinear => GridLookup::Trilinear,
-            LookupArg::Nearest => GridLookup::Nearest,
-            LookupArg::Texture => GridLookup::Texture,
-            LookupArg::TextureF16 => GridLookup::TextureHalf,
-            LookupArg::Stochastic => GridLookup::Stochastic,
-        }
-    }
-}
-
-/// The precision a film adds samples in (`volpt converge --setting accumulation=...`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-enum AccumulationArg {
-    F64,
-    F32,
-}
-
-impl From<AccumulationArg> for Accumulation {
-    fn from(a: AccumulationArg) -> Self {
-        match a {
-            AccumulationArg::F64 => Accumulation::F64,
-            AccumulationArg::F32 => Accumulation::F32,
-        }
-    }
+/// The value parser of a flag that takes one of the library's choices ([`volpt::Named`]): its
+/// names and their help come from the library's table, so the CLI keeps none of its own.
+pub(crate) fn named<T: Named>() -> impl clap::builder::TypedValueParser<Value = T> {
+    use clap::builder::TypedValueParser as _;
+    clap::builder::PossibleValuesParser::new(
+        T::all()
+            .iter()
+            .map(|v| clap::builder::PossibleValue::new(v.name()).help(v.about())),
+    )
+    .map(|name| volpt::names::parse::<T>(&name).expect("clap takes only the table's names"))
 }
 
 impl SceneArgs {
@@ -261,11 +172,11 @@ impl SceneArgs {
             resolution: self.resolution,
             max_depth: self.max_depth.map(depth),
             rr_depth: self.rr_depth.map(depth),
-            tracking: self.tracking.map(Into::into),
+            tracking: self.tracking,
             majorant_resolution: self.majorant_resolution,
-            estimator: self.estimator.map(Into::into),
-            lookup: self.lookup.map(Into::into),
-            roulette: self.roulette.map(Into::into),
+            estimator: self.estimator,
+            lookup: self.lookup,
+            roulette: self.roulette,
             effects: if self.general {
                 Effects::General
             } else {
@@ -290,7 +201,7 @@ struct SamplingArgs {
     #[arg(long)]
     threads: Option<usize>,
     /// Where to render.
-    #[arg(long, value_enum, default_value_t = BackendKind::Cpu)]
+    #[arg(long, value_parser = named::<BackendKind>(), default_value_t = BackendKind::Cpu)]
     backend: BackendKind,
     #[command(flatten)]
     gpu: GpuArgs,
@@ -302,7 +213,7 @@ impl SamplingArgs {
     /// Opens the backend these flags name; flags that do not apply to it are refused.
     fn open(&self) -> Result<Backend> {
         Ok(Backend::open(&BackendOptions {
-            kind: self.backend.into(),
+            kind: self.backend,
             gpu: self.gpu.options(&self.volumes),
         })?)
     }
@@ -467,6 +378,26 @@ fn parse_param(s: &str) -> Result<(String, String), String> {
 }
 
 fn main() -> Result<()> {
+    run().map_err(spelled_as_flags)
+}
+
+/// A library error of one setting, its key spelled as the flag that sets it
+/// (`majorant_resolution`: `--majorant-resolution`); any other error as it is.
+fn spelled_as_flags(error: anyhow::Error) -> anyhow::Error {
+    match error.downcast_ref::<volpt::Error>() {
+        Some(volpt::Error::Setting {
+            key,
+            expected,
+            found,
+        }) if error.chain().count() == 1 => anyhow::anyhow!(
+            "--{}: expected {expected}, found {found}",
+            key.replace('_', "-")
+        ),
+        _ => error,
+    }
+}
+
+fn run() -> Result<()> {
     tracing_subscriber::fmt()
         .with_env_filter(
             EnvFilter::try_from_default_env().unwrap_or_else(|_| EnvFilter::new("info")),
@@ -518,7 +449,7 @@ fn main() -> Result<()> {
                 token: args.token,
                 tev: args.tev,
                 backend: BackendOptions {
-                    kind: args.sampling.backend.into(),
+                    kind: args.sampling.backend,
                     gpu: args.sampling.gpu.options(&args.sampling.volumes),
                 },
             };

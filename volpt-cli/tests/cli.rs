@@ -191,6 +191,21 @@ fn half_texels_refuse_a_grid_beyond_their_range() {
 }
 
 #[test]
+fn the_majorant_grid_bound_is_the_librarys_in_the_flags_spelling() {
+    let e = example();
+    let e = e.to_str().unwrap();
+    for cells in ["0", "1025"] {
+        let out = volpt(&["info", e, "--majorant-resolution", cells]);
+        let words = format!("--majorant-resolution: expected 1 to 1024 cells, found {cells}");
+        assert_clean_error(&out, &[&words]);
+        let setting = format!("majorant_resolution={cells}");
+        let out = volpt(&["converge", e, "--setting", &setting]);
+        let words = format!("majorant_resolution: expected 1 to 1024 cells, found {cells}");
+        assert_clean_error(&out, &[&words]);
+    }
+}
+
+#[test]
 fn zero_threads_and_zero_trials_are_refused() {
     let e = example();
     let out = volpt(&["render", e.to_str().unwrap(), "--threads", "0"]);

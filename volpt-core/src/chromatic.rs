@@ -2,9 +2,11 @@
 //! spectral MIS that tracks it without bias and without the variance of one channel's tracking.
 //!
 //! `sigma_t(p) = extinction * density(p)`: an RGB extinction times an optional density grid (none:
-//! density 1, a homogeneous chromatic medium); the albedo is a constant or an RGB grid. Which of
-//! these a medium has is a run-time branch inside the one type, so chromatic media add one value
-//! to the registry's medium axis, not a cartesian product of their own.
+//! density 1, a homogeneous chromatic medium); the albedo is a constant or an RGB grid. Or a
+//! material-indexed volume ([`crate::material`]): extinction, albedo and phase asymmetry from the
+//! table row of the voxel's material. Which of these a medium has is a run-time branch inside the
+//! one type, so chromatic media add one value to the registry's medium axis, not a cartesian
+//! product of their own.
 //!
 //! Tracking ([`crate::tracking::spectral_delta_tracking`]) uses one majorant that bounds every
 //! channel (`max(extinction) * max(density)`, or per majorant-grid cell), samples the tentative
@@ -17,7 +19,7 @@
 //! `1 - w_c` (a null one) under channel `c`. The path's contribution in channel `c` is
 //! `f_c / mean_j p_j = (f_c / p_c) * r_c` with `r_c = p_c / mean_j p_j`: `f_c / p_c` is what a grey
 //! medium's throughput already holds (albedos, BSDF weights, roulette; a null collision's
-//! `sigma_n / sigma_n` is 1), and [`rescale`] keeps `r` (`PathState::r_u`) event by event.
+//! `sigma_n / sigma_n` is 1), and [`rescale`] keeps `r` ([`HeroChannel::r_u`]) event by event.
 //! Every `r_c` stays in `[0, 3]` and finite by construction; a path whose `r` would be all zero
 //! (its hero's density underflowed) ends, which loses only light below f32's range.
 
@@ -26,8 +28,10 @@ use bytemuck::{Pod, Zeroable};
 use crate::abi::{Component, GridParams, Upload};
 use crate::grid::{DenseTrilinear, Grid, GridPlacement, GridReads};
 use crate::majorant::{MajorantGrid, MajorantGridParams};
+use crate::material::{MaterialGrid, MaterialGridParams};
 use crate::medium::{Medium, TrackedMedium};
 use crate::rng::Rng;
+use crate::spectral::HeroChannel;
 use crate::{Spectrum, Vec3};
 
 /// A chromatic medium: `sigma_t(p) = extinction * density(p)` per channel, read trilinearly.
@@ -44,6 +48,9 @@ pub struct ChromaticMedium<'a> {
     /// The albedo where there is no albedo grid.
     pub albedo: Spectrum,
     pub albedo_grid: Option<Grid<'a, 3>>,
+    /// A material-indexed volume, which then alone gives the extinction, albedo and phase
+    /// asymmetry (`extinction`, `density`, `albedo` and `albedo_grid` are not read).
+    pub materials: Option<MaterialGrid<'a>>,
 }
 
 impl<'a> ChromaticMedium<'a> {
@@ -62,13 +69,28 @@ impl<'a> ChromaticMedium<'a> {
             majorants: None,
             albedo,
             albedo_grid,
+            materials: None,
+        }
+    }
+
+    /// The medium of a material-indexed volume, whose majorant is its materials' largest
+    /// extinction.
+    pub fn indexed(materials: MaterialGrid<'a>) -> Self {
+        Self {
+            extinction: Spectrum::ZERO,
+            density: None,
+            majorant: materials.max_extinction(),
+            majorants: None,
+            albedo: Spectrum::ZERO,
+            albedo_grid: None,
+            materials: Some(materials),
         }
     }
 }
 
 impl Medium for ChromaticMedium<'_> {
+    type Spectral = HeroChannel;
     const HOMOGENEOUS: bool = false;
-    const CHROMATIC: bool = true;
 
     #[inline]
     fn majorant(&self) -> f32 {
@@ -88,6 +110,9 @@ impl Medium for ChromaticMedium<'_> {
 
     #[inline(always)]
     fn sigma_t_rgb(&self, p: Vec3) -> Spectrum {
+        if let Some(materials) = &self.materials {
+            return materials.sigma_t(p);
+        }
         match &self.density {
             Some(grid) => self.extinction * DenseTrilinear::lookup(grid, p)[0],
             None => self.extinction,
@@ -96,6 +121,9 @@ impl Medium for ChromaticMedium<'_> {
 
     #[inline(always)]
     fn uniform_sigma_t_rgb(&self) -> Option<Spectrum> {
+        if let Some(materials) = &self.materials {
+            return materials.uniform_sigma_t();
+        }
         match self.density {
             Some(_) => None,
             None => Some(self.extinction),
@@ -104,10 +132,18 @@ impl Medium for ChromaticMedium<'_> {
 
     #[inline(always)]
     fn albedo(&self, p: Vec3) -> Spectrum {
+        if let Some(materials) = &self.materials {
+            return materials.albedo(p);
+        }
         match &self.albedo_grid {
             Some(grid) => Spectrum::from_array(DenseTrilinear::lookup(grid, p)),
             None => self.albedo,
         }
+    }
+
+    #[inline(always)]
+    fn phase_g(&self, p: Vec3) -> Option<f32> {
+        self.materials.as_ref().map(|m| m.g(p))
     }
 }
 
@@ -119,6 +155,10 @@ impl<'a> TrackedMedium<'a> for ChromaticMedium<'a> {
 
     fn track_with(&mut self, grid: Option<MajorantGrid<'a>>) {
         self.majorants = grid;
+    }
+
+    fn materials(&self) -> Option<MaterialGrid<'a>> {
+        self.materials
     }
 }
 
@@ -151,6 +191,7 @@ pub struct ChromaticParams {
     pub density: GridParams,
     pub albedo_grid: GridParams,
     pub majorants: MajorantGridParams,
+    pub materials: MaterialGridParams,
     pub extinction: [f32; 3],
     pub majorant: f32,
     pub albedo: [f32; 3],
@@ -175,6 +216,7 @@ impl Component for ChromaticMedium<'_> {
             density: optional_grid(self.density.as_ref(), upload),
             albedo_grid: optional_grid(self.albedo_grid.as_ref(), upload),
             majorants: MajorantGridParams::new(self.majorants.as_ref(), upload),
+            materials: MaterialGridParams::new(self.materials.as_ref(), upload),
             extinction: self.extinction.to_array(),
             majorant: self.majorant,
             albedo: self.albedo.to_array(),
@@ -194,6 +236,8 @@ impl Component for ChromaticMedium<'_> {
             albedo: Spectrum::from_array(p.albedo),
             // SAFETY: forwarded to the caller.
             albedo_grid: (p.albedo_grid.len > 0).then(|| unsafe { p.albedo_grid.grid::<3>() }),
+            // SAFETY: forwarded to the caller.
+            materials: unsafe { p.materials.grid() },
         }
     }
 }

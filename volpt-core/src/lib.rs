@@ -22,6 +22,7 @@ pub mod fresnel;
 pub mod geometry;
 pub mod grid;
 pub mod majorant;
+pub mod material;
 pub mod math;
 pub mod medium;
 pub mod mesh;
@@ -33,6 +34,7 @@ pub mod sampling;
 pub mod scene;
 pub mod shape;
 pub mod sparse;
+pub mod spectral;
 pub mod tracking;
 pub mod variant;
 
@@ -49,16 +51,18 @@ pub use grid::{
     TexelFormat, TextureTrilinear,
 };
 pub use majorant::MajorantGrid;
+pub use material::{Material, MaterialGrid};
 pub use medium::{
     AlbedoField, ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium, Medium, ReadAs,
     TrackedMedium,
 };
 pub use mesh::{BvhNode, MeshTriangle, TriangleMesh};
-pub use path::{Estimator, PathCounters, PathSettings, PathState, Roulette};
+pub use path::{Estimator, PathCounters, PathOf, PathSettings, PathState, Roulette};
 pub use phase::{HenyeyGreenstein, Isotropic, PhaseFunction};
 pub use rng::Rng;
 pub use scene::{Scene, VolumeScene, WithShape};
 pub use shape::Shape;
+pub use spectral::{HeroChannel, SpectralState};
 
 /// Linear RGB radiance, throughput or albedo.
 pub type Spectrum = glam::Vec3;

@@ -25,7 +25,7 @@ pub struct MajorantGrid<'a> {
 
 /// The part of a cell a point may be assigned to by the DDA although rounding puts it just outside:
 /// each cell's bound covers its box grown by this fraction of a cell on every side.
-const CELL_MARGIN: f32 = 0.01;
+pub(crate) const CELL_MARGIN: f32 = 0.01;
 
 impl<'a> MajorantGrid<'a> {
     /// `data.len()` must be `res_x * res_y * res_z`, every resolution at least 1.

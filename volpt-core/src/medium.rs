@@ -2,7 +2,7 @@
 //!
 //! Extinction is grey (one `sigma_t` for all channels) in every medium here; albedo is RGB. Delta
 //! tracking then needs one majorant and no spectral MIS, and coloured albedo only scales the path
-//! throughput. A chromatic extinction is [`crate::chromatic`]'s ([`Medium::CHROMATIC`]).
+//! throughput. A chromatic extinction is [`crate::chromatic`]'s ([`Medium::Spectral`]).
 
 use bytemuck::{Pod, Zeroable};
 
@@ -10,6 +10,8 @@ use crate::abi::name::Joined;
 use crate::abi::{Component, GridParams, Upload};
 use crate::grid::{DenseTrilinear, Grid, GridReads};
 use crate::majorant::{MajorantGrid, MajorantGridParams};
+use crate::material::MaterialGrid;
+use crate::spectral::SpectralState;
 use crate::{Spectrum, Vec3};
 
 pub trait Medium {
@@ -18,10 +20,12 @@ pub trait Medium {
     /// The albedo is the same everywhere and reads no memory: a strategy that orders albedo reads
     /// (sorting-sk) has nothing to order.
     const CONSTANT_ALBEDO: bool = false;
-    /// The extinction differs between channels: paths track it by a hero channel with spectral
-    /// MIS ([`crate::chromatic`]) and read [`Medium::sigma_t_rgb`]; [`Medium::sigma_t`] and the
-    /// majorants bound every channel. A grey medium compiles none of that.
-    const CHROMATIC: bool = false;
+    /// What a path carries for this medium's extinction ([`crate::spectral`]): `()` for a grey
+    /// one. A chromatic one ([`crate::spectral::HeroChannel`]) differs between channels: paths
+    /// track it by a hero channel with spectral MIS ([`crate::chromatic`]) and read
+    /// [`Medium::sigma_t_rgb`]; [`Medium::sigma_t`] and the majorants bound every channel. A grey
+    /// medium compiles none of that.
+    type Spectral: SpectralState;
 
     /// An upper bound of `sigma_t` over the medium (the majorant of delta tracking).
     fn majorant(&self) -> f32;
@@ -60,6 +64,13 @@ pub trait Medium {
     fn albedo_random(&self, p: Vec3, _bits: u64) -> Spectrum {
         self.albedo(p)
     }
+
+    /// The Henyey-Greenstein asymmetry of the material at `p`, if the medium's materials carry
+    /// their own ([`crate::material`]); `None`: the scene's phase function holds everywhere.
+    #[inline(always)]
+    fn phase_g(&self, _p: Vec3) -> Option<f32> {
+        None
+    }
 }
 
 /// What the host's factory derives from a medium for tracking: a medium with a density grid
@@ -76,6 +87,12 @@ pub trait TrackedMedium<'a> {
     fn track_with(&mut self, grid: Option<MajorantGrid<'a>>) {
         let _ = grid;
     }
+
+    /// The material-indexed volume whose majorant grid tightens tracking
+    /// ([`crate::material::build_material_majorants`]), if the medium is one.
+    fn materials(&self) -> Option<MaterialGrid<'a>> {
+        None
+    }
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -85,6 +102,7 @@ pub struct HomogeneousMedium {
 }
 
 impl Medium for HomogeneousMedium {
+    type Spectral = ();
     const HOMOGENEOUS: bool = true;
     const CONSTANT_ALBEDO: bool = true;
 
@@ -171,6 +189,7 @@ pub struct GridMedium<'a, A, R = DenseTrilinear> {
 }
 
 impl<A: AlbedoField, R: GridReads> Medium for GridMedium<'_, A, R> {
+    type Spectral = ();
     const HOMOGENEOUS: bool = false;
     const CONSTANT_ALBEDO: bool = A::CONSTANT;
 

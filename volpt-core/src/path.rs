@@ -25,14 +25,14 @@
 //! ([`Roulette`]); before `rr_depth`, or with roulette off, a path faces roulette only once that
 //! weight is negligible ([`NEGLIGIBLE_WEIGHT`]).
 //!
-//! A chromatic medium ([`Medium::CHROMATIC`]) is tracked by the path's hero channel with spectral
-//! MIS ([`crate::chromatic`]): the light a path gathers is then its throughput times its path
-//! densities `r_u`; a grey medium's path never reads them.
+//! A chromatic medium is tracked by the path's hero channel with spectral MIS
+//! ([`crate::chromatic`]): the light a path gathers is then its throughput times its path
+//! densities `r_u`. What a path carries for that is its medium's [`Medium::Spectral`]
+//! ([`crate::spectral`]): nothing for a grey medium, whose paths compile plain tracking.
 
 use core::ops::Range;
 
 use crate::bsdf::Bsdf;
-use crate::chromatic::choose_hero;
 use crate::environment::Environment;
 use crate::geometry::BoxHit;
 use crate::medium::Medium;
@@ -40,9 +40,8 @@ use crate::phase::PhaseFunction;
 use crate::rng::Rng;
 use crate::scene::Scene;
 use crate::shape::Shape;
-use crate::tracking::{
-    delta_tracking, ratio_tracking, spectral_delta_tracking, spectral_ratio_tracking, FreeFlight,
-};
+use crate::spectral::SpectralState;
+use crate::tracking::FreeFlight;
 use crate::{Ray, Spectrum, Vec3};
 
 /// The integrator's limits.
@@ -143,10 +142,17 @@ impl Default for PathSettings {
     }
 }
 
+/// The spectral state of a path of scene `S` ([`Medium::Spectral`]).
+pub type SpectralOf<S> = <<S as Scene>::Medium as Medium>::Spectral;
+
+/// The state of a path of scene `S`.
+pub type PathOf<S> = PathState<SpectralOf<S>>;
+
 /// Everything a path carries between steps: small and `Copy`, so that strategies can park paths in
-/// device memory and resume them anywhere.
+/// device memory and resume them anywhere. `X` is what its medium's extinction needs
+/// ([`crate::spectral`]): nothing for a grey one.
 #[derive(Clone, Copy, Debug)]
-pub struct PathState {
+pub struct PathState<X = ()> {
     pub ray: Ray,
     pub throughput: Spectrum,
     /// Radiance gathered so far (only ever added when the path escapes).
@@ -162,16 +168,13 @@ pub struct PathState {
     pub tracking_steps: u32,
     pub inside: bool,
     pub alive: bool,
-    /// The channel whose extinction samples this path's collisions in a chromatic medium.
-    pub hero: u8,
     /// Whether, and by which safety bound, the path was cut.
     pub truncated: Truncation,
     /// The phase function's density of the current direction if next-event estimation also
     /// sampled the environment at its origin (the escape is then weighted by MIS), else 0.
     pub mis_pdf: f32,
-    /// In a chromatic medium, the path's density under each channel over their mean (pbrt-v4's
-    /// rescaled `r_u`; mean 1, each in `[0, 3]`): the light it gathers is `throughput * r_u`.
-    pub r_u: Spectrum,
+    /// The hero channel and path densities of a chromatic medium's path; nothing for a grey one.
+    pub spectral: X,
 }
 
 /// Which safety bound of [`PathSettings`] ended a path (it then contributes zero).
@@ -184,18 +187,17 @@ pub enum Truncation {
     TrackingSteps,
 }
 
-impl PathState {
+impl<X: SpectralState> PathState<X> {
     /// Sample `sample` of pixel `(px, py)`: a camera ray through a uniformly jittered film position.
     #[inline]
-    pub fn from_camera<S: Scene>(scene: &S, px: u32, py: u32, sample: u32, seed: u32) -> Self {
+    pub fn from_camera<S: Scene>(scene: &S, px: u32, py: u32, sample: u32, seed: u32) -> Self
+    where
+        S::Medium: Medium<Spectral = X>,
+    {
         let camera = scene.camera();
         let mut rng = Rng::new(seed, py * camera.width + px, sample);
         let ray = camera.generate_ray(px, py, rng.next_2d());
-        let hero = if S::Medium::CHROMATIC {
-            choose_hero(&mut rng)
-        } else {
-            0
-        };
+        let spectral = X::start(&mut rng);
         Self {
             ray,
             throughput: Spectrum::ONE,
@@ -207,22 +209,17 @@ impl PathState {
             tracking_steps: 0,
             inside: scene.shape().contains(ray.origin),
             alive: true,
-            hero,
             truncated: Truncation::None,
             mis_pdf: 0.0,
-            r_u: Spectrum::ONE,
+            spectral,
         }
     }
 
     /// What the path's light is multiplied by: its throughput, times its path densities `r_u` in a
     /// chromatic medium (the balance heuristic's weight over the channels).
     #[inline(always)]
-    fn weight<S: Scene>(&self) -> Spectrum {
-        if S::Medium::CHROMATIC {
-            self.throughput * self.r_u
-        } else {
-            self.throughput
-        }
+    fn weight(&self) -> Spectrum {
+        self.spectral.weight(self.throughput)
     }
 
     /// Whether this path samples the environment at its scattering events.
@@ -259,8 +256,8 @@ impl PathState {
     /// Russian roulette after an interaction: from `rr_depth` on by the scene's rule, before it
     /// (or with roulette off) only once the path's weight is negligible ([`NEGLIGIBLE_WEIGHT`]).
     #[inline]
-    fn russian_roulette<S: Scene>(&mut self, settings: &PathSettings) {
-        let weight = self.weight::<S>().max_element() * self.eta_scale * self.eta_scale;
+    fn russian_roulette(&mut self, settings: &PathSettings) {
+        let weight = self.weight().max_element() * self.eta_scale * self.eta_scale;
         let q = if self.depth > settings.rr_depth {
             match settings.roulette {
                 Roulette::Mitsuba => weight.min(0.95),
@@ -281,7 +278,7 @@ impl PathState {
 
 /// Advances `path` by one free flight and the event that ends it.
 #[inline(always)]
-pub fn step<S: Scene>(scene: &S, path: &mut PathState) {
+pub fn step<S: Scene>(scene: &S, path: &mut PathOf<S>) {
     advance::<S, false>(scene, path);
 }
 
@@ -291,7 +288,7 @@ pub fn step<S: Scene>(scene: &S, path: &mut PathState) {
 /// the albedo draws no random number (a stochastic lookup peeks at the next one,
 /// [`crate::rng::Rng::peek_u64`]), so the path is the same either way.
 #[inline(always)]
-pub fn fly<S: Scene>(scene: &S, path: &mut PathState) -> Option<Vec3> {
+pub fn fly<S: Scene>(scene: &S, path: &mut PathOf<S>) -> Option<Vec3> {
     advance::<S, true>(scene, path)
 }
 
@@ -299,7 +296,7 @@ pub fn fly<S: Scene>(scene: &S, path: &mut PathState) -> Option<Vec3> {
 /// the split (returning the collision from the middle of the step reordered the kernels' code and
 /// cost regeneration-sk 3% on the cubes, H100, 2026-11-24).
 #[inline(always)]
-fn advance<S: Scene, const DEFER_SCATTER: bool>(scene: &S, path: &mut PathState) -> Option<Vec3> {
+fn advance<S: Scene, const DEFER_SCATTER: bool>(scene: &S, path: &mut PathOf<S>) -> Option<Vec3> {
     // Mitsuba's max_depth 0 allows no segment at all: the image is black.
     if scene.settings().max_depth == 0 {
         path.alive = false;
@@ -312,33 +309,19 @@ fn advance<S: Scene, const DEFER_SCATTER: bool>(scene: &S, path: &mut PathState)
     }
     if path.inside {
         let t_exit = scene.shape().exit_distance(&path.ray);
-        let collision = if S::Medium::CHROMATIC {
-            let flight = spectral_delta_tracking(
-                scene.medium(),
-                &path.ray,
-                t_exit,
-                &mut path.rng,
-                path.hero,
-                &mut path.r_u,
-                &mut path.tracking_steps,
-                scene.settings().max_tracking_steps,
-            );
-            if path.r_u == Spectrum::ZERO {
-                // No channel's density is left: the path weighs nothing (`chromatic::rescale`).
-                path.alive = false;
-                return None;
-            }
-            flight
-        } else {
-            delta_tracking(
-                scene.medium(),
-                &path.ray,
-                t_exit,
-                &mut path.rng,
-                &mut path.tracking_steps,
-                scene.settings().max_tracking_steps,
-            )
-        };
+        let collision = path.spectral.free_flight(
+            scene.medium(),
+            &path.ray,
+            t_exit,
+            &mut path.rng,
+            &mut path.tracking_steps,
+            scene.settings().max_tracking_steps,
+        );
+        if path.spectral.is_void() {
+            // No channel's density is left: the path weighs nothing (`chromatic::rescale`).
+            path.alive = false;
+            return None;
+        }
         match collision {
             FreeFlight::Collision(t) => {
                 let p = path.ray.at(t);
@@ -357,9 +340,9 @@ fn advance<S: Scene, const DEFER_SCATTER: bool>(scene: &S, path: &mut PathState)
         match scene.shape().entry(&path.ray) {
             Some(hit) => interact_with_boundary(scene, path, hit),
             None => {
-                let mut light = path.weight::<S>() * scene.background(path.ray.dir);
-                let weighted =
-                    PathState::uses_next_event(scene) || PathState::uses_boundary_next_event(scene);
+                let mut light = path.weight() * scene.background(path.ray.dir);
+                let weighted = PathOf::<S>::uses_next_event(scene)
+                    || PathOf::<S>::uses_boundary_next_event(scene);
                 if weighted && path.mis_pdf > 0.0 {
                     let light_pdf = scene.environment().pdf(path.ray.dir);
                     light *= power_heuristic(path.mis_pdf, light_pdf);
@@ -374,7 +357,7 @@ fn advance<S: Scene, const DEFER_SCATTER: bool>(scene: &S, path: &mut PathState)
 
 /// Runs `path` to its end.
 #[inline]
-pub fn trace<S: Scene>(scene: &S, path: &mut PathState) {
+pub fn trace<S: Scene>(scene: &S, path: &mut PathOf<S>) {
     while path.alive {
         step(scene, path);
     }
@@ -409,7 +392,7 @@ pub fn sample_pixel<S: Scene>(
 /// estimator) and the phase function, sampled exactly, gives the new direction.
 /// Always inlined: a GPU call taking the scene by address moves it into local memory.
 #[inline(always)]
-pub fn scatter<S: Scene>(scene: &S, path: &mut PathState, p: Vec3, albedo: Option<Spectrum>) {
+pub fn scatter<S: Scene>(scene: &S, path: &mut PathOf<S>, p: Vec3, albedo: Option<Spectrum>) {
     let settings = scene.settings();
     if !path.begin_interaction(settings) {
         return;
@@ -425,16 +408,29 @@ pub fn scatter<S: Scene>(scene: &S, path: &mut PathState, p: Vec3, albedo: Optio
         path.alive = false;
         return;
     }
-    let next_event = PathState::uses_next_event(scene);
-    if next_event && !next_event_estimate(scene, path, p) {
+    let next_event = PathOf::<S>::uses_next_event(scene);
+    let phase = collision_phase(scene, p);
+    if next_event && !next_event_estimate(scene, path, p, &phase) {
         return;
     }
-    let sample = scene.phase().sample(path.ray.dir, path.rng.next_2d());
+    let sample = phase.sample(path.ray.dir, path.rng.next_2d());
     path.ray = Ray::new(p, sample.wo);
     if next_event {
         path.mis_pdf = sample.pdf;
     }
-    path.russian_roulette::<S>(settings);
+    path.russian_roulette(settings);
+}
+
+/// The phase function at a collision at `p`: the scene's, with the asymmetry of the material
+/// there where the medium's materials carry their own ([`Medium::phase_g`]). A material-indexed
+/// volume whose materials' `g` differ is rendered by a Henyey-Greenstein variant (the factory's
+/// choice) whose `g` each collision replaces; a grey medium reads nothing.
+#[inline(always)]
+fn collision_phase<S: Scene>(scene: &S, p: Vec3) -> S::Phase {
+    match scene.medium().phase_g(p) {
+        Some(g) => scene.phase().with_g(g),
+        None => *scene.phase(),
+    }
 }
 
 /// Next-event estimation at a scattering event at `p` (Veach 1997, ch. 9; pbrt-v4 section 14.2.2):
@@ -446,43 +442,48 @@ pub fn scatter<S: Scene>(scene: &S, path: &mut PathState, p: Vec3, albedo: Optio
 /// where nothing but the medium lies between `p` and the environment: an index-matched boundary.
 /// False (and the path is cut) when ratio tracking runs out of steps.
 #[inline(always)]
-fn next_event_estimate<S: Scene>(scene: &S, path: &mut PathState, p: Vec3) -> bool {
+fn next_event_estimate<S: Scene>(
+    scene: &S,
+    path: &mut PathOf<S>,
+    p: Vec3,
+    phase: &S::Phase,
+) -> bool {
     let Some(light) = scene.environment().sample(path.rng.next_2d()) else {
         return true;
     };
-    let phase = scene.phase().eval(path.ray.dir, light.dir);
+    let phase = phase.eval(path.ray.dir, light.dir);
     let shadow = Ray::new(p, light.dir);
-    if S::Medium::CHROMATIC {
-        // Each channel's transmittance, estimated at once; the path's weight carries the MIS.
-        let Some(transmittance) = spectral_shadow_transmittance(scene, path, shadow) else {
-            path.truncate(Truncation::TrackingSteps);
-            return false;
-        };
-        let weight = power_heuristic(light.pdf, phase) * phase / light.pdf;
-        path.radiance += path.weight::<S>() * transmittance * light.radiance * weight;
-        return true;
-    }
     let Some(transmittance) = shadow_transmittance(scene, path, shadow) else {
         path.truncate(Truncation::TrackingSteps);
         return false;
     };
-    let weight = power_heuristic(light.pdf, phase) * phase * transmittance / light.pdf;
-    path.radiance += path.throughput * light.radiance * weight;
+    path.radiance += path.spectral.next_event_light(
+        path.throughput,
+        light.radiance,
+        power_heuristic(light.pdf, phase),
+        phase,
+        light.pdf,
+        transmittance,
+    );
     true
 }
 
 /// The transmittance along `shadow` to the environment, estimated by ratio tracking over each
 /// chord through the medium: one for a convex shape (the box's code is the single call); a ray
 /// that leaves a non-convex one (a torus) may enter it again. `None` when tracking runs out of
-/// steps.
+/// steps. Per channel for a chromatic medium ([`SpectralState::Transmittance`]).
 #[inline(always)]
-fn shadow_transmittance<S: Scene>(scene: &S, path: &mut PathState, shadow: Ray) -> Option<f32> {
+fn shadow_transmittance<S: Scene>(
+    scene: &S,
+    path: &mut PathOf<S>,
+    shadow: Ray,
+) -> Option<Transmittance<S>> {
     let mut transmittance = chord_transmittance(scene, path, &shadow)?;
     if S::Shape::CONVEX {
         return Some(transmittance);
     }
     let mut shadow = shadow;
-    while transmittance > 0.0 {
+    while SpectralOf::<S>::transmits(transmittance) {
         let exit = scene.shape().exit(&shadow);
         match scene.shape().entry(&Ray::new(exit.point, shadow.dir)) {
             Some(entry) => shadow.origin = entry.point,
@@ -493,45 +494,19 @@ fn shadow_transmittance<S: Scene>(scene: &S, path: &mut PathState, shadow: Ray) 
     Some(transmittance)
 }
 
-/// [`shadow_transmittance`] of a chromatic medium, per channel ([`spectral_ratio_tracking`]).
-#[inline(always)]
-fn spectral_shadow_transmittance<S: Scene>(
-    scene: &S,
-    path: &mut PathState,
-    shadow: Ray,
-) -> Option<Spectrum> {
-    let chord = |path: &mut PathState, ray: &Ray| {
-        spectral_ratio_tracking(
-            scene.medium(),
-            ray,
-            scene.shape().exit_distance(ray),
-            &mut path.rng,
-            &mut path.tracking_steps,
-            scene.settings().max_tracking_steps,
-        )
-    };
-    let mut transmittance = chord(path, &shadow)?;
-    if S::Shape::CONVEX {
-        return Some(transmittance);
-    }
-    let mut shadow = shadow;
-    while transmittance.max_element() > 0.0 {
-        let exit = scene.shape().exit(&shadow);
-        match scene.shape().entry(&Ray::new(exit.point, shadow.dir)) {
-            Some(entry) => shadow.origin = entry.point,
-            None => break,
-        }
-        transmittance *= chord(path, &shadow)?;
-    }
-    Some(transmittance)
-}
+/// A transmittance estimate of scene `S`'s medium.
+type Transmittance<S> = <SpectralOf<S> as SpectralState>::Transmittance;
 
 /// Ratio tracking's estimate along `ray`, from inside the medium to where it leaves the shape.
 /// A function, not a closure: a closure called from two places may stay a function of its own,
 /// which on a GPU takes the scene into local memory.
 #[inline(always)]
-fn chord_transmittance<S: Scene>(scene: &S, path: &mut PathState, ray: &Ray) -> Option<f32> {
-    ratio_tracking(
+fn chord_transmittance<S: Scene>(
+    scene: &S,
+    path: &mut PathOf<S>,
+    ray: &Ray,
+) -> Option<Transmittance<S>> {
+    SpectralOf::<S>::transmittance(
         scene.medium(),
         ray,
         scene.shape().exit_distance(ray),
@@ -554,7 +529,7 @@ fn chord_transmittance<S: Scene>(scene: &S, path: &mut PathState, ray: &Ray) -> 
 /// meets it again adds nothing here, and the BSDF's sample of it meets the mesh before any light,
 /// where its weight is set anew.
 #[inline(always)]
-fn boundary_next_event_estimate<S: Scene>(scene: &S, path: &mut PathState, hit: &BoxHit) {
+fn boundary_next_event_estimate<S: Scene>(scene: &S, path: &mut PathOf<S>, hit: &BoxHit) {
     let Some(light) = scene.environment().sample(path.rng.next_2d()) else {
         return;
     };
@@ -575,7 +550,7 @@ fn boundary_next_event_estimate<S: Scene>(scene: &S, path: &mut PathState, hit: 
         return;
     }
     let weight = power_heuristic(light.pdf, bsdf.pdf) * bsdf.value / light.pdf;
-    path.radiance += path.weight::<S>() * light.radiance * weight;
+    path.radiance += path.weight() * light.radiance * weight;
 }
 
 /// Veach's power heuristic with exponent 2: the weight of a strategy of density `a` against one of
@@ -593,7 +568,7 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
 // Inlined into every kernel's step: called by address, it would take the scene with it and keep
 // a copy of it in local memory (`ptx_entries::no_kernel_keeps_the_scene_in_local_memory`).
 #[inline(always)]
-fn interact_with_boundary<S: Scene>(scene: &S, path: &mut PathState, hit: BoxHit) {
+fn interact_with_boundary<S: Scene>(scene: &S, path: &mut PathOf<S>, hit: BoxHit) {
     if S::Bsdf::IS_NULL {
         path.ray.origin = hit.point;
         path.inside = !path.inside;
@@ -603,7 +578,7 @@ fn interact_with_boundary<S: Scene>(scene: &S, path: &mut PathState, hit: BoxHit
     if !path.begin_interaction(settings) {
         return;
     }
-    let next_event = PathState::uses_boundary_next_event(scene);
+    let next_event = PathOf::<S>::uses_boundary_next_event(scene);
     if next_event {
         boundary_next_event_estimate(scene, path, &hit);
     }
@@ -630,7 +605,7 @@ fn interact_with_boundary<S: Scene>(scene: &S, path: &mut PathState, hit: BoxHit
                 path.eta_scale *= sample.eta;
             }
             path.ray = Ray::new(hit.point, sample.wo);
-            path.russian_roulette::<S>(settings);
+            path.russian_roulette(settings);
         }
         None => path.alive = false,
     }
@@ -651,7 +626,7 @@ pub struct PathCounters {
 
 impl PathCounters {
     #[inline]
-    pub fn record(&mut self, path: &PathState) {
+    pub fn record<X>(&mut self, path: &PathState<X>) {
         self.paths += 1;
         self.segments += path.segments as u64;
         self.tracking_steps += path.tracking_steps as u64;

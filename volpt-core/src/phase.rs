@@ -15,10 +15,13 @@ pub struct PhaseSample {
     pub pdf: f32,
 }
 
-pub trait PhaseFunction {
+pub trait PhaseFunction: Copy {
     /// The phase function value, which is also the density of `sample`.
     fn eval(&self, wi: Vec3, wo: Vec3) -> f32;
     fn sample(&self, wi: Vec3, u: Vec2) -> PhaseSample;
+    /// This phase function with asymmetry `g`, a collision's material's
+    /// ([`crate::Medium::phase_g`]); a function without asymmetry is itself.
+    fn with_g(&self, g: f32) -> Self;
 }
 
 #[derive(Clone, Copy, Debug, Default)]
@@ -36,6 +39,11 @@ impl PhaseFunction for Isotropic {
             wo: sample_uniform_sphere(u),
             pdf: INV_4PI,
         }
+    }
+
+    #[inline]
+    fn with_g(&self, _g: f32) -> Self {
+        Isotropic
     }
 }
 
@@ -84,6 +92,11 @@ impl PhaseFunction for HenyeyGreenstein {
             wo: direction_about(wi, cos_theta, u.y),
             pdf: self.eval_cos(cos_theta),
         }
+    }
+
+    #[inline]
+    fn with_g(&self, g: f32) -> Self {
+        Self { g }
     }
 }
 

@@ -343,7 +343,7 @@ fn spectral_weights_are_finite_and_bounded_on_extreme_media() {
                 let mut path = PathState::from_camera(&scene, 1, 2, sample, 9);
                 while path.alive {
                     volpt_core::path::step(&scene, &mut path);
-                    let r = path.r_u;
+                    let r = path.spectral.r_u;
                     assert!(
                         r.is_finite() && r.min_element() >= 0.0 && r.max_element() <= 3.0001,
                         "r_u {r:?}"

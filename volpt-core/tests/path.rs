@@ -525,10 +525,9 @@ fn finished(segments: u32, tracking_steps: u32, truncated: Truncation) -> PathSt
         tracking_steps,
         inside: false,
         alive: false,
-        hero: 0,
         truncated,
         mis_pdf: 0.0,
-        r_u: Spectrum::ONE,
+        spectral: (),
     }
 }
 

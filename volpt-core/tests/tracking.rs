@@ -23,6 +23,7 @@ struct Layered {
 }
 
 impl Medium for Layered {
+    type Spectral = ();
     const HOMOGENEOUS: bool = false;
 
     fn majorant(&self) -> f32 {
@@ -51,6 +52,7 @@ struct ConstantButTracked {
 }
 
 impl Medium for ConstantButTracked {
+    type Spectral = ();
     const HOMOGENEOUS: bool = false;
 
     fn majorant(&self) -> f32 {
@@ -341,6 +343,7 @@ struct LayeredOnGrid<'a> {
 }
 
 impl Medium for LayeredOnGrid<'_> {
+    type Spectral = ();
     const HOMOGENEOUS: bool = false;
 
     fn majorant(&self) -> f32 {
@@ -449,6 +452,7 @@ const FAINT: f32 = 2.2e-42;
 const FAINT_CELLS: [f32; 4] = [FAINT; 4];
 
 impl Medium for Faint<'_> {
+    type Spectral = ();
     const HOMOGENEOUS: bool = false;
 
     fn majorant(&self) -> f32 {

@@ -29,6 +29,7 @@ impl HalfOfMajorant {
 }
 
 impl Medium for HalfOfMajorant {
+    type Spectral = ();
     const HOMOGENEOUS: bool = false;
 
     fn majorant(&self) -> f32 {

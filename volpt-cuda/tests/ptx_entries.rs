@@ -132,31 +132,34 @@ fn a_damaged_pack_says_so() {
     }
 }
 
-/// Local memory this test lets through today, pinned at the sizes measured when it came (both
-/// builds, 2026-11-28), so that any growth still fails; each is a regression to remove, not a
-/// design:
-/// - the chromatic index-matched kernels keep the scene in local memory (up to 672 bytes more,
-///   576-776 in all): the spectral next-event shadow ray calls its tracking closure at two sites
-///   (`spectral_shadow_transmittance`), which takes the scene by address;
-/// - the strategies that park paths (streaming, sorting, multi-kernel, regeneration-2p) hold
-///   16-32 more bytes since the path state gained its spectral fields (`hero`, `r_u`); the
-///   strategies that keep a path in registers (naive, regeneration, -warp, -block) hold none.
+/// Local memory this test lets through today, pinned at the sizes measured (exact build,
+/// 2026-11-28), so that any growth still fails; a regression to remove, not a design. Only
+/// chromatic kernels that park paths carry it: the chromatic path state (`HeroChannel`, its `u8`
+/// hero beside `r_u`) is copied through 8 bytes of local memory where a path is parked, and the
+/// two-path array of regeneration-2p-sk and multi-kernel's rough dielectric under a map hold 48
+/// more. Grey kernels carry none (their path state has no spectral part), and no chromatic kernel
+/// keeps the scene there.
 fn known_debt(entry: &str) -> usize {
-    const CHROMATIC_NEXT_EVENT_BYTES: usize = 672;
-    const PARKED_SPECTRAL_STATE_BYTES: usize = 32;
-    let parks_paths = [
+    if !entry.contains("__chromatic__") {
+        return 0;
+    }
+    let parks = |s: &str| entry.starts_with(s);
+    if parks("regeneration_2p_sk__")
+        || (parks("multi_kernel__")
+            && entry.contains("__rough_dielectric__")
+            && entry.ends_with("__lat_long"))
+    {
+        48
+    } else if [
         "streaming_sk__",
         "streaming_sorted_sk__",
         "sorting_sk__",
         "multi_kernel__",
-        "regeneration_2p_sk__",
     ]
     .iter()
-    .any(|s| entry.starts_with(s));
-    if entry.contains("__chromatic__index_matched__") {
-        CHROMATIC_NEXT_EVENT_BYTES
-    } else if parks_paths {
-        PARKED_SPECTRAL_STATE_BYTES
+    .any(|s| parks(s))
+    {
+        8
     } else {
         0
     }
@@ -193,8 +196,7 @@ fn no_kernel_keeps_the_scene_in_local_memory() {
             } else {
                 COUNTER_FLUSH_BYTES
             };
-            let allowed = base + known_debt(&entry);
-            if depot > allowed {
+            if depot > base + known_debt(&entry) {
                 heavy.push(format!("{entry}: {depot} bytes"));
             }
         }

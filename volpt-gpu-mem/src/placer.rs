@@ -392,7 +392,7 @@ impl VolumePlacer {
     }
 
     fn zero_copy(&mut self, grid: &Grid<'_>) -> Result<(u64, PlacedIn), GpuMemError> {
-        if grid.layout == GridLayout::Dense {
+        if grid.layout == GridLayout::Dense && owns_its_pages(grid.values) {
             match HostRegistration::new(&self.ctx, grid.values) {
                 Ok(registration) => {
                     let address = registration.device_address();
@@ -429,6 +429,20 @@ impl VolumePlacer {
 /// Frees the kept grids that `which` selects and returns the device bytes they took. The renders
 /// that read them are over (each placer waits for its kernels before it is dropped); the stream is
 /// waited for anyway rather than free memory a kernel could read.
+/// The smallest grid page-locked in place: glibc serves every allocation this large (its largest
+/// dynamic mmap threshold on 64-bit systems) from pages of its own.
+const IN_PLACE_MIN_BYTES: usize = 32 << 20;
+
+/// Whether registering `values` in place page-locks only pages that hold nothing else.
+/// Registration covers whole pages ([`crate::memory::register_range`]); a small allocation shares
+/// its first and last pages with its neighbours, and a CUDA copy whose host range then lies partly
+/// in a registered range fails with `CUDA_ERROR_INVALID_VALUE` (the film read back after a render
+/// of scenes/bucky, whose two grids are 128 and 384 KiB). A smaller grid is copied into pinned
+/// memory of its own, which costs little at that size.
+fn owns_its_pages(values: &[f32]) -> bool {
+    std::mem::size_of_val(values) >= IN_PLACE_MIN_BYTES
+}
+
 fn free_kept(
     stream: &CudaStream,
     grids: &mut Vec<Resident>,

@@ -133,6 +133,110 @@ pub enum SceneError {
         #[source]
         error: Box<SceneError>,
     },
+
+    /// A material-indexed volume that cannot be rendered ([`crate::material`]): `path` is its
+    /// index grid's file, slice folder or scene.
+    #[error("{}: {problem}", path.display())]
+    Material {
+        path: PathBuf,
+        problem: MaterialProblem,
+    },
+}
+
+/// What is wrong with a material-indexed volume.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MaterialProblem {
+    /// A table of no material, or of more than 256 (indices are bytes).
+    TableSize { found: usize },
+    /// A voxel names a material the table does not have.
+    IndexOutOfTable {
+        voxel: [u32; 3],
+        index: u32,
+        materials: usize,
+    },
+    /// A voxel value that is not a material index (not an integer in 0..=255).
+    NotAnIndex { voxel: [u32; 3], value: f32 },
+    /// An index grid of another size than the volume's.
+    GridSize {
+        resolution: [u32; 3],
+        expected: u64,
+        found: u64,
+    },
+    /// The grid file holds something else than one channel of dense samples.
+    NotAnIndexGrid { what: String },
+    /// A slice of another size than the first.
+    SliceSize {
+        slice: String,
+        expected: [u32; 2],
+        found: [u32; 2],
+    },
+    /// A slice whose pixel's colour names no material of the palette.
+    PaletteColour {
+        slice: String,
+        pixel: [u32; 2],
+        colour: [u8; 3],
+    },
+    /// A slice count other than the one the scene gives.
+    SliceCount { expected: u32, found: u32 },
+    /// A slice volpt cannot decode (not an 8-bit RGB or RGBA PNG, or corrupt).
+    Slice { slice: String, message: String },
+}
+
+impl fmt::Display for MaterialProblem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::TableSize { found } => write!(
+                f,
+                "materials: expected 1 to 256 materials (indices are bytes), found {found}"
+            ),
+            Self::IndexOutOfTable {
+                voxel,
+                index,
+                materials,
+            } => write!(
+                f,
+                "voxel {voxel:?}: expected a material index below {materials} (the table's \
+                 length), found {index}"
+            ),
+            Self::NotAnIndex { voxel, value } => write!(
+                f,
+                "voxel {voxel:?}: expected a material index (an integer 0..=255), found {value}"
+            ),
+            Self::GridSize {
+                resolution,
+                expected,
+                found,
+            } => write!(
+                f,
+                "index grid: expected {expected} indices ({resolution:?} voxels), found {found}"
+            ),
+            Self::NotAnIndexGrid { what } => write!(f, "index grid: {what}"),
+            Self::SliceSize {
+                slice,
+                expected,
+                found,
+            } => write!(
+                f,
+                "slice {slice}: expected {}x{} pixels (the first slice's), found {}x{}",
+                expected[0], expected[1], found[0], found[1]
+            ),
+            Self::PaletteColour {
+                slice,
+                pixel,
+                colour,
+            } => write!(
+                f,
+                "slice {slice}, pixel {pixel:?}: expected a palette colour of [[materials]], found \
+                 #{:02x}{:02x}{:02x}",
+                colour[0], colour[1], colour[2]
+            ),
+            Self::SliceCount { expected, found } => write!(
+                f,
+                "slices: expected {expected} (volume.resolution's z), found {found}"
+            ),
+            Self::Slice { slice, message } => write!(f, "slice {slice}: {message}"),
+        }
+    }
 }
 
 /// What is wrong with a `.vol` file.

@@ -9,6 +9,8 @@
 //! - [`param`]: the numbers of a description a scene takes between renders.
 //! - [`builder`]: [`SceneBuilder`]s (one per source) and the [`SceneAssembler`] that applies the
 //!   command line's [`Config`] to what they build.
+//! - [`material`]: material-indexed volumes (a table of materials and an index per voxel).
+//! - [`slices`]: voxel-print slice stacks (a folder of PNG images whose colours name materials).
 //! - [`toml_scene`]: volpt's own TOML scene files: one grid file, a transfer function, defaults.
 //! - [`error`]: what can go wrong loading one ([`SceneError`]); every message names the file and,
 //!   for XML, the line.
@@ -41,6 +43,7 @@ pub mod error;
 pub mod from_description;
 pub mod generate;
 pub mod limits;
+pub mod material;
 pub mod medium;
 pub mod mesh;
 pub mod metaimage;
@@ -55,6 +58,7 @@ pub mod phase;
 pub mod raw;
 pub mod scanner;
 pub mod simplification;
+pub mod slices;
 pub mod sparse;
 pub mod tiff_stack;
 pub mod toml_scene;
@@ -70,7 +74,7 @@ pub use boundary::BoundaryInput;
 pub use builder::{builder_for, Config, SceneAssembler, SceneBuilder};
 pub use description::*;
 pub use dicom::read_dicom_series;
-pub use error::{GridProblem, SceneError, VolProblem};
+pub use error::{GridProblem, MaterialProblem, SceneError, VolProblem};
 pub use from_description::FromDescription;
 pub use medium::{MediumInput, ReadsRule};
 pub use metaimage::{read_metaimage, write_metaimage, MetaImageOptions};

@@ -17,13 +17,14 @@ use volpt_core::grid::{
     TextureTrilinear,
 };
 use volpt_core::{
-    Aabb, ChromaticMedium, ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium, Spectrum,
-    Vec3,
+    Aabb, ChromaticMedium, ConstantAlbedo, GridAlbedo, GridMedium, HomogeneousMedium, MaterialGrid,
+    Spectrum, Vec3,
 };
 
 use crate::description::{Bounds, GridConvention, GridDesc, SampleLayout, SceneDescription};
 use crate::error::SceneError;
 use crate::from_description::FromDescription;
+use crate::material::{IndexedDesc, InfoTable, MaterialDesc};
 use crate::mitsuba::export::rgb_element;
 use crate::mitsuba::plugin::{quoted, Arg, Ctx, Plugin};
 use crate::mitsuba::preprocess::Dialect;
@@ -85,6 +86,9 @@ pub enum DensityDesc {
     /// A constant density per channel: a chromatic extinction, `scale * rgb` (milk, skin, a
     /// print's resin; [`volpt_core::ChromaticMedium`]). Equal channels render as `Constant`.
     Rgb([f32; 3]),
+    /// A material-indexed volume ([`crate::material`]): each voxel's material gives its
+    /// extinction (times `scale`), albedo and phase asymmetry; the medium's own albedo is not read.
+    Indexed(IndexedDesc),
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -119,14 +123,17 @@ impl MediumDesc {
                 reason: "this old name is not read: use <float name=\"scale\"> instead".into(),
             });
         }
-        if let Some(arg) = p.find(&["material"])? {
-            return Err(SceneError::Unsupported {
-                path: arg.written.file.to_path_buf(),
-                line: arg.written.line,
-                what: arg.written.describe(),
-                reason: "volpt has no material presets: give the coefficients (sigma_t and albedo)"
-                    .into(),
-            });
+        if kind == "heterogeneous" {
+            if let Some(arg) = p.find(&["material"])? {
+                return Err(SceneError::Unsupported {
+                    path: arg.written.file.to_path_buf(),
+                    line: arg.written.line,
+                    what: arg.written.describe(),
+                    reason: "material presets are read for homogeneous media (a preset is \
+                             one constant extinction)"
+                        .into(),
+                });
+            }
         }
         let scale = match p.find(&["scale"])? {
             None => 1.0,
@@ -161,11 +168,43 @@ impl MediumDesc {
     }
 }
 
+/// A preset's extinction and albedo ([`crate::mitsuba::presets`]).
+fn from_preset(sigma_s: [f32; 3], sigma_a: [f32; 3]) -> (DensityDesc, AlbedoDesc) {
+    let t = [0, 1, 2].map(|c| sigma_a[c] + sigma_s[c]);
+    let albedo = [0, 1, 2].map(|c| if t[c] > 0.0 { sigma_s[c] / t[c] } else { 0.0 });
+    (extinction(t), AlbedoDesc::Constant(albedo))
+}
+
 fn homogeneous(p: &Plugin<'_>) -> Result<(DensityDesc, AlbedoDesc), SceneError> {
     let sigma_a = p.find(&["sigmaA", "sigma_a"])?;
     let sigma_s = p.find(&["sigmaS", "sigma_s"])?;
     let sigma_t = p.find(&["sigmaT", "sigma_t"])?;
     let albedo = p.find(&["albedo"])?;
+    if let Some(arg) = p.find(&["material"])? {
+        if let Some(other) = sigma_a.or(sigma_s).or(sigma_t).or(albedo) {
+            return Err(other.invalid(
+                "either a preset material or coefficients",
+                "both (as Mitsuba 0.6 refuses)",
+            ));
+        }
+        let name = arg.string()?;
+        let Some((s, a)) = crate::mitsuba::presets::preset(name) else {
+            return Err(arg.invalid(
+                &format!(
+                    "one of Mitsuba 0.6's presets ({})",
+                    crate::mitsuba::presets::preset_names()
+                ),
+                quoted(name),
+            ));
+        };
+        return Ok(from_preset(s, a));
+    }
+    if p.ctx.dialect == Dialect::Mitsuba06 && sigma_a.or(sigma_s).or(sigma_t).or(albedo).is_none() {
+        // Mitsuba 0.6's medium without coefficients is its default preset.
+        let (s, a) = crate::mitsuba::presets::preset(crate::mitsuba::presets::DEFAULT_PRESET)
+            .expect("the default preset is in the table");
+        return Ok(from_preset(s, a));
+    }
     match (sigma_a, sigma_s) {
         (Some(a_arg), Some(s_arg)) => {
             if let Some(extra) = sigma_t.or(albedo) {
@@ -248,7 +287,8 @@ fn default_for(p: &Plugin<'_>, value: f32, what: &str) -> Result<f32, SceneError
     match p.ctx.dialect {
         Dialect::Mitsuba3 => Ok(value),
         Dialect::Mitsuba06 => Err(p.missing(format!(
-            "{what} (Mitsuba 0.6 would fall back to a material preset, which volpt does not have)"
+            "{what} (Mitsuba 0.6 would fall back to a material preset, which volpt reads for \
+             homogeneous media only)"
         ))),
     }
 }
@@ -363,13 +403,31 @@ impl MediumDesc {
                 }
                 rgb.iter().copied().fold(0.0, f32::max)
             }
+            DensityDesc::Indexed(indexed) => {
+                if let Some((k, (field, expected, found))) = indexed
+                    .materials()
+                    .iter()
+                    .enumerate()
+                    .find_map(|(k, m)| Some((k, m.problem()?)))
+                {
+                    return Err(invalid(&format!("materials[{k}].{field}"), expected, found));
+                }
+                if matches!(self.albedo, AlbedoDesc::Grid(_)) {
+                    return Err(invalid(
+                        "medium albedo",
+                        "the materials' own albedos (no albedo grid beside a material-indexed volume)",
+                        "an albedo grid".into(),
+                    ));
+                }
+                indexed.max_extinction()
+            }
             DensityDesc::Grid(grid) => match checked {
                 Some(data) => data.largest_density,
                 None => check_grid(grid, "density grid", f32::MAX, invalid)?,
             },
         };
         let largest_density = match &self.density {
-            DensityDesc::Constant(_) | DensityDesc::Rgb(_) => 0.0,
+            DensityDesc::Constant(_) | DensityDesc::Rgb(_) | DensityDesc::Indexed(_) => 0.0,
             DensityDesc::Grid(_) => max_density,
         };
         let mut largest_albedo = 0.0;
@@ -424,6 +482,7 @@ impl MediumDesc {
         match &self.density {
             DensityDesc::Constant(density) => self.scale * density,
             DensityDesc::Rgb(rgb) => self.scale * rgb.iter().copied().fold(0.0, f32::max),
+            DensityDesc::Indexed(indexed) => self.scale * indexed.max_extinction(),
             DensityDesc::Grid(grid) => self.scale * grid.max_value(),
         }
     }
@@ -437,6 +496,7 @@ impl MediumDesc {
                 match &self.density {
                     DensityDesc::Constant(v) => *v,
                     DensityDesc::Rgb(rgb) => rgb.iter().copied().fold(0.0, f32::max),
+                    DensityDesc::Indexed(indexed) => indexed.max_extinction(),
                     DensityDesc::Grid(_) => checked.largest_density,
                 },
             ),
@@ -454,7 +514,7 @@ impl MediumDesc {
     pub fn grids(&self) -> impl Iterator<Item = (&'static str, &GridDesc)> {
         let density = match &self.density {
             DensityDesc::Grid(g) => Some(("density", g)),
-            DensityDesc::Constant(_) | DensityDesc::Rgb(_) => None,
+            DensityDesc::Constant(_) | DensityDesc::Rgb(_) | DensityDesc::Indexed(_) => None,
         };
         let albedo = match &self.albedo {
             AlbedoDesc::Grid(g) => Some(("albedo", g)),
@@ -465,15 +525,18 @@ impl MediumDesc {
 
     /// The values the description's serialisation leaves out (the grids' samples), the
     /// density's then the albedo's (empty for a constant), which what fingerprints a scene
-    /// hashes on their own (the facade's `fingerprint::content`).
+    /// hashes on their own (the facade's `fingerprint::content`). A material-indexed volume's
+    /// are its packed indices (their bits as `f32`s) then its table.
     pub fn unserialised_values(&self) -> [&[f32]; 2] {
         let density = match &self.density {
             DensityDesc::Grid(g) => &g.data[..],
+            DensityDesc::Indexed(indexed) => bytemuck::cast_slice(indexed.packed_indices()),
             DensityDesc::Constant(_) | DensityDesc::Rgb(_) => &[],
         };
-        let albedo = match &self.albedo {
-            AlbedoDesc::Grid(g) => &g.data[..],
-            AlbedoDesc::Constant(_) => &[],
+        let albedo = match (&self.density, &self.albedo) {
+            (DensityDesc::Indexed(indexed), _) => indexed.table(),
+            (_, AlbedoDesc::Grid(g)) => &g.data[..],
+            (_, AlbedoDesc::Constant(_)) => &[],
         };
         [density, albedo]
     }
@@ -492,7 +555,11 @@ impl MediumDesc {
     /// Whether the extinction differs between channels (the medium renders as
     /// [`volpt_core::ChromaticMedium`]; Mitsuba 3's peer integrator is `volpathmis`).
     pub fn is_chromatic(&self) -> bool {
-        matches!(&self.density, DensityDesc::Rgb(rgb) if !rgb.iter().all(|&c| c == rgb[0]))
+        match &self.density {
+            DensityDesc::Rgb(rgb) => !rgb.iter().all(|&c| c == rgb[0]),
+            DensityDesc::Indexed(_) => true,
+            DensityDesc::Constant(_) | DensityDesc::Grid(_) => false,
+        }
     }
 
     /// The `<medium>`'s type, its extinction and its albedo elements in a Mitsuba 3 scene; `grid`
@@ -519,6 +586,14 @@ impl MediumDesc {
                 ("homogeneous", rgb_element("sigma_t", &unit))
             }
             DensityDesc::Grid(g) => ("heterogeneous", grid(g, "density", "sigma_t")?),
+            DensityDesc::Indexed(_) => {
+                return Err(SceneError::Export {
+                    path: PathBuf::from("medium"),
+                    reason: "a material-indexed volume has no Mitsuba 3 form (Mitsuba 3 reads \
+                             no material table); export it as RGB grids instead"
+                        .into(),
+                })
+            }
         };
         let albedo = match &self.albedo {
             AlbedoDesc::Constant(rgb) => rgb_element("albedo", rgb),
@@ -540,9 +615,39 @@ impl MediumDesc {
         ),
     ];
 
-    /// The value of parameter `key`, if it is one of [`MediumDesc::PARAMS`] (the phase's are
-    /// [`PhaseDesc::param`]'s); `Some(Err(why))` where this medium has no such value.
+    /// The keys of a material-indexed volume's coefficients, `materials.<k>.sigma_s` and
+    /// `.sigma_a` (RGB per world unit, before `medium.scale`) and `.g` (a number in (-1, 1)) for
+    /// every material `k` of its table (none for another medium): [`MediumDesc::param`] and
+    /// [`MediumDesc::set_param`] take them beside [`MediumDesc::PARAMS`].
+    pub fn material_params(&self) -> Vec<String> {
+        let DensityDesc::Indexed(indexed) = &self.density else {
+            return Vec::new();
+        };
+        (0..indexed.materials().len())
+            .flat_map(|k| MATERIAL_FIELDS.map(|field| format!("materials.{k}.{field}")))
+            .collect()
+    }
+
+    /// The value of parameter `key`, if it is one of [`MediumDesc::PARAMS`] or
+    /// [`MediumDesc::material_params`] (the phase's are [`PhaseDesc::param`]'s); `Some(Err(why))`
+    /// where this medium has no such value.
     pub fn param(&self, key: &str) -> Option<Result<MediumParam, ParamRefused>> {
+        if let Some((k, field)) = material_key(key) {
+            let DensityDesc::Indexed(indexed) = &self.density else {
+                return Some(Err(NOT_INDEXED));
+            };
+            let Some(m) = indexed.materials().get(k) else {
+                return Some(Err(ParamRefused::NotHere {
+                    needs: "a material of the table",
+                    found: "an index past its end",
+                }));
+            };
+            return Some(Ok(match field {
+                "sigma_s" => MediumParam::Rgb(m.sigma_s),
+                "sigma_a" => MediumParam::Rgb(m.sigma_a),
+                _ => MediumParam::Float(m.g),
+            }));
+        }
         Some(match key {
             "medium.scale" => Ok(MediumParam::Float(self.scale)),
             "medium.albedo" => match &self.albedo {
@@ -556,6 +661,9 @@ impl MediumDesc {
     /// Sets parameter `key` to `value`, if it is one of [`MediumDesc::PARAMS`] (`None`: the
     /// medium is left alone). `Some(Err(why))` refuses the value, leaving the medium as it was.
     pub fn set_param(&mut self, key: &str, value: MediumParam) -> Option<Result<(), ParamRefused>> {
+        if let Some((k, field)) = material_key(key) {
+            return Some(self.set_material_param(k, field, value));
+        }
         Some(match key {
             "medium.scale" => match value {
                 MediumParam::Float(v) if v.is_finite() && v >= 0.0 => {
@@ -589,8 +697,10 @@ impl MediumDesc {
     /// nearest-sample lookups select the any-layout grid media (with a constant albedo and with an
     /// albedo grid); a grid decoded with the other lookup renders a different image, so both
     /// lookups cross the device ABI. The sixth reads textures of half-precision texels: decoded as
-    /// f32 texels, its samples would differ. The last reads one texel per lookup (stochastic):
-    /// decoded as trilinear, it would read eight.
+    /// f32 texels, its samples would differ. The eighth reads one texel per lookup (stochastic):
+    /// decoded as trilinear, it would read eight. The last is material-indexed: three materials
+    /// over a 3 x 2 x 2 index grid a little off the unit cube, every voxel's index differing from
+    /// its neighbours', so that a swapped axis or table row shows.
     pub fn examples() -> Vec<Self> {
         let bounds = Bounds {
             min: [-0.6, -0.45, -0.5],
@@ -662,7 +772,94 @@ impl MediumDesc {
                 lookup,
                 storage: GridStorage::Dense,
             })
+            .chain(std::iter::once(Self::indexed_example(bounds)))
             .collect()
+    }
+
+    /// [`MediumDesc::examples`]'s material-indexed medium over `bounds`.
+    fn indexed_example(bounds: Bounds) -> Self {
+        let materials = [
+            ("cyan", [0.6, 1.2, 1.5], [2.5, 0.6, 0.1], 0.4),
+            ("magenta", [1.1, 0.5, 1.0], [0.2, 2.0, 0.3], -0.3),
+            ("white", [2.0, 2.0, 2.0], [0.05, 0.05, 0.05], 0.0),
+        ]
+        .map(|(name, sigma_s, sigma_a, g)| MaterialDesc {
+            name: name.into(),
+            sigma_s,
+            sigma_a,
+            g,
+            colour: None,
+        });
+        let indices = [0, 1, 2, 1, 2, 0, 2, 0, 1, 0, 2, 1];
+        let indexed = IndexedDesc::new(
+            std::path::Path::new("example"),
+            materials.to_vec(),
+            [3, 2, 2],
+            bounds,
+            &indices,
+        )
+        .expect("a valid example");
+        MediumDesc {
+            density: DensityDesc::Indexed(indexed),
+            scale: 3.0,
+            albedo: AlbedoDesc::Constant([0.0; 3]),
+            phase: PhaseDesc::HenyeyGreenstein { g: 0.0 },
+            lookup: GridLookup::Trilinear,
+            storage: GridStorage::Dense,
+        }
+    }
+}
+
+/// The fields of a material's parameters ([`MediumDesc::material_params`]).
+const MATERIAL_FIELDS: [&str; 3] = ["sigma_s", "sigma_a", "g"];
+
+/// `(k, field)` of a key `materials.<k>.<field>`.
+fn material_key(key: &str) -> Option<(usize, &str)> {
+    let rest = key.strip_prefix("materials.")?;
+    let (k, field) = rest.split_once('.')?;
+    let field = MATERIAL_FIELDS.into_iter().find(|&f| f == field)?;
+    Some((k.parse().ok()?, field))
+}
+
+/// A material parameter of a medium that is not material-indexed.
+const NOT_INDEXED: ParamRefused = ParamRefused::NotHere {
+    needs: "a material-indexed volume",
+    found: "another medium",
+};
+
+impl MediumDesc {
+    /// Sets `field` of material `k`; its phase variant follows the materials' asymmetries.
+    fn set_material_param(
+        &mut self,
+        k: usize,
+        field: &str,
+        value: MediumParam,
+    ) -> Result<(), ParamRefused> {
+        let DensityDesc::Indexed(indexed) = &mut self.density else {
+            return Err(NOT_INDEXED);
+        };
+        let Some(mut m) = indexed.materials().get(k).cloned() else {
+            return Err(ParamRefused::NotHere {
+                needs: "a material of the table",
+                found: "an index past its end",
+            });
+        };
+        match (field, value) {
+            ("sigma_s", MediumParam::Rgb(v)) => m.sigma_s = v,
+            ("sigma_a", MediumParam::Rgb(v)) => m.sigma_a = v,
+            ("g", MediumParam::Float(g)) => m.g = g,
+            ("g", _) => return Err(ParamRefused::Value("a number in (-1, 1)")),
+            _ => return Err(ParamRefused::Value("three finite numbers >= 0")),
+        }
+        indexed
+            .set_material(k, m)
+            .map_err(|(_, expected, _)| ParamRefused::Value(expected))?;
+        self.phase = if indexed.anisotropic() {
+            PhaseDesc::HenyeyGreenstein { g: 0.0 }
+        } else {
+            PhaseDesc::Isotropic
+        };
+        Ok(())
     }
 }
 
@@ -697,6 +894,7 @@ impl fmt::Display for DensityDesc {
         match self {
             DensityDesc::Constant(d) => write!(f, "constant {d}"),
             DensityDesc::Rgb(rgb) => write!(f, "constant RGB {rgb:?} (chromatic)"),
+            DensityDesc::Indexed(indexed) => write!(f, "{}", InfoTable(indexed)),
             DensityDesc::Grid(g) => write!(f, "{}", InfoGrid(g)),
         }
     }
@@ -775,6 +973,7 @@ enum Density<'a> {
     Grid(&'a GridDesc),
     /// Channels that differ (equal ones are `Constant`).
     Rgb(&'a [f32; 3]),
+    Indexed(&'a IndexedDesc),
 }
 
 enum Albedo<'a> {
@@ -810,6 +1009,7 @@ impl<'a> MediumInput<'a> {
                 Density::Constant(&rgb[0])
             }
             DensityDesc::Rgb(rgb) => Density::Rgb(rgb),
+            DensityDesc::Indexed(indexed) => Density::Indexed(indexed),
         };
         let albedo = match &medium.albedo {
             AlbedoDesc::Grid(grid) => match uniform(grid) {
@@ -868,7 +1068,7 @@ impl<'a, R: ReadsRule> FromDescription<'a> for GridMedium<'a, ConstantAlbedo, R>
     type Input = MediumInput<'a>;
 
     fn specialised(input: &MediumInput<'a>, _: &mut dyn FnMut(Simplification)) -> Option<Self> {
-        if matches!(input.density, Density::Rgb(_)) {
+        if matches!(input.density, Density::Rgb(_) | Density::Indexed(_)) {
             return None;
         }
         match input.albedo {
@@ -895,7 +1095,9 @@ impl<'a, R: ReadsRule> FromDescription<'a> for GridMedium<'a, GridAlbedo<'a, R>,
     }
 
     fn general(input: &MediumInput<'a>) -> Option<Self> {
-        if !R::asked_by(input.medium) || matches!(input.density, Density::Rgb(_)) {
+        if !R::asked_by(input.medium)
+            || matches!(input.density, Density::Rgb(_) | Density::Indexed(_))
+        {
             return None;
         }
         let albedo = match input.albedo {
@@ -916,8 +1118,18 @@ impl<'a> FromDescription<'a> for ChromaticMedium<'a> {
     }
 
     fn general(input: &MediumInput<'a>) -> Option<Self> {
-        let Density::Rgb(rgb) = input.density else {
-            return None;
+        let rgb = match input.density {
+            Density::Rgb(rgb) => rgb,
+            Density::Indexed(indexed) => {
+                return Some(ChromaticMedium::indexed(MaterialGrid::new(
+                    indexed.packed_indices(),
+                    indexed.resolution,
+                    aabb(&indexed.bounds),
+                    indexed.table(),
+                    input.medium.scale,
+                )))
+            }
+            Density::Constant(_) | Density::Grid(_) => return None,
         };
         let (albedo, albedo_grid) = match input.albedo {
             Albedo::Constant(a) => (Spectrum::new(a[0], a[1], a[2]), None),
@@ -934,7 +1146,9 @@ fn grid_medium<'a, A, R: GridReads>(input: &MediumInput<'a>, albedo: A) -> GridM
     let density = match input.density {
         Density::Grid(density) => grid::<1>(density, medium.lookup),
         Density::Constant(sigma) => one_voxel(input, std::slice::from_ref(sigma)),
-        Density::Rgb(_) => unreachable!("a chromatic extinction is ChromaticMedium's"),
+        Density::Rgb(_) | Density::Indexed(_) => {
+            unreachable!("a chromatic extinction is ChromaticMedium's")
+        }
     };
     let max_density = density.samples().iter().copied().fold(0.0, f32::max);
     GridMedium {

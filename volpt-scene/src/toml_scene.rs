@@ -13,6 +13,7 @@ use serde::Deserialize;
 
 use crate::description::*;
 use crate::error::SceneError;
+use crate::material::{IndexedDesc, MaterialSpec};
 use crate::raw::{read_raw, ByteOrder, RawLayout, ScalarType};
 use crate::{normalise, read_metaimage, read_vol, read_vtk};
 
@@ -43,6 +44,9 @@ pub struct SceneFile {
     pub integrator: IntegratorSpec,
     #[serde(default)]
     pub environment: EnvironmentSpec,
+    /// A material-indexed volume's table: `[volume]` is then its index grid (or PNG slices).
+    #[serde(default)]
+    pub materials: Vec<MaterialSpec>,
 }
 
 /// The density grid.
@@ -76,9 +80,13 @@ pub struct VolumeSpec {
     pub sparse: Option<String>,
     /// Map the grid's `[0, max]` linearly onto `[0, normalise]` before scaling.
     pub normalise: Option<f32>,
-    /// Extinction per unit density.
+    /// Extinction per unit density (of a material-indexed volume: a factor of every
+    /// material's extinction).
     #[serde(default = "one")]
     pub scale: f32,
+    /// PNG slice stacks: the voxel's size `[x, y, z]` in world units (the box is then centred on
+    /// the origin), instead of `bounds`.
+    pub voxel_size: Option<[f32; 3]>,
 }
 
 /// The grid file's format (`volume.format`).
@@ -95,6 +103,8 @@ pub enum VolumeFormat {
     Tiff,
     /// A folder of DICOM slices (one series), or one slice.
     Dicom,
+    /// A folder of PNG slices whose colours name `[[materials]]` (a voxel print's layers).
+    Png,
 }
 
 /// The image axis the field of view spans (`camera.fov_axis`), as Mitsuba names it.
@@ -344,6 +354,7 @@ pub fn load_volume_only(
             sparse: None,
             normalise: None,
             scale: 1.0,
+            voxel_size: None,
         },
         albedo: AlbedoSpec::default(),
         phase: PhaseSpec::default(),
@@ -353,6 +364,7 @@ pub fn load_volume_only(
         sampler: SamplerSpec::default(),
         integrator: IntegratorSpec::default(),
         environment: EnvironmentSpec::default(),
+        materials: Vec::new(),
     };
     assemble(&Cx { path, text: "" }, Path::new(""), file, params)
 }
@@ -367,6 +379,16 @@ fn assemble(
     let v = &file.volume;
 
     let volume_path = resolve(&v.file, "volume.file")?;
+    if !file.materials.is_empty() {
+        return assemble_indexed(cx, &file, &volume_path);
+    }
+    if v.format == Some(VolumeFormat::Png) {
+        return Err(cx.invalid(
+            "volume.format",
+            "png only with [[materials]] (a slice stack's colours name materials)",
+            "no [[materials]]",
+        ));
+    }
     let (mut grid, file_box) = read_volume(cx, &volume_path, v)?;
     if let Some(target) = v.normalise {
         if !(target.is_finite() && target > 0.0) {
@@ -414,11 +436,144 @@ fn assemble(
     };
     let albedo = file.albedo.albedo(cx, albedo_grid, &grid, &resolve)?;
     let phase = file.phase.phase(cx)?;
+    let grid_bounds = grid.bounds;
+    let medium = MediumDesc {
+        density: DensityDesc::Grid(grid),
+        scale: v.scale,
+        albedo,
+        phase,
+        lookup: Default::default(),
+        storage: Default::default(),
+    };
+    finish(cx, &file, grid_bounds, medium)
+}
 
+/// A material-indexed volume's scene: `[[materials]]` and `[volume]`'s index grid or slices;
+/// the medium's albedo and phase are the materials'.
+fn assemble_indexed(
+    cx: &Cx<'_>,
+    file: &SceneFile,
+    volume_path: &Path,
+) -> Result<SceneDescription, SceneError> {
+    let v = &file.volume;
+    if file.albedo.value.is_some()
+        || file.albedo.transfer_function.is_some()
+        || file.albedo.grid.is_some()
+    {
+        return Err(cx.invalid(
+            "albedo",
+            "no [albedo] beside [[materials]] (each material has its own)",
+            "an [albedo] table",
+        ));
+    }
+    if file.phase.g.is_some() {
+        return Err(cx.invalid(
+            "phase.g",
+            "no [phase] beside [[materials]] (each material has its own g)",
+            "a phase.g",
+        ));
+    }
+    if v.normalise.is_some() {
+        return Err(cx.invalid(
+            "volume.normalise",
+            "no normalise for an index grid (its values name materials)",
+            "a normalise",
+        ));
+    }
+    if !(v.scale.is_finite() && v.scale >= 0.0) {
+        return Err(cx.invalid("volume.scale", "a finite scale >= 0", v.scale));
+    }
+    let materials = file
+        .materials
+        .iter()
+        .enumerate()
+        .map(|(k, m)| {
+            m.material(&|field, expected, found| {
+                let field = if field.is_empty() {
+                    format!("materials[{k}]")
+                } else {
+                    format!("materials[{k}].{field}")
+                };
+                cx.invalid(&field, expected, found)
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let slices = v.format == Some(VolumeFormat::Png)
+        || (v.format.is_none() && volume_path.is_dir() && {
+            let files = crate::slices::slice_files(volume_path)?;
+            !files.is_empty()
+        });
+    let indexed = if slices {
+        let (indices, resolution) =
+            crate::slices::read_slices(volume_path, &materials, v.resolution.map(|r| r[2]))?;
+        if let Some(r) = v.resolution {
+            if r != resolution {
+                return Err(cx.invalid(
+                    "volume.resolution",
+                    "the slices' width, height and count",
+                    format!("{r:?} for slices of {resolution:?}"),
+                ));
+            }
+        }
+        let bounds = match (v.bounds, v.voxel_size) {
+            (Some(b), None) => checked_box(cx, "volume.bounds", b)?,
+            (None, Some(size)) => {
+                if !size.iter().all(|s| s.is_finite() && *s > 0.0) {
+                    return Err(cx.invalid(
+                        "volume.voxel_size",
+                        "three sizes > 0",
+                        format!("{size:?}"),
+                    ));
+                }
+                let half = [0, 1, 2].map(|a| 0.5 * size[a] * resolution[a] as f32);
+                Bounds {
+                    min: half.map(|h| -h),
+                    max: half,
+                }
+            }
+            _ => {
+                return Err(cx.invalid(
+                    "volume",
+                    "voxel_size = [x, y, z] or bounds = [[min], [max]] for a slice stack",
+                    "both or neither",
+                ))
+            }
+        };
+        IndexedDesc::new(volume_path, materials, resolution, bounds, &indices)?
+    } else {
+        let (grid, _) = read_volume(cx, volume_path, v)?;
+        IndexedDesc::from_grid(volume_path, materials, &grid)?
+    };
+    let bounds = indexed.bounds;
+    let phase = if indexed.anisotropic() {
+        // Each collision takes its material's g ([`volpt_core::Medium::phase_g`]).
+        PhaseDesc::HenyeyGreenstein { g: 0.0 }
+    } else {
+        PhaseDesc::Isotropic
+    };
+    let medium = MediumDesc {
+        density: DensityDesc::Indexed(indexed),
+        scale: v.scale,
+        albedo: AlbedoDesc::Constant([0.0; 3]),
+        phase,
+        lookup: Default::default(),
+        storage: Default::default(),
+    };
+    finish(cx, file, bounds, medium)
+}
+
+/// The scene around `medium`, whose grid's box is `grid_bounds`: boundary, camera, film,
+/// sampler, integrator and environment.
+fn finish(
+    cx: &Cx<'_>,
+    file: &SceneFile,
+    grid_bounds: Bounds,
+    medium: MediumDesc,
+) -> Result<SceneDescription, SceneError> {
     let bsdf = file.boundary.bsdf(cx)?;
     let bounds = match file.boundary.bounds {
         Some(box_) => checked_box(cx, "boundary.bounds", box_)?,
-        None => grid.bounds,
+        None => grid_bounds,
     };
 
     let c = &file.camera;
@@ -471,14 +626,7 @@ fn assemble(
             rr_depth: depth(file.integrator.rr_depth, "integrator.rr_depth")?,
         },
         boundary: BoundaryDesc { bounds, bsdf },
-        medium: MediumDesc {
-            density: DensityDesc::Grid(grid),
-            scale: v.scale,
-            albedo,
-            phase,
-            lookup: Default::default(),
-            storage: Default::default(),
-        },
+        medium,
         environment,
     })
 }
@@ -616,6 +764,13 @@ fn read_volume(cx: &Cx<'_>, file: &Path, v: &VolumeSpec) -> Result<(GridDesc, Bo
             crate::scanner::read_scanned(file, format).expect("a scanner format")?
         }
         VolumeFormat::Vtk => read_vtk(file, v.array.as_deref())?,
+        VolumeFormat::Png => {
+            return Err(cx.invalid(
+                "volume.format",
+                "a grid format (PNG slices are read with [[materials]] alone)",
+                "png",
+            ))
+        }
         VolumeFormat::Vol => {
             let vol = read_vol(file)?;
             vol.check_density(file)?;

@@ -359,22 +359,22 @@ fn density_multiplier_points_to_scale() {
 }
 
 #[test]
-fn material_preset_is_unsupported() {
+fn material_preset_in_a_heterogeneous_medium_is_unsupported() {
     let text = medium_scene(
-        r#"<medium type="homogeneous" name="interior">
+        r#"<medium type="heterogeneous" name="interior">
             <string name="material" value="Ketchup"/>
         </medium>"#,
     );
     let err = error_at(&text, "material");
-    message_of(&err, &["<string name=\"material\">", "preset"]);
+    message_of(&err, &["<string name=\"material\">", "homogeneous"]);
 }
 
 #[test]
-fn mitsuba06_medium_needs_coefficients() {
+fn mitsuba06_heterogeneous_medium_needs_a_density() {
     let text =
-        medium_scene(r#"<medium type="homogeneous" name="interior"/>"#).replace("3.0.0", "0.6.0");
+        medium_scene(r#"<medium type="heterogeneous" name="interior"/>"#).replace("3.0.0", "0.6.0");
     let err = error_at(&text, "<medium");
-    message_of(&err, &["sigma_t", "preset"]);
+    message_of(&err, &["density", "preset"]);
 }
 
 #[test]

@@ -460,7 +460,7 @@ impl Backend {
         if let Some(seed) = request.seed {
             options.seed = seed;
         }
-        let (factory, grids) = scene.grids();
+        let (factory, grids) = scene.kept_data();
         let visitor = Render {
             backend: self,
             fingerprint: &|| scene.fingerprint_of(&desc, &path, effects),
@@ -699,8 +699,8 @@ impl SceneVisitor for Render<'_> {
                         move |film: &mut Film,
                               range: Range<u32>,
                               report: &(dyn Fn(u64, u64) + Sync)| {
-                            // SAFETY: `grids` names this scene's grids, which no one writes
-                            // ([`Scene::grids`]).
+                            // SAFETY: `grids` names this scene's grids' values, which no one
+                            // writes: new values get a new number ([`Scene::kept_data`]).
                             Ok(unsafe {
                                 renderer.render_samples_keeping(
                                     scene, schedule, film, range, options, report, grids,

@@ -11,10 +11,31 @@ pub enum Error {
     /// Settings that contradict each other or the backend (e.g. a GPU strategy on the CPU).
     #[error("{0}")]
     Settings(String),
-    /// A scene parameter ([`crate::Scene::set`]) that does not exist or has a value out of range.
+    /// A setting's value out of its range or no name of its choices ([`crate::names`]): `key` in
+    /// the library's spelling (`majorant_resolution`), which each front end spells its own way
+    /// (`--majorant-resolution`, `settings["majorant_resolution"]`).
+    #[error("{key}: expected {expected}, found {found}")]
+    Setting {
+        key: &'static str,
+        expected: String,
+        found: String,
+    },
+    /// A scene parameter ([`crate::Scene::get`], [`crate::Scene::set`]) that does not exist;
+    /// `expected` lists those that do.
+    #[error("parameter {key}: expected {expected}, found no such parameter")]
+    UnknownParam { key: String, expected: String },
+    /// A scene parameter's value ([`crate::Scene::set`]) out of range.
     #[error("parameter {key}: expected {expected}, found {found}")]
     Param {
         key: String,
+        expected: String,
+        found: String,
+    },
+    /// Grid values ([`crate::Scene::set_grid`]) for a grid the scene lacks, of the wrong size,
+    /// or out of range.
+    #[error("grid {grid}: expected {expected}, found {found}")]
+    Grid {
+        grid: String,
         expected: String,
         found: String,
     },

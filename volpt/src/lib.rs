@@ -28,6 +28,10 @@
 //! - [`films`]: films of sample ranges rendered anywhere, read from their files and merged.
 //! - [`multi`]: several GPUs in one render, pulling batches of samples from one queue.
 //! - [`fingerprint`]: what makes two renders the same render, as one hash.
+//! - [`names`]: the words users type for every choice ([`Named`]: backend, strategy, math,
+//!   lookup, estimator, ...), one table each, which every front end lists and parses.
+//! - [`metrics`]: error metrics against a reference (MSE, bias, per-pixel error maps,
+//!   quantiles) and the z test of two estimates for one expectation (`volpt converge`, `compare`).
 //! - [`info`]: what a scene loads to, field by field (`volpt info`, Python's `Scene.info()`).
 //! - [`error`]: every way the above fails, as one [`Error`].
 //!
@@ -41,7 +45,9 @@ pub mod error;
 pub mod films;
 pub mod fingerprint;
 pub mod info;
+pub mod metrics;
 pub mod multi;
+pub mod names;
 pub mod observer;
 pub mod request;
 pub mod scene;
@@ -54,14 +60,15 @@ pub use checkpoint::{merge, render_checkpointed, Checkpointing, Part};
 pub use error::Error;
 pub use films::{merge_films, read_film, FilmFile, MergeError, Merged};
 pub use info::Info;
+pub use names::Named;
 pub use observer::{Observer, Quiet};
 pub use request::RenderRequest;
 pub use scene::{ParamValue, Scene, PARAMS};
-pub use settings::{RenderSettings, Tracking};
+pub use settings::{check_majorant_resolution, RenderSettings, Tracking, MAJORANT_RESOLUTION};
 
 pub use volpt_core::{Estimator, PathSettings, Roulette};
 pub use volpt_cuda::{Math, Strategy};
-pub use volpt_film::{Film, Image, RenderStats};
+pub use volpt_film::{Accumulation, Film, Image, RenderStats};
 pub use volpt_gpu_mem::VolumeMemory;
 pub use volpt_render::{Effects, Variant};
 pub use volpt_scene::{GridLookup, SceneDescription};

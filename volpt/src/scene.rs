@@ -14,8 +14,8 @@ use volpt_scene::medium::{MediumParam, ParamRefused};
 use volpt_scene::toml_scene::look_at;
 use volpt_scene::validate::CheckedData;
 use volpt_scene::{
-    GridLookup, GridStorage, MediumDesc, NumberParam, PhaseDesc, SampleLayout, SceneAssembler,
-    SceneBuilder, SceneDescription,
+    AlbedoDesc, DensityDesc, GridDesc, GridLookup, GridStorage, MediumDesc, NumberParam, PhaseDesc,
+    SampleLayout, SceneAssembler, SceneBuilder, SceneDescription,
 };
 
 use crate::settings::RenderSettings;
@@ -39,7 +39,8 @@ pub struct Scene {
     /// Whether the grid lookup was chosen (a setting, [`Scene::set_lookup`]) rather than left to
     /// the backend's default ([`crate::Backend::default_lookup`]).
     lookup_chosen: bool,
-    /// What is known of the grids, which no method changes once the scene is built.
+    /// What is known of the grids' values: replaced with them ([`Scene::set_grid`]), never
+    /// changed in place, so that what names the values names one set of values.
     data: Arc<DataFacts>,
     /// The description as a backend that stores or looks up the grids otherwise reads it, made by
     /// the first render that needed it ([`Scene::read_as`]); dropped by every change of the
@@ -543,9 +544,119 @@ impl Scene {
     }
 
     /// What a renderer keeps of this scene between renders: the factory's scans of its grids,
-    /// and the number naming its grids (unique to this scene; its grids are never written).
-    pub(crate) fn grids(&self) -> (&FactoryCache, u64) {
+    /// and the number naming its grids' values (unique to this scene's current grids: cloning a
+    /// scene or replacing a grid's values names them anew, [`Scene::set_grid`]).
+    pub(crate) fn kept_data(&self) -> (&FactoryCache, u64) {
         (&self.data.factory, self.data.id)
+    }
+
+    /// The medium's grid `name` (`"density"`, `"albedo"`: [`Scene::grid_names`]): its resolution,
+    /// channels, box and values (x fastest, then y, then z, channels interleaved).
+    pub fn grid(&self, name: &str) -> Result<&GridDesc, Error> {
+        match self.desc.medium.grids().find(|(n, _)| *n == name) {
+            Some((_, grid)) => Ok(grid),
+            None => Err(self.no_grid(name)),
+        }
+    }
+
+    /// The names of the medium's grids, in [`Scene::grid`]'s spelling.
+    pub fn grid_names(&self) -> Vec<&'static str> {
+        self.desc.medium.grids().map(|(name, _)| name).collect()
+    }
+
+    /// Replaces the values of the medium's grid `name` with `values`, laid out as the grid's
+    /// own ([`Scene::grid`]: the same resolution and channels, x fastest), checked as a loaded
+    /// scene's are. New values are new data: the scene's fingerprint, the backends' kept copies
+    /// (the factory's scans, a GPU's resident grids, `auto`'s calibration key) follow them, and
+    /// renders give the image of a scene loaded with them. Values equal to the grid's own, bit
+    /// for bit, change nothing (every kept copy stays). A refusal (no such grid, a grid kept
+    /// sparse, the wrong number of values, a value out of range) leaves the scene as it was.
+    pub fn set_grid(&mut self, name: &str, values: Vec<f32>) -> Result<(), Error> {
+        let grid = self.grid(name)?;
+        let wrong = |expected: String, found: String| Error::Grid {
+            grid: name.to_owned(),
+            expected,
+            found,
+        };
+        if grid.layout == SampleLayout::Sparse {
+            return Err(wrong(
+                "a dense grid (its values replaced in place)".into(),
+                "a grid kept sparse (a VDB's leaves): load it dense (sparse = \"never\" in a \
+                 TOML scene) to replace its values"
+                    .into(),
+            ));
+        }
+        let [x, y, z] = grid.resolution;
+        if values.len() != grid.data.len() {
+            return Err(wrong(
+                format!(
+                    "{} values ({x} x {y} x {z} samples x {} channels)",
+                    grid.data.len(),
+                    grid.channels
+                ),
+                format!("{} values", values.len()),
+            ));
+        }
+        let same = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(a, b)| a.to_bits() == b.to_bits());
+        if same(&grid.data, &values) {
+            return Ok(());
+        }
+        let old = std::mem::replace(self.grid_values(name), values);
+        let checked = volpt_scene::validate::validate(&self.desc, &self.source)
+            .map_err(|error| match error {
+                volpt_scene::SceneError::InvalidScene {
+                    field,
+                    expected,
+                    found,
+                    ..
+                } => wrong(format!("{expected} (the scene's {field})"), found),
+                error => Error::Scene(error),
+            })
+            .and_then(|checked| {
+                check_lookup(&self.desc, self.desc.medium.lookup, checked).map(|()| checked)
+            });
+        match checked {
+            Ok(checked) => {
+                // New values, new identity: nothing kept of the old values is read again.
+                self.data = Arc::new(DataFacts::new(checked));
+                self.changed();
+                Ok(())
+            }
+            Err(error) => {
+                *self.grid_values(name) = old;
+                Err(error)
+            }
+        }
+    }
+
+    /// [`Scene::set_grid`] by value, for a chain of calls.
+    pub fn with_grid(mut self, name: &str, values: Vec<f32>) -> Result<Self, Error> {
+        self.set_grid(name, values)?;
+        Ok(self)
+    }
+
+    /// The values of grid `name`, which [`Scene::grid`] found.
+    fn grid_values(&mut self, name: &str) -> &mut Vec<f32> {
+        let medium = &mut self.desc.medium;
+        match (name, &mut medium.density, &mut medium.albedo) {
+            ("density", DensityDesc::Grid(grid), _) | ("albedo", _, AlbedoDesc::Grid(grid)) => {
+                &mut grid.data
+            }
+            _ => unreachable!("grid {name} was found by Scene::grid"),
+        }
+    }
+
+    fn no_grid(&self, name: &str) -> Error {
+        let names = self.grid_names();
+        Error::Grid {
+            grid: name.to_owned(),
+            expected: if names.is_empty() {
+                "a grid of the medium, which has none (its density and albedo are constants)".into()
+            } else {
+                format!("one of the medium's grids: {}", names.join(", "))
+            },
+            found: "no such grid".into(),
+        }
     }
 
     /// The small parts [`Scene::set`] changes (never the grids), to restore on a refusal.
@@ -612,10 +723,9 @@ impl WithChoices for PathSettings {
 
 fn unknown(key: &str) -> Error {
     let keys: Vec<_> = PARAMS.iter().map(|(k, _)| *k).collect();
-    Error::Param {
+    Error::UnknownParam {
         key: key.to_owned(),
         expected: format!("one of {}", keys.join(", ")),
-        found: "no such parameter".into(),
     }
 }
 

@@ -44,6 +44,27 @@ pub struct RenderSettings {
     pub threads: Option<usize>,
 }
 
+/// The cells of a majorant grid along the box's longest axis a setting may ask for
+/// ([`RenderSettings::majorant_resolution`]; 1 is the global majorant).
+pub const MAJORANT_RESOLUTION: std::ops::RangeInclusive<u32> = 1..=1024;
+
+/// `cells` if a majorant grid may have so many cells along its longest axis
+/// ([`MAJORANT_RESOLUTION`]), else [`Error::Setting`].
+pub fn check_majorant_resolution(cells: u32) -> Result<u32, Error> {
+    if MAJORANT_RESOLUTION.contains(&cells) {
+        return Ok(cells);
+    }
+    Err(Error::Setting {
+        key: "majorant_resolution",
+        expected: format!(
+            "{} to {} cells",
+            MAJORANT_RESOLUTION.start(),
+            MAJORANT_RESOLUTION.end()
+        ),
+        found: cells.to_string(),
+    })
+}
+
 /// Delta and ratio tracking under one majorant or a grid of them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Tracking {
@@ -75,13 +96,8 @@ impl RenderSettings {
                      grid"
                 )))
             }
-            (_, Some(0)) => {
-                return Err(Error::Settings(
-                    "--majorant-resolution: expected 1 to 1024 cells, found 0".into(),
-                ))
-            }
             (Some(Tracking::Global), _) => 1,
-            (_, Some(r)) => r,
+            (_, Some(r)) => check_majorant_resolution(r)?,
             (Some(Tracking::Grid), None) if settings.majorant_resolution <= 1 => {
                 PathSettings::DEFAULT_MAJORANT_RESOLUTION
             }
@@ -105,10 +121,11 @@ impl RenderSettings {
         let cores = std::thread::available_parallelism().map_or(1, usize::from);
         let most = 4 * cores;
         if !(1..=most).contains(&threads) {
-            return Err(Error::Settings(format!(
-                "--threads: expected 1 to {most} (4 x the {cores} cores of this machine), found \
-                 {threads}"
-            )));
+            return Err(Error::Setting {
+                key: "threads",
+                expected: format!("1 to {most} (4 x the {cores} cores of this machine)"),
+                found: threads.to_string(),
+            });
         }
         Ok(())
     }

@@ -7,7 +7,9 @@
 #   MODE=gpu bash bench/peers/mitsuba3/device.sh   # only the GPU rows; MODE=cpu only the CPU rows
 #
 # Settings: GPU_RES/GPU_SPP (default 400/100, the thesis settings), CPU_RES/CPU_SPP (default 100/64:
-# Mitsuba's LLVM backend is slow on these dense scenes), SCENES (names, default all seven).
+# Mitsuba's LLVM backend is slow on these dense scenes), SCENES (names, default the seven grey
+# scenes; chromatic-cube and chromatic-slab name scenes/chromatic's media, which Mitsuba renders with
+# `volpathmis`).
 # Everything lands under $OUT/peers: results.md (one Markdown row per scene and device), <name>.json,
 # the EXR images, the Mitsuba 3 XML each scene was rendered from, and the logs.
 #
@@ -85,6 +87,8 @@ scene_args() { # name -> file and -D parameters
         smoke) echo "bundle/scenes/smoke/scene.xml -D data=$DATA" ;;
         bucky) echo "bundle/scenes/bucky/scene.toml -D data=$DATA" ;;
         envmap-cube) echo "bundle/scenes/envmap-cube/scene.xml" ;;
+        chromatic-cube) echo "bundle/scenes/chromatic/cube.xml" ;;
+        chromatic-slab) echo "bundle/scenes/chromatic/slab.xml" ;;
         *) echo "" ;;
     esac
 }

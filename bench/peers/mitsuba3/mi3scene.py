@@ -2,7 +2,7 @@
 the estimator volpt uses. Everything this changes is listed in the returned notes.
 
 For every scene:
-  * integrator: must be `volpath`; `rr_depth <= 0` (volpt: "no Russian roulette") becomes 10^9, since
+  * integrator: must be `volpath` or `volpathmis` (spectral MIS, for chromatic media); `rr_depth <= 0` (volpt: "no Russian roulette") becomes 10^9, since
     Mitsuba 3 rejects `rr_depth` values below 1; `max_depth` is kept (-1 = unlimited in both).
   * sampler: must be `independent` (anything else is an error: volpt only has that one).
   * `filename` strings are made absolute (after filling `$name` parameters), so that the written
@@ -151,8 +151,8 @@ class Converter:
                                                 "(generate grids with `volpt scene generate scenes`)")
                     c.set("value", f)
         integrators = list(self.root.iter("integrator"))
-        if len(integrators) != 1 or integrators[0].get("type") != "volpath":
-            raise ValueError(f"{self.path}: needs exactly one `volpath` integrator")
+        if len(integrators) != 1 or integrators[0].get("type") not in ("volpath", "volpathmis"):
+            raise ValueError(f"{self.path}: needs exactly one `volpath` or `volpathmis` integrator")
         integ = integrators[0]
         rr = [c for c in integ if c.get("name") == "rr_depth"]
         if rr and int(self.subst(rr[0].get("value"))) <= 0:

@@ -21,6 +21,7 @@ pub struct SmoothBall {
 }
 
 impl Medium for SmoothBall {
+    type Spectral = ();
     const HOMOGENEOUS: bool = false;
 
     #[inline]

@@ -320,15 +320,16 @@ impl Wavefront {
 pub const SLOT_BYTES: usize = 128;
 
 /// A path in flight with the film pixel it belongs to (parked in shared or device memory by the
-/// strategies that move paths between threads).
+/// strategies that move paths between threads); `X` is the path's spectral state (nothing for a
+/// grey medium).
 #[derive(Clone, Copy)]
 #[repr(C)]
-pub struct Slot {
-    pub path: volpt_core::path::PathState,
+pub struct Slot<X = ()> {
+    pub path: volpt_core::path::PathState<X>,
     pub pixel: u32,
 }
 
-const _: () = assert!(core::mem::size_of::<Slot>() <= SLOT_BYTES);
+const _: () = assert!(core::mem::size_of::<Slot<volpt_core::HeroChannel>>() <= SLOT_BYTES);
 
 /// Queued paths per resident thread of streaming-mk: each thread extends several paths per
 /// launch, so that the launches' fixed cost is shared by more segments.

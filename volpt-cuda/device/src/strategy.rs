@@ -30,7 +30,10 @@
 //! code, and lanes vote or wait at different instructions.
 
 use volpt_core::medium::Medium;
-use volpt_core::path::{fly, sample_pixel, scatter, step, PathCounters, PathState, Truncation};
+use volpt_core::path::{
+    fly, sample_pixel, scatter, step, PathCounters, PathOf, PathState, SpectralOf, Truncation,
+};
+use volpt_core::{HeroChannel, SpectralState};
 use volpt_core::{Scene, Spectrum, Vec3};
 
 use crate::launch::{path_of, LaunchParams, Slot, Stage, Wavefront, BLOCK_SIZE, SLOT_BYTES};
@@ -78,7 +81,7 @@ impl ThreadCounters {
     /// # Safety
     /// `totals` must be the launch's `launch::COUNTERS` totals.
     #[inline(always)]
-    unsafe fn record(&mut self, path: &PathState, totals: *mut u64) {
+    unsafe fn record<X>(&mut self, path: &PathState<X>, totals: *mut u64) {
         // SAFETY: the caller's contract; the indices are those of `launch::COUNTERS`.
         unsafe {
             Self::add(&mut self.paths, 1, totals);
@@ -223,7 +226,7 @@ impl<'a, S: Scene, P> PathPool<'a, S, P> {
 
     /// A lane without a path: its path is a placeholder until a refill starts one.
     #[inline(always)]
-    fn idle_lane(&self) -> Lane {
+    fn idle_lane(&self) -> Lane<SpectralOf<S>> {
         Lane {
             path: PathState::from_camera(self.scene, 0, 0, 0, self.lp.seed),
             pixel: 0,
@@ -234,7 +237,7 @@ impl<'a, S: Scene, P> PathPool<'a, S, P> {
     /// Path `index` of the launch ([`path_of`]): its first state, from the camera, and its film
     /// pixel.
     #[inline(always)]
-    fn start(&self, index: u64) -> Slot {
+    fn start(&self, index: u64) -> Slot<SpectralOf<S>> {
         let (tile_pixel, sample) = path_of(index, self.pixels, self.lp.first_sample);
         let (px, py, pixel) = self
             .lp
@@ -248,7 +251,7 @@ impl<'a, S: Scene, P> PathPool<'a, S, P> {
 
     /// Starts path `index` in `lane`, which becomes live.
     #[inline(always)]
-    fn start_in(&self, lane: &mut Lane, index: u64) {
+    fn start_in(&self, lane: &mut Lane<SpectralOf<S>>, index: u64) {
         let Slot { path, pixel } = self.start(index);
         lane.path = path;
         lane.pixel = pixel;
@@ -260,7 +263,7 @@ impl<'a, S: Scene, P> PathPool<'a, S, P> {
     /// # Safety
     /// `pixel` must be a pixel of the launch's film (every [`Self::start`]ed path's is).
     #[inline(always)]
-    unsafe fn record(&mut self, path: &PathState, pixel: u32) {
+    unsafe fn record(&mut self, path: &PathOf<S>, pixel: u32) {
         // SAFETY: `totals` holds the launch's `launch::COUNTERS` totals.
         unsafe { self.counters.record(path, self.totals) };
         for c in 0..3 {
@@ -274,7 +277,7 @@ impl<'a, S: Scene, P> PathPool<'a, S, P> {
 
     /// Records the path of a live `lane` if it has ended, and idles the lane.
     #[inline(always)]
-    fn retire_if_ended(&mut self, lane: &mut Lane) {
+    fn retire_if_ended(&mut self, lane: &mut Lane<SpectralOf<S>>) {
         if !lane.path.alive {
             // SAFETY: a live lane's pixel is its started path's.
             unsafe { self.record(&lane.path, lane.pixel) };
@@ -284,7 +287,7 @@ impl<'a, S: Scene, P> PathPool<'a, S, P> {
 
     /// One step of `lane`'s path if it is live; an ended path is recorded and the lane idles.
     #[inline(always)]
-    fn step(&mut self, lane: &mut Lane) {
+    fn step(&mut self, lane: &mut Lane<SpectralOf<S>>) {
         if lane.active {
             step(self.scene, &mut lane.path);
             self.retire_if_ended(lane);
@@ -303,8 +306,8 @@ impl<'a, S: Scene, P> PathPool<'a, S, P> {
 /// One path slot of a thread: a path and its film pixel, traced while `active`. An idle lane's
 /// path is a placeholder or the path it last finished, and is never stepped.
 #[derive(Clone, Copy)]
-struct Lane {
-    path: PathState,
+struct Lane<X> {
+    path: PathState<X>,
     pixel: u32,
     active: bool,
 }
@@ -312,21 +315,25 @@ struct Lane {
 /// The lanes a thread keeps: one [`Lane`], or an array of them that one copy of the step's code
 /// walks in turn.
 trait Lanes: Copy {
-    fn idle(lane: Lane) -> Self;
+    /// The spectral state of the lanes' paths.
+    type X: SpectralState;
+    fn idle(lane: Lane<Self::X>) -> Self;
     /// Calls `f` on every lane, in order.
-    fn each(&mut self, f: impl FnMut(&mut Lane));
+    fn each(&mut self, f: impl FnMut(&mut Lane<Self::X>));
     /// Whether any of this thread's lanes is live (no vote).
     fn any_active(&self) -> bool;
 }
 
-impl Lanes for Lane {
+impl<X: SpectralState> Lanes for Lane<X> {
+    type X = X;
+
     #[inline(always)]
-    fn idle(lane: Lane) -> Self {
+    fn idle(lane: Lane<X>) -> Self {
         lane
     }
 
     #[inline(always)]
-    fn each(&mut self, mut f: impl FnMut(&mut Lane)) {
+    fn each(&mut self, mut f: impl FnMut(&mut Lane<X>)) {
         f(self)
     }
 
@@ -339,14 +346,16 @@ impl Lanes for Lane {
 /// `K` lanes walked by a loop: the array is indexed at run time and so kept in local memory (the
 /// one kind of kernel that keeps more than the counters' 64 bytes there,
 /// `volpt-cuda/tests/ptx_entries.rs`). Unrolled, the step's code would be inlined `K` times.
-impl<const K: usize> Lanes for [Lane; K] {
+impl<X: SpectralState, const K: usize> Lanes for [Lane<X>; K] {
+    type X = X;
+
     #[inline(always)]
-    fn idle(lane: Lane) -> Self {
+    fn idle(lane: Lane<X>) -> Self {
         [lane; K]
     }
 
     #[inline(always)]
-    fn each(&mut self, mut f: impl FnMut(&mut Lane)) {
+    fn each(&mut self, mut f: impl FnMut(&mut Lane<X>)) {
         for lane in self.iter_mut() {
             f(lane)
         }
@@ -367,7 +376,10 @@ trait Refill {
 
     /// Gives idle lanes the next path indices, in lane order, and sets `pool.exhausted` once the
     /// indices run out. Every thread of the group calls it at the same point with all its lanes.
-    fn refill<S: Scene, P, L: Lanes>(pool: &mut PathPool<'_, S, P>, lanes: &mut L);
+    fn refill<S: Scene, P, L: Lanes<X = SpectralOf<S>>>(
+        pool: &mut PathPool<'_, S, P>,
+        lanes: &mut L,
+    );
 
     /// Whether any lane of the group is live, given whether this thread's are: the same answer
     /// in every thread of the group, so that the group leaves the loop together.
@@ -396,7 +408,7 @@ struct BlockRefill;
 /// steps its paths to their ends, without the refill's votes (that tail sets the pace of the
 /// launch's last, longest paths, docs/strategies.md).
 #[inline(always)]
-fn warp_refill<S: Scene, P, L: Lanes>(
+fn warp_refill<S: Scene, P, L: Lanes<X = SpectralOf<S>>>(
     pool: &mut PathPool<'_, S, P>,
     lanes: &mut L,
     ready: impl Fn(&LaunchParams<P>, bool) -> bool,
@@ -423,7 +435,10 @@ impl Refill for ThreadRefill {
     const BLOCK: bool = false;
 
     #[inline(always)]
-    fn refill<S: Scene, P, L: Lanes>(pool: &mut PathPool<'_, S, P>, lanes: &mut L) {
+    fn refill<S: Scene, P, L: Lanes<X = SpectralOf<S>>>(
+        pool: &mut PathPool<'_, S, P>,
+        lanes: &mut L,
+    ) {
         warp_refill(
             pool,
             lanes,
@@ -441,7 +456,10 @@ impl Refill for WarpRefill {
     const BLOCK: bool = false;
 
     #[inline(always)]
-    fn refill<S: Scene, P, L: Lanes>(pool: &mut PathPool<'_, S, P>, lanes: &mut L) {
+    fn refill<S: Scene, P, L: Lanes<X = SpectralOf<S>>>(
+        pool: &mut PathPool<'_, S, P>,
+        lanes: &mut L,
+    ) {
         warp_refill(
             pool,
             lanes,
@@ -457,7 +475,10 @@ impl Refill for BlockRefill {
     const BLOCK: bool = true;
 
     #[inline(always)]
-    fn refill<S: Scene, P, L: Lanes>(pool: &mut PathPool<'_, S, P>, lanes: &mut L) {
+    fn refill<S: Scene, P, L: Lanes<X = SpectralOf<S>>>(
+        pool: &mut PathPool<'_, S, P>,
+        lanes: &mut L,
+    ) {
         lanes.each(
             #[inline(always)]
             |lane| {
@@ -500,7 +521,11 @@ trait Advance<L: Lanes> {
     type Setup: Copy;
     fn setup() -> Self::Setup;
 
-    fn advance<S: Scene, P>(setup: Self::Setup, pool: &mut PathPool<'_, S, P>, lanes: &mut L);
+    fn advance<S: Scene<Medium: Medium<Spectral = L::X>>, P>(
+        setup: Self::Setup,
+        pool: &mut PathPool<'_, S, P>,
+        lanes: &mut L,
+    );
 }
 
 /// Each lane steps its own path (no collective).
@@ -535,7 +560,11 @@ impl<L: Lanes> Advance<L> for InPlace {
     fn setup() {}
 
     #[inline(always)]
-    fn advance<S: Scene, P>(_: (), pool: &mut PathPool<'_, S, P>, lanes: &mut L) {
+    fn advance<S: Scene<Medium: Medium<Spectral = L::X>>, P>(
+        _: (),
+        pool: &mut PathPool<'_, S, P>,
+        lanes: &mut L,
+    ) {
         lanes.each(
             #[inline(always)]
             |lane| pool.step(lane),
@@ -543,7 +572,7 @@ impl<L: Lanes> Advance<L> for InPlace {
     }
 }
 
-impl Advance<Lane> for Compact {
+impl<X: SpectralState> Advance<Lane<X>> for Compact {
     const BLOCK: bool = true;
     const FIRST: bool = true;
     type Setup = BlockSlots;
@@ -554,13 +583,17 @@ impl Advance<Lane> for Compact {
     }
 
     #[inline(always)]
-    fn advance<S: Scene, P>(block: BlockSlots, pool: &mut PathPool<'_, S, P>, lane: &mut Lane) {
+    fn advance<S: Scene<Medium: Medium<Spectral = X>>, P>(
+        block: BlockSlots,
+        pool: &mut PathPool<'_, S, P>,
+        lane: &mut Lane<X>,
+    ) {
         pool.step(lane);
         compact(block, lane);
     }
 }
 
-impl Advance<Lane> for SortPaths {
+impl<X: SpectralState> Advance<Lane<X>> for SortPaths {
     const BLOCK: bool = true;
     const FIRST: bool = true;
     type Setup = BlockSlots;
@@ -571,11 +604,15 @@ impl Advance<Lane> for SortPaths {
     }
 
     #[inline(always)]
-    fn advance<S: Scene, P>(block: BlockSlots, pool: &mut PathPool<'_, S, P>, lane: &mut Lane) {
+    fn advance<S: Scene<Medium: Medium<Spectral = X>>, P>(
+        block: BlockSlots,
+        pool: &mut PathPool<'_, S, P>,
+        lane: &mut Lane<X>,
+    ) {
         pool.step(lane);
         // Each thread parks its live path at its own index and takes the path of its place in
         // the Morton order.
-        let BlockSlots { slots, thread } = block;
+        let (slots, thread) = (block.of::<X>(), block.thread);
         let key = if lane.active {
             morton30(lane.path.ray.origin, &pool.scene.bounds())
         } else {
@@ -597,7 +634,7 @@ impl Advance<Lane> for SortPaths {
     }
 }
 
-impl Advance<Lane> for SortAlbedoReads {
+impl<X: SpectralState> Advance<Lane<X>> for SortAlbedoReads {
     const BLOCK: bool = true;
     const FIRST: bool = true;
     type Setup = BlockSlots;
@@ -608,7 +645,11 @@ impl Advance<Lane> for SortAlbedoReads {
     }
 
     #[inline(always)]
-    fn advance<S: Scene, P>(block: BlockSlots, pool: &mut PathPool<'_, S, P>, lane: &mut Lane) {
+    fn advance<S: Scene<Medium: Medium<Spectral = X>>, P>(
+        block: BlockSlots,
+        pool: &mut PathPool<'_, S, P>,
+        lane: &mut Lane<X>,
+    ) {
         if S::Medium::CONSTANT_ALBEDO {
             pool.step(lane);
         } else {
@@ -621,9 +662,9 @@ impl Advance<Lane> for SortAlbedoReads {
     }
 }
 
-impl Lane {
+impl<X: SpectralState> Lane<X> {
     #[inline(always)]
-    fn slot(&self) -> Slot {
+    fn slot(&self) -> Slot<X> {
         Slot {
             path: self.path,
             pixel: self.pixel,
@@ -631,24 +672,25 @@ impl Lane {
     }
 
     #[inline(always)]
-    fn set_slot(&mut self, slot: Slot) {
+    fn set_slot(&mut self, slot: Slot<X>) {
         self.path = slot.path;
         self.pixel = slot.pixel;
     }
 }
 
-// One slot per thread of the block, where the regroupings park its paths.
+// One slot per thread of the block, where the regroupings park its paths: the largest slot, a
+// chromatic path's (one array serves every kernel of the module).
 core::arch::global_asm!(
     ".shared .align 16 .b8 volpt_stream_slots[{n}];",
-    n = const core::mem::size_of::<Slot>() * BLOCK_SIZE as usize,
+    n = const core::mem::size_of::<Slot<HeroChannel>>() * BLOCK_SIZE as usize,
 );
 
 /// The block's path slots in shared memory, one per thread, and this thread's index there;
 /// computed once per kernel, before the loop (the address comes from asm, which LLVM does not
-/// hoist out of a loop).
+/// hoist out of a loop). The slots' type is the paths' ([`BlockSlots::of`]).
 #[derive(Clone, Copy)]
 struct BlockSlots {
-    slots: *mut Slot,
+    slots: *mut u8,
     thread: u32,
 }
 
@@ -656,16 +698,24 @@ impl BlockSlots {
     #[inline(always)]
     fn new() -> Self {
         BlockSlots {
-            slots: shared_to_generic(shared_address!("volpt_stream_slots")) as *mut Slot,
+            slots: shared_to_generic(shared_address!("volpt_stream_slots")) as *mut u8,
             thread: thread_index(),
         }
+    }
+
+    /// The slots as slots of paths of spectral state `X` (at most as large as the array's).
+    #[inline(always)]
+    fn of<X: SpectralState>(self) -> *mut Slot<X> {
+        const { assert!(core::mem::size_of::<Slot<X>>() <= core::mem::size_of::<Slot<HeroChannel>>()) };
+        self.slots as *mut Slot<X>
     }
 }
 
 /// The block's live paths move to its first threads, in thread order: live path `rank` to thread
 /// `rank` (block-collective).
 #[inline(always)]
-fn compact(BlockSlots { slots, thread }: BlockSlots, lane: &mut Lane) {
+fn compact<X: SpectralState>(block: BlockSlots, lane: &mut Lane<X>) {
+    let (slots, thread) = (block.of::<X>(), block.thread);
     let (rank, live) = block_exclusive_count(opaque(lane.active));
     if lane.active {
         // SAFETY: `rank < BLOCK_SIZE` slots.
@@ -691,7 +741,7 @@ core::arch::global_asm!(
 /// One step of the block's live paths with the albedo of their collisions read in Morton order
 /// (block-collective).
 #[inline(always)]
-fn step_with_sorted_albedo_reads<S: Scene>(scene: &S, path: &mut PathState, active: bool) {
+fn step_with_sorted_albedo_reads<S: Scene>(scene: &S, path: &mut PathOf<S>, active: bool) {
     let points = shared_to_generic(shared_address!("volpt_sort_points")) as *mut [f32; 3];
     let albedos = shared_to_generic(shared_address!("volpt_sort_albedos")) as *mut [f32; 3];
     let thread = thread_index() as usize;
@@ -742,7 +792,7 @@ fn step_with_sorted_albedo_reads<S: Scene>(scene: &S, path: &mut PathState, acti
 /// `lp.next_path` one zeroed `u64`; the block size a multiple of 32 (of `BLOCK_SIZE` under a
 /// block-level refill), and every thread of the block runs the kernel.
 #[inline(always)]
-unsafe fn persistent<S: Scene, P, R: Refill, A: Advance<L>, L: Lanes>(
+unsafe fn persistent<S: Scene, P, R: Refill, A: Advance<L>, L: Lanes<X = SpectralOf<S>>>(
     scene: &S,
     lp: &LaunchParams<P>,
 ) {
@@ -781,7 +831,7 @@ unsafe fn persistent<S: Scene, P, R: Refill, A: Advance<L>, L: Lanes>(
 #[inline(always)]
 pub unsafe fn regeneration_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     // SAFETY: forwarded.
-    unsafe { persistent::<S, P, ThreadRefill, InPlace, Lane>(scene, lp) }
+    unsafe { persistent::<S, P, ThreadRefill, InPlace, Lane<SpectralOf<S>>>(scene, lp) }
 }
 
 /// regenerationSK at warp level: see [`WarpRefill`].
@@ -791,7 +841,7 @@ pub unsafe fn regeneration_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
 #[inline(always)]
 pub unsafe fn regeneration_warp_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     // SAFETY: forwarded.
-    unsafe { persistent::<S, P, WarpRefill, InPlace, Lane>(scene, lp) }
+    unsafe { persistent::<S, P, WarpRefill, InPlace, Lane<SpectralOf<S>>>(scene, lp) }
 }
 
 /// regenerationSK at block level: see [`BlockRefill`].
@@ -801,7 +851,7 @@ pub unsafe fn regeneration_warp_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>)
 #[inline(always)]
 pub unsafe fn regeneration_block_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     // SAFETY: forwarded.
-    unsafe { persistent::<S, P, BlockRefill, InPlace, Lane>(scene, lp) }
+    unsafe { persistent::<S, P, BlockRefill, InPlace, Lane<SpectralOf<S>>>(scene, lp) }
 }
 
 /// regenerationSK with two paths per thread (the thesis's instruction-level-parallelism study):
@@ -816,7 +866,7 @@ pub unsafe fn regeneration_block_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>
 #[inline(always)]
 pub unsafe fn regeneration_2p_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     // SAFETY: forwarded.
-    unsafe { persistent::<S, P, ThreadRefill, InPlace, [Lane; 2]>(scene, lp) }
+    unsafe { persistent::<S, P, ThreadRefill, InPlace, [Lane<SpectralOf<S>>; 2]>(scene, lp) }
 }
 
 /// streamingSK (the thesis's algorithm 5, with compaction in the block): see [`Compact`].
@@ -826,7 +876,7 @@ pub unsafe fn regeneration_2p_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
 #[inline(always)]
 pub unsafe fn streaming_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     // SAFETY: forwarded.
-    unsafe { persistent::<S, P, BlockRefill, Compact, Lane>(scene, lp) }
+    unsafe { persistent::<S, P, BlockRefill, Compact, Lane<SpectralOf<S>>>(scene, lp) }
 }
 
 /// streamingSK with Morton sorting: see [`SortPaths`].
@@ -836,7 +886,7 @@ pub unsafe fn streaming_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
 #[inline(always)]
 pub unsafe fn streaming_sorted_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     // SAFETY: forwarded.
-    unsafe { persistent::<S, P, BlockRefill, SortPaths, Lane>(scene, lp) }
+    unsafe { persistent::<S, P, BlockRefill, SortPaths, Lane<SpectralOf<S>>>(scene, lp) }
 }
 
 /// sortingSK: see [`SortAlbedoReads`].
@@ -846,7 +896,7 @@ pub unsafe fn streaming_sorted_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) 
 #[inline(always)]
 pub unsafe fn sorting_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     // SAFETY: forwarded.
-    unsafe { persistent::<S, P, BlockRefill, SortAlbedoReads, Lane>(scene, lp) }
+    unsafe { persistent::<S, P, BlockRefill, SortAlbedoReads, Lane<SpectralOf<S>>>(scene, lp) }
 }
 
 /// The multi-kernel strategies, naiveMK and streamingMK (the thesis's; `Regeneration` says how
@@ -867,9 +917,9 @@ pub unsafe fn sorting_sk<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
 #[inline(always)]
 pub unsafe fn multi_kernel<S: Scene, P>(scene: &S, lp: &LaunchParams<P>) {
     let state = lp.wavefront as *mut Wavefront;
-    let slot_at = |queue: u32, i: u64| -> *mut Slot {
+    let slot_at = |queue: u32, i: u64| -> *mut Slot<SpectralOf<S>> {
         let index = queue as u64 * lp.capacity as u64 + i;
-        (lp.queues + index * SLOT_BYTES as u64) as *mut Slot
+        (lp.queues + index * SLOT_BYTES as u64) as *mut Slot<SpectralOf<S>>
     };
     // SAFETY: the caller's contract.
     let mut pool = unsafe { PathPool::new(scene, lp) };

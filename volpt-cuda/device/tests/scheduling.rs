@@ -348,4 +348,5 @@ fn the_launch_parameters_keep_their_layout_with_the_queue_fields() {
     let () = LaunchParams::<[u64; 3]>::LAYOUT;
     assert_eq!(size_of::<LaunchParams<[u64; 3]>>(), 24 + 88);
     assert!(size_of::<Slot>() <= SLOT_BYTES);
+    assert!(size_of::<Slot<volpt_core::HeroChannel>>() <= SLOT_BYTES);
 }

@@ -45,6 +45,7 @@ use volpt_core::abi::SceneAbi;
 use volpt_core::grid::Grid;
 
 use volpt_core::majorant::MajorantGrid;
+use volpt_core::material::build_material_majorants;
 use volpt_core::math::tan;
 use volpt_core::path::Estimator;
 use volpt_core::{Aabb, PathSettings, PerspectiveCamera, Scene, Vec2, Vec3, VolumeScene};
@@ -162,6 +163,12 @@ macro_rules! factory {
             fn track_with(&mut self, grid: Option<MajorantGrid<'a>>) {
                 match self {
                     $(MediumPart::$Mv(m) => m.track_with(grid),)*
+                }
+            }
+
+            fn materials(&self) -> Option<volpt_core::MaterialGrid<'a>> {
+                match self {
+                    $(MediumPart::$Mv(m) => m.materials(),)*
                 }
             }
         }
@@ -388,13 +395,20 @@ impl Derived {
         settings: &PathSettings,
         cache: &FactoryCache,
     ) -> Self {
-        let majorants = parts
-            .medium
-            .density()
-            .filter(|_| settings.majorant_resolution > 1)
-            .map(|(density, scale)| {
-                let res = MajorantGrid::resolution_for(bounds, settings.majorant_resolution);
-                cache.majorants(&density, scale, bounds, res)
+        // A material-indexed volume's bounds come from its index grid, replaced between renders
+        // by a printing application: built anew each time, not cached.
+        let indexed = |res: [u32; 3]| {
+            parts.medium.materials().map(|grid| {
+                let mut data = vec![0.0; res.iter().map(|&r| r as usize).product()];
+                build_material_majorants(&grid, bounds, res, &mut data);
+                Arc::new(Majorants { data, res })
+            })
+        };
+        let majorants = (settings.majorant_resolution > 1)
+            .then(|| MajorantGrid::resolution_for(bounds, settings.majorant_resolution))
+            .and_then(|res| match parts.medium.density() {
+                Some((density, scale)) => Some(cache.majorants(&density, scale, bounds, res)),
+                None => indexed(res),
             })
             // A grid whose every cell has the global bound (a uniform density, as ad's) saves no
             // step and costs the walk: track with the global majorant.

@@ -18,6 +18,7 @@ pub(crate) mod ior;
 mod obj;
 pub(crate) mod plugin;
 pub(crate) mod preprocess;
+pub mod presets;
 mod sensor;
 mod shape;
 pub(crate) mod spectrum;

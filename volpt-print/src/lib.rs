@@ -1,0 +1,26 @@
+//! Colour 3D printing on volpt: predicting a voxel print's appearance and compensating the
+//! scattering that blurs its texture (Elek et al. 2017, "Scattering-aware texture reproduction
+//! for 3D printing"). `docs/printing.md` states what exists and the model choices.
+//!
+//! - [`colour`]: sRGB, linear RGB, CIE XYZ, CIE L*a*b* (D65) and CIEDE2000.
+//! - [`material`]: a print's material table and where its five inks are.
+//! - [`print`]: a voxel print, one material index per voxel.
+//! - [`slices`]: slice stacks (one PNG per layer and `materials.toml`), written and read.
+//! - [`halftone`]: the printer's naive ink mix and its 3D ordered dithering into voxels.
+//! - [`compensate`]: the scattering compensation loop, against a [`compensate::Predictor`].
+//! - [`predict`]: the real predictor, a volpt render of the print from straight above.
+//! - [`error`]: what reading or writing a print can refuse ([`PrintError`]).
+
+pub mod colour;
+pub mod compensate;
+pub mod error;
+pub mod halftone;
+pub mod material;
+pub mod predict;
+pub mod print;
+pub mod record;
+pub mod slices;
+
+pub use error::PrintError;
+pub use material::{Inks, Material};
+pub use print::VoxelPrint;

@@ -1,0 +1,237 @@
+//! The compensation loop on a linear blur model of a print (tests/common: a test fixture, not a
+//! product path): a reachable target is reached, the error falls monotonically, and each
+//! iteration is recorded.
+
+mod common;
+
+use common::{BlurModel, Rng};
+use volpt_print::colour::{LinearRgb, Srgb};
+use volpt_print::compensate::{compensate, percentile_95, print_for, Options, Predictor, Setup};
+use volpt_print::halftone::Halftone;
+use volpt_print::Inks;
+
+const SIZE: [u32; 2] = [32, 32];
+
+fn setup() -> Setup {
+    let materials = common::inks();
+    Setup {
+        halftone: Halftone {
+            layers: 32,
+            depth: 40,
+            inks: Inks::find(&materials).unwrap(),
+            seed: 11,
+        },
+        materials,
+        voxel_size: [0.0846, 0.0423, 0.027],
+    }
+}
+
+fn model() -> BlurModel {
+    BlurModel {
+        rho: 0.93,
+        radius: 2,
+    }
+}
+
+/// A smooth, printable aim image: channels in [0.5, 0.95], where the naive mix is exact.
+fn smooth_aims(rng: &mut Rng) -> Vec<LinearRgb> {
+    let [w, h] = SIZE.map(|n| n as usize);
+    let phase = [0, 1, 2].map(|_| rng.unit() * 6.0);
+    (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f64 / w as f64, (i / w) as f64 / h as f64);
+            LinearRgb(
+                [0, 1, 2]
+                    .map(|c| 0.725 + 0.225 * (6.0 * x + 4.0 * y * (c as f64) + phase[c]).sin()),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn a_reachable_target_is_reached() {
+    let setup = setup();
+    let aims = smooth_aims(&mut Rng(2));
+    let print = print_for(&setup, &aims, SIZE[0], SIZE[1]).unwrap();
+    let target = model().predict(&print).unwrap();
+    let options = Options {
+        max_iterations: 20,
+        step: 1.0,
+        min_improvement: 0.0,
+        backtracks: 2,
+    };
+    let result = compensate(&target, SIZE, &setup, &options, &mut model(), |_| {}).unwrap();
+    let naive = result.iterations[0].mean;
+    let best = result.iterations[result.best].mean;
+    eprintln!(
+        "means: {:?}",
+        result.iterations.iter().map(|i| i.mean).collect::<Vec<_>>()
+    );
+    assert!(naive > 1.0, "the naive assignment should miss: {naive}");
+    // Halftoning's 1/L per ink per texel, blurred: the loop gets within a fraction of a JND.
+    assert!(best < 0.3, "best mean dE00 {best} (naive {naive})");
+    assert_eq!(
+        result.print,
+        print_for(
+            &setup,
+            &result.iterations[result.best].aims,
+            SIZE[0],
+            SIZE[1]
+        )
+        .unwrap()
+    );
+}
+
+/// Bars of printable colours, one to four texels wide: fine detail.
+fn bars() -> Vec<LinearRgb> {
+    let [w, h] = SIZE.map(|n| n as usize);
+    let colours = [[200u8, 120, 140], [120, 200, 190], [230, 230, 150]];
+    (0..w * h)
+        .map(|i| {
+            let x = i % w;
+            let bar = [1, 1, 2, 2, 4, 4, 4][x % 7] + x / 7;
+            Srgb::from_u8(colours[bar % 3]).to_linear()
+        })
+        .collect()
+}
+
+#[test]
+fn the_error_falls_monotonically_on_a_blur_until_the_loop_stops() {
+    let setup = setup();
+    let [w, h] = SIZE.map(|n| n as usize);
+    // The blur of a print of fine bars: reaching it means undoing the blur.
+    let print = print_for(&setup, &bars(), SIZE[0], SIZE[1]).unwrap();
+    let target = model().predict(&print).unwrap();
+    let mut seen = Vec::new();
+    let options = Options {
+        max_iterations: 12,
+        step: 1.0,
+        min_improvement: 1e-3,
+        backtracks: 0,
+    };
+    let result = compensate(&target, SIZE, &setup, &options, &mut model(), |it| {
+        seen.push(it.mean)
+    })
+    .unwrap();
+    let means: Vec<f64> = result.iterations.iter().map(|i| i.mean).collect();
+    eprintln!("means: {means:?}");
+    assert_eq!(seen, means, "the observer sees every iteration");
+    assert!(means.len() >= 4, "{means:?}");
+    // Every iteration but the one that stopped the loop lowered the mean.
+    for k in 1..means.len() - 1 {
+        assert!(means[k] < means[k - 1], "iteration {k}: {means:?}");
+    }
+    assert!(means[result.best] < 0.25 * means[0], "{means:?}");
+    for it in &result.iterations {
+        assert_eq!(it.delta_e.len(), w * h);
+        assert_eq!(it.p95, percentile_95(&it.delta_e));
+    }
+}
+
+#[test]
+fn an_unreachable_target_ends_no_worse_than_the_naive_print() {
+    // Bars sharper than the blur passes: the update's unreachable part drifts into the clamp,
+    // the error stops falling and the loop keeps its best print.
+    let setup = setup();
+    let target = bars();
+    let options = Options::default();
+    let result = compensate(&target, SIZE, &setup, &options, &mut model(), |_| {}).unwrap();
+    let means: Vec<f64> = result.iterations.iter().map(|i| i.mean).collect();
+    eprintln!("means: {means:?}");
+    assert!(means.len() < options.max_iterations, "{means:?}");
+    assert!(means[result.best] < means[0], "{means:?}");
+    let best = &result.iterations[result.best];
+    assert_eq!(
+        result.print,
+        print_for(&setup, &best.aims, SIZE[0], SIZE[1]).unwrap()
+    );
+}
+
+#[test]
+fn percentile_95_is_the_nearest_rank() {
+    let values: Vec<f64> = (1..=100).map(f64::from).rev().collect();
+    assert_eq!(percentile_95(&values), 95.0);
+    assert_eq!(percentile_95(&[3.0]), 3.0);
+    assert_eq!(
+        percentile_95(&(1..=20).map(f64::from).collect::<Vec<_>>()),
+        19.0
+    );
+}
+
+#[test]
+fn every_update_starts_from_the_best_iteration_and_halves_the_step_after_a_miss() {
+    let setup = setup();
+    let target = bars();
+    let options = Options {
+        max_iterations: 12,
+        backtracks: 3,
+        ..Options::default()
+    };
+    let result = compensate(&target, SIZE, &setup, &options, &mut model(), |_| {}).unwrap();
+    let its = &result.iterations;
+    let (mut best, mut step, mut misses) = (0usize, options.step, 0);
+    for j in 1..its.len() {
+        let k = j - 1;
+        if k > 0 {
+            let best_mean = its[best].mean;
+            if its[k].mean < best_mean {
+                best = k;
+            }
+            if its[k].mean >= best_mean * (1.0 - options.min_improvement) {
+                step *= 0.5;
+                misses += 1;
+            }
+        }
+        let expected: Vec<LinearRgb> = its[best]
+            .aims
+            .iter()
+            .zip(target.iter().zip(&its[best].prediction))
+            .map(|(a, (t, p))| {
+                LinearRgb([0, 1, 2].map(|c| (a.0[c] + step * (t.0[c] - p.0[c])).clamp(0.0, 1.0)))
+            })
+            .collect();
+        assert!(
+            its[j].aims == expected,
+            "iteration {j}: not the update of iteration {best} at step {step}"
+        );
+    }
+    assert!(misses >= 1, "the case should backtrack");
+    assert_eq!(
+        result.best,
+        (0..its.len())
+            .min_by(|&a, &b| its[a].mean.total_cmp(&its[b].mean))
+            .unwrap()
+    );
+}
+
+#[test]
+fn the_record_holds_every_iteration_and_the_best_prints_slices() {
+    let setup = setup();
+    let target = bars();
+    let result = compensate(
+        &target,
+        SIZE,
+        &setup,
+        &Options::default(),
+        &mut model(),
+        |_| {},
+    )
+    .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    volpt_print::record::write_record(&result, &target, SIZE, dir.path()).unwrap();
+    let csv = std::fs::read_to_string(dir.path().join("iterations.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + result.iterations.len(), "{csv}");
+    let best_line = csv.lines().nth(1 + result.best).unwrap();
+    assert!(best_line.ends_with(",1"), "{csv}");
+    for k in 0..result.iterations.len() {
+        for file in ["prediction.png", "delta_e.png"] {
+            assert!(dir
+                .path()
+                .join(format!("iteration_{k:02}"))
+                .join(file)
+                .is_file());
+        }
+    }
+    let slices = volpt_print::slices::read_slices(&dir.path().join("slices")).unwrap();
+    assert_eq!(slices, result.print);
+}

@@ -1,0 +1,137 @@
+//! The names of the library's choices ([`volpt::names`]) and its bounds: every name parses back to
+//! its value and is unique among its choice's; a name no value has is refused with the setting's
+//! key and the names it takes; the majorant grid's bound is refused by the library, once, with the
+//! setting's key (which the front ends spell their own way: volpt-cli/tests/cli.rs,
+//! python/tests/test_errors.py).
+
+use std::collections::HashSet;
+
+use volpt::names::{expected, names, parse};
+use volpt::{
+    Accumulation, BackendKind, Effects, Error, Estimator, GridLookup, Math, Named, RenderSettings,
+    Roulette, Scene, Strategy, StrategyChoice, Tracking, VolumeMemory, MAJORANT_RESOLUTION,
+};
+
+/// Every value of `T` round-trips through its name; the names are unique and non-empty, and
+/// each value says what it does; a name of no value is refused naming the setting.
+fn round_trips<T: Named>() {
+    let mut seen = HashSet::new();
+    for &value in T::all() {
+        let name = value.name();
+        assert!(!name.is_empty() && !value.about().is_empty(), "{value:?}");
+        assert!(seen.insert(name), "{name} twice among {}", T::KEY);
+        assert_eq!(parse::<T>(name).unwrap(), value, "{name}");
+    }
+    assert_eq!(names::<T>().len(), T::all().len());
+    match parse::<T>("no-such-name").unwrap_err() {
+        Error::Setting {
+            key,
+            expected: e,
+            found,
+        } => {
+            assert_eq!(key, T::KEY);
+            assert_eq!(e, expected::<T>());
+            assert_eq!(found, "\"no-such-name\"");
+        }
+        error => panic!("{}: {error:?}", T::KEY),
+    }
+}
+
+#[test]
+fn every_choice_names_round_trip() {
+    round_trips::<BackendKind>();
+    round_trips::<StrategyChoice>();
+    round_trips::<Strategy>();
+    round_trips::<Math>();
+    round_trips::<GridLookup>();
+    round_trips::<Estimator>();
+    round_trips::<Roulette>();
+    round_trips::<Tracking>();
+    round_trips::<Effects>();
+    round_trips::<Accumulation>();
+    round_trips::<VolumeMemory>();
+}
+
+#[test]
+fn the_tables_name_every_value_as_the_crates_below_do() {
+    // Where a crate below names its values itself, the table agrees with it.
+    for &m in Math::ALL {
+        assert_eq!(Named::name(m), m.name());
+    }
+    for m in VolumeMemory::ALL {
+        assert_eq!(Named::name(m), m.name());
+        assert_eq!(m.name().parse::<VolumeMemory>().unwrap(), m);
+    }
+    assert_eq!(StrategyChoice::all().len(), Strategy::ALL.len() + 1);
+    for &choice in StrategyChoice::all() {
+        assert_eq!(Named::name(choice), choice.to_string());
+    }
+    // The facade's own choices display and parse by the table.
+    for &kind in BackendKind::all() {
+        assert_eq!(kind.to_string().parse::<BackendKind>().unwrap(), kind);
+    }
+    for &tracking in Tracking::all() {
+        assert_eq!(tracking.to_string().parse::<Tracking>().unwrap(), tracking);
+    }
+    assert_eq!(
+        "auto".parse::<StrategyChoice>().unwrap(),
+        StrategyChoice::Auto
+    );
+    assert_eq!(
+        parse::<GridLookup>("texture-f16").unwrap(),
+        GridLookup::TextureHalf
+    );
+}
+
+#[test]
+fn the_majorant_grid_bound_is_the_librarys() {
+    let cube = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/example/cube.xml");
+    let load = |cells: u32| {
+        let settings = RenderSettings {
+            majorant_resolution: Some(cells),
+            resolution: Some((4, 4)),
+            ..RenderSettings::default()
+        };
+        Scene::load(&cube, &settings)
+    };
+    for cells in [*MAJORANT_RESOLUTION.start(), *MAJORANT_RESOLUTION.end()] {
+        assert_eq!(
+            load(cells).unwrap().path_settings().majorant_resolution,
+            cells
+        );
+    }
+    for cells in [0, MAJORANT_RESOLUTION.end() + 1, u32::MAX] {
+        let error = load(cells).unwrap_err();
+        assert!(
+            matches!(&error, Error::Setting { key: "majorant_resolution", expected, found }
+                if expected == "1 to 1024 cells" && *found == cells.to_string()),
+            "{error:?}"
+        );
+        assert_eq!(
+            error.to_string(),
+            format!("majorant_resolution: expected 1 to 1024 cells, found {cells}")
+        );
+    }
+}
+
+#[test]
+fn an_unknown_parameter_is_its_own_error() {
+    let cube = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/example/cube.xml");
+    let mut scene = Scene::load(cube, &RenderSettings::default()).unwrap();
+    for error in [
+        scene.get("medium.density").unwrap_err(),
+        scene
+            .set("medium.density", volpt::ParamValue::Float(1.0))
+            .unwrap_err(),
+    ] {
+        assert!(
+            matches!(&error, Error::UnknownParam { key, expected }
+                if key == "medium.density" && expected.starts_with("one of spp, seed")),
+            "{error:?}"
+        );
+    }
+    assert!(matches!(
+        scene.set("spp", volpt::ParamValue::Int(0)).unwrap_err(),
+        Error::Param { .. }
+    ));
+}
