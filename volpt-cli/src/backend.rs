@@ -26,12 +26,12 @@ pub struct GpuArgs {
     pub math: Option<Math>,
     /// Cap the GPU kernel's registers per thread (the JIT spills the rest): more threads resident
     /// per multiprocessor, at the price of spills.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(16..=255))]
+    #[arg(long, value_name = "N")]
     pub max_registers: Option<u32>,
     /// regeneration-sk: refill a warp's idle lanes with new paths once at least N of them are
     /// idle (default 8; 1 refills at once, 32 waits for the whole warp): fewer, fuller refills
     /// against lanes idling in between.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=32))]
+    #[arg(long, value_name = "N")]
     pub refill_at: Option<u32>,
     /// Cut the image into COLUMNS x ROWS tiles, each rendered by its own launches one after the
     /// other (the thesis's tiling study: smaller launches, more tails; docs/strategies.md).

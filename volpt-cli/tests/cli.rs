@@ -206,6 +206,35 @@ fn the_majorant_grid_bound_is_the_librarys_in_the_flags_spelling() {
 }
 
 #[test]
+fn the_gpu_knobs_bounds_are_the_librarys_on_every_backend() {
+    let e = example();
+    let e = e.to_str().unwrap();
+    for (flag, value, words) in [
+        (
+            "--max-registers",
+            "8",
+            "--max-registers: expected 16 to 255, found 8",
+        ),
+        (
+            "--max-registers",
+            "256",
+            "--max-registers: expected 16 to 255, found 256",
+        ),
+        ("--refill-at", "0", "--refill-at: expected 1 to 32, found 0"),
+        (
+            "--refill-at",
+            "33",
+            "--refill-at: expected 1 to 32, found 33",
+        ),
+    ] {
+        for backend in ["cpu", "cuda"] {
+            let out = volpt(&["render", e, "--backend", backend, flag, value]);
+            assert_clean_error(&out, &[words]);
+        }
+    }
+}
+
+#[test]
 fn zero_threads_and_zero_trials_are_refused() {
     let e = example();
     let out = volpt(&["render", e.to_str().unwrap(), "--threads", "0"]);

@@ -15,6 +15,7 @@ use volpt_core::material::{Material, MATERIAL_FLOATS, MAX_MATERIALS};
 
 use crate::description::{Bounds, GridDesc, SampleLayout};
 use crate::error::{MaterialProblem, SceneError};
+use crate::phase::PhaseDesc;
 use crate::toml_scene::OneOrThree;
 
 /// One material of a table.
@@ -262,6 +263,17 @@ impl IndexedDesc {
     /// Henyey-Greenstein variant whose `g` each collision replaces).
     pub fn anisotropic(&self) -> bool {
         self.materials.iter().any(|m| m.g != 0.0)
+    }
+
+    /// The medium's phase description: isotropic where every material's `g` is 0, else
+    /// Henyey-Greenstein with the first non-zero `g`, which each collision replaces by its
+    /// material's (`volpt_core::Medium::phase_g`). Not `g = 0`: the factory would specialise that
+    /// to the isotropic phase, which has no asymmetry to replace.
+    pub fn phase(&self) -> PhaseDesc {
+        match self.materials.iter().find(|m| m.g != 0.0) {
+            Some(m) => PhaseDesc::HenyeyGreenstein { g: m.g },
+            None => PhaseDesc::Isotropic,
+        }
     }
 
     /// Bytes on a GPU: one per voxel (rounded up to a word), and the table.

@@ -800,10 +800,10 @@ impl MediumDesc {
         )
         .expect("a valid example");
         MediumDesc {
+            phase: indexed.phase(),
             density: DensityDesc::Indexed(indexed),
             scale: 3.0,
             albedo: AlbedoDesc::Constant([0.0; 3]),
-            phase: PhaseDesc::HenyeyGreenstein { g: 0.0 },
             lookup: GridLookup::Trilinear,
             storage: GridStorage::Dense,
         }
@@ -854,11 +854,7 @@ impl MediumDesc {
         indexed
             .set_material(k, m)
             .map_err(|(_, expected, _)| ParamRefused::Value(expected))?;
-        self.phase = if indexed.anisotropic() {
-            PhaseDesc::HenyeyGreenstein { g: 0.0 }
-        } else {
-            PhaseDesc::Isotropic
-        };
+        self.phase = indexed.phase();
         Ok(())
     }
 }

@@ -545,12 +545,7 @@ fn assemble_indexed(
         IndexedDesc::from_grid(volume_path, materials, &grid)?
     };
     let bounds = indexed.bounds;
-    let phase = if indexed.anisotropic() {
-        // Each collision takes its material's g ([`volpt_core::Medium::phase_g`]).
-        PhaseDesc::HenyeyGreenstein { g: 0.0 }
-    } else {
-        PhaseDesc::Isotropic
-    };
+    let phase = indexed.phase();
     let medium = MediumDesc {
         density: DensityDesc::Indexed(indexed),
         scale: v.scale,

@@ -68,8 +68,9 @@ fn a_raw_index_grid_and_its_table_load_as_an_indexed_medium() {
     assert_eq!(white.sigma_s, [0.99 * 12.0, 0.98 * 12.0, 0.97 * 12.0]);
     assert_eq!(white.colour, Some([255, 255, 255]));
     assert_eq!(indexed.histogram(), vec![6, 6]);
-    // The materials' g differ from 0: a Henyey-Greenstein variant, g per collision.
-    assert_eq!(desc.medium.phase, PhaseDesc::HenyeyGreenstein { g: 0.0 });
+    // The materials' g differ from 0: a Henyey-Greenstein variant (with the first non-zero g,
+    // which the factory does not specialise to the isotropic phase), g per collision.
+    assert_eq!(desc.medium.phase, PhaseDesc::HenyeyGreenstein { g: 0.3 });
     assert_eq!(desc.medium.scale, 2.0);
     assert!(desc.medium.is_chromatic());
     // Largest extinction: white's 12, times the scale.

@@ -5,7 +5,7 @@
 //! random numbers), and every backend adds a pixel's samples in sample order: so a render in
 //! chunks, resumed, or split into ranges gives the uninterrupted render's sums.
 
-use std::ops::Range;
+use std::ops::{Range, RangeInclusive};
 use std::time::{Duration, Instant};
 
 use volpt_core::GridLayout;
@@ -216,9 +216,11 @@ impl Backend {
         Backend(Inner::CpuDevices(devices.max(1)))
     }
 
-    /// Opens the backend `options` name; options that do not apply to it are refused.
+    /// Opens the backend `options` name; options out of their bounds ([`MAX_REGISTERS`],
+    /// [`REFILL_AT`]) or that do not apply to it are refused.
     pub fn open(options: &BackendOptions) -> Result<Self, Error> {
         let gpu = &options.gpu;
+        check_bounds(gpu)?;
         match options.kind {
             BackendKind::Cpu => {
                 refuse_on_cpu(gpu)?;
@@ -502,6 +504,27 @@ impl Backend {
             fingerprint
         )
     }
+}
+
+/// The register caps a GPU kernel may be compiled with ([`GpuOptions::max_registers`]): below 16
+/// the JIT cannot fit the path state, above 255 no cap applies.
+pub const MAX_REGISTERS: RangeInclusive<u32> = 16..=255;
+
+/// regeneration-sk's refill thresholds ([`GpuOptions::refill_at`]): idle lanes of a 32-lane warp.
+pub const REFILL_AT: RangeInclusive<u32> = 1..=32;
+
+/// Refuses a GPU option out of its bounds with [`Error::Setting`], whichever backend it is for.
+fn check_bounds(gpu: &GpuOptions) -> Result<(), Error> {
+    let bound = |key, range: &RangeInclusive<u32>, value: Option<u32>| match value {
+        Some(v) if !range.contains(&v) => Err(Error::Setting {
+            key,
+            expected: format!("{} to {}", range.start(), range.end()),
+            found: v.to_string(),
+        }),
+        _ => Ok(()),
+    };
+    bound("max_registers", &MAX_REGISTERS, gpu.max_registers)?;
+    bound("refill_at", &REFILL_AT, gpu.refill_at)
 }
 
 /// Refuses GPU options for the CPU backend, naming the option and what to do.

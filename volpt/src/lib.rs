@@ -55,6 +55,7 @@ pub mod settings;
 
 pub use backend::{
     Backend, BackendKind, BackendOptions, GpuOptions, Gpus, Rendered, StrategyChoice,
+    MAX_REGISTERS, REFILL_AT,
 };
 pub use checkpoint::{merge, render_checkpointed, Checkpointing, Part};
 pub use error::Error;

@@ -115,6 +115,60 @@ fn the_majorant_grid_bound_is_the_librarys() {
 }
 
 #[test]
+fn the_gpu_knobs_bounds_are_refused_before_any_gpu_is_opened() {
+    use volpt::{Backend, BackendOptions, GpuOptions, MAX_REGISTERS, REFILL_AT};
+    let refused = |gpu: GpuOptions, key: &str, expected: &str, found: &str| {
+        for options in [
+            BackendOptions::cuda(gpu),
+            BackendOptions {
+                gpu,
+                ..Default::default()
+            },
+        ] {
+            match Backend::open(&options) {
+                Err(Error::Setting {
+                    key: k,
+                    expected: e,
+                    found: f,
+                }) => {
+                    assert_eq!((k, e.as_str(), f.as_str()), (key, expected, found))
+                }
+                Err(error) => panic!("{error:?}"),
+                Ok(_) => panic!("{gpu:?} opened"),
+            }
+        }
+    };
+    let registers = |n| GpuOptions {
+        max_registers: Some(n),
+        ..GpuOptions::default()
+    };
+    let refill = |n| GpuOptions {
+        refill_at: Some(n),
+        ..GpuOptions::default()
+    };
+    refused(
+        registers(MAX_REGISTERS.start() - 1),
+        "max_registers",
+        "16 to 255",
+        "15",
+    );
+    refused(
+        registers(MAX_REGISTERS.end() + 1),
+        "max_registers",
+        "16 to 255",
+        "256",
+    );
+    refused(refill(REFILL_AT.start() - 1), "refill_at", "1 to 32", "0");
+    refused(refill(REFILL_AT.end() + 1), "refill_at", "1 to 32", "33");
+    // In bounds, the CPU refuses them for what they are: GPU knobs.
+    let in_bounds = Backend::open(&BackendOptions {
+        gpu: registers(*MAX_REGISTERS.end()),
+        ..Default::default()
+    });
+    assert!(matches!(in_bounds, Err(Error::Settings(m)) if m.contains("--max-registers 255")));
+}
+
+#[test]
 fn an_unknown_parameter_is_its_own_error() {
     let cube = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/example/cube.xml");
     let mut scene = Scene::load(cube, &RenderSettings::default()).unwrap();
