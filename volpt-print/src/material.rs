@@ -4,8 +4,9 @@
 //!
 //! The fields and their TOML spelling (`[[materials]]` with `name`, `sigma_s`, `sigma_a`, `g`,
 //! `colour`) are those of volpt-scene's material table (the material-indexed volumes issue), so
-//! that a print's `materials.toml` reads as that table; this type stands in for it until it lands
-//! on main, and then becomes it.
+//! that a print's `materials.toml` reads as that table. volpt-scene's `MaterialDesc` reached main
+//! at the end of the session that wrote this; this type becomes it (its colour optional there,
+//! required here) when the predictor moves onto material-indexed volumes.
 
 use serde::{Deserialize, Serialize};
 
