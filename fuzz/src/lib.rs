@@ -121,7 +121,11 @@ impl Target {
                 assemble(&write(dir, "scene.xml", part(0)), params);
             }
             Self::Vol => assemble(&write(dir, "g.vol", data), Vec::new()),
-            Self::Vdb => assemble(&write(dir, "g.vdb", data), Vec::new()),
+            Self::Vdb => {
+                let path = write(dir, "g.vdb", data);
+                assemble(&path, Vec::new());
+                read_sparse(&path);
+            }
             Self::MetaImage => {
                 let path = if parts.len() > 1 {
                     write(dir, "d.raw", part(1));
@@ -284,6 +288,44 @@ fn assemble(path: &Path, params: Vec<(String, String)>) {
     };
     if let Ok(builder) = builder_for(path) {
         let _ = SceneAssembler::new(config).assemble(builder.as_ref());
+    }
+}
+
+/// A VDB's float grid kept sparse and read as the renderers read it: the brick table the loader
+/// wrote must pass the lookup's checks, the majorant grid is built from it, and no lookup may
+/// exceed its cell's majorant (delta tracking's one requirement of the majorants).
+fn read_sparse(path: &Path) {
+    use volpt::core::grid::{Grid, GridMapping};
+    use volpt::core::majorant::{build_majorants, MajorantGrid};
+    use volpt::core::{Aabb, Vec3};
+    use volpt_scene::vdb::{read_vdb, Sparsity, VdbOptions};
+    let options = VdbOptions {
+        sparsity: Sparsity::Always,
+        ..VdbOptions::default()
+    };
+    let Ok(grid) = read_vdb(path, &options) else {
+        return;
+    };
+    if let Err(e) = volpt_scene::sparse::check(&grid) {
+        panic!("the VDB loader wrote a sparse grid the lookup refuses: {e}");
+    }
+    let bounds = Aabb::new(Vec3::ZERO, Vec3::ONE);
+    let mapping = GridMapping::cell_centred(bounds, grid.resolution);
+    let density = Grid::<1>::sparse(&grid.data, grid.resolution, mapping);
+    const CELLS: u32 = 4;
+    let mut cells = vec![0.0; (CELLS * CELLS * CELLS) as usize];
+    build_majorants(&density, 1.0, bounds, [CELLS; 3], &mut cells);
+    let majorants = MajorantGrid::new(&cells, [CELLS; 3], bounds);
+    const STEPS: u32 = 7;
+    for i in 0..STEPS * STEPS * STEPS {
+        let u = |k: u32| ((k % STEPS) as f32 + 0.5) / STEPS as f32;
+        let p = Vec3::new(u(i), u(i / STEPS), u(i / (STEPS * STEPS)));
+        let (value, bound) = (density.lookup(p)[0], majorants.at_point(p));
+        // NaN samples compare with nothing; a number must not exceed its bound.
+        assert!(
+            value.partial_cmp(&bound) != Some(std::cmp::Ordering::Greater),
+            "a lookup of {value} above its majorant {bound} at {p:?}"
+        );
     }
 }
 

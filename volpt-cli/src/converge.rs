@@ -576,8 +576,11 @@ fn write_plots(dir: &Path, title: &str, results: &[(String, Vec<Row>)]) -> Resul
 /// machine whose plots did not come back), titled with `title`.
 pub fn replot(dir: &Path, title: &str) -> Result<()> {
     let path = dir.join("converge.csv");
-    let text =
-        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    // A regular file only: a FIFO named converge.csv would block the read for ever.
+    let text = volpt::film::regular::open_regular(&path)
+        .map_err(std::io::Error::from)
+        .and_then(|(file, _)| std::io::read_to_string(file))
+        .with_context(|| format!("reading {}", path.display()))?;
     let results = parse_csv(&text).with_context(|| format!("{}", path.display()))?;
     for path in write_plots(dir, title, &results)? {
         println!("wrote {}", path.display());

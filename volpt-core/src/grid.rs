@@ -79,22 +79,14 @@ pub enum GridLayout {
     /// the grid over PCIe (zero-copy, managed memory) fetches fewer, fuller lines.
     /// Axes that are not a multiple of [`BRICK`] are padded; padding is never read.
     Bricked,
-    /// Only the bricks that hold something: a sparse volume (a VDB's active 8^3 leaves) without
-    /// a dense copy of its box. `data` is the stored bricks, each [`BRICK`]^3 samples laid out as
-    /// in [`GridLayout::Bricked`], followed by a *brick table*: one entry per brick of the box
-    /// (x fastest), the `f32` bits of the `u32` slot of that brick among the stored ones
-    /// ([`sparse_table_len`], [`Grid::sparse`]). Slot 0 is the background brick, one value
-    /// everywhere, which every empty brick of the box points at: an empty region costs 4 bytes
-    /// per brick and reads like any other, so the lookup has no extra branch.
+    /// Only the bricks that hold something: a sparse volume (a VDB's active 8^3 leaves and its
+    /// tiles) without a dense copy of its box. `data` is the stored bricks, each [`BRICK`]^3
+    /// samples laid out as in [`GridLayout::Bricked`], followed by a two-level *brick table*
+    /// ([`crate::sparse`]) that gives every brick of the box the slot of the stored brick it
+    /// reads. Slot 0 is the background brick, one value everywhere; a uniform region (empty, or a
+    /// tile) costs one table entry per 128^3 block, and reads like any other region, so the lookup
+    /// has no extra branch ([`Grid::sparse`]).
     Sparse,
-}
-
-/// Entries of a [`GridLayout::Sparse`] grid's brick table for a grid of `res` samples (one per
-/// brick of its box), or `None` if that does not fit in `u64`.
-pub fn sparse_table_len(res: [u32; 3]) -> Option<u64> {
-    res.iter().try_fold(1u64, |acc, &r| {
-        acc.checked_mul(u64::from(r.div_ceil(BRICK)))
-    })
 }
 
 /// Samples along each edge of a brick of [`GridLayout::Bricked`].
@@ -163,17 +155,12 @@ fn bricked_index(res: [u32; 3], x: u32, y: u32, z: u32) -> u32 {
 }
 
 /// The sample index of `(x, y, z)` in a [`GridLayout::Sparse`] grid's `data`: the brick's slot
-/// from the table at the end of `data`, then the sample's place inside the brick. `u32` like the
-/// other layouts: the stored samples must number below 2^32 (checked on the host).
+/// from the brick table ([`crate::sparse::slot`]), then the sample's place inside the brick.
+/// `u32` like the other layouts: the stored samples must number below 2^32 (checked on the host).
 #[inline(always)]
 fn sparse_index(data: &[f32], res: [u32; 3], x: u32, y: u32, z: u32) -> u32 {
-    let bricks_x = (res[0] + BRICK - 1) >> BRICK_SHIFT;
-    let bricks_y = (res[1] + BRICK - 1) >> BRICK_SHIFT;
-    let bricks_z = (res[2] + BRICK - 1) >> BRICK_SHIFT;
-    let table = data.len() - (bricks_x * bricks_y * bricks_z) as usize;
-    let brick =
-        ((z >> BRICK_SHIFT) * bricks_y + (y >> BRICK_SHIFT)) * bricks_x + (x >> BRICK_SHIFT);
-    let slot = data[table + brick as usize].to_bits();
+    let brick = [x >> BRICK_SHIFT, y >> BRICK_SHIFT, z >> BRICK_SHIFT];
+    let slot = crate::sparse::slot(data, res, brick);
     let mask = BRICK - 1;
     let inner = (((z & mask) << BRICK_SHIFT) + (y & mask)) << BRICK_SHIFT | (x & mask);
     (slot << (3 * BRICK_SHIFT)) | inner
@@ -246,23 +233,13 @@ impl<'a, const C: usize> Grid<'a, C> {
     }
 
     /// A [`GridLayout::Sparse`] grid: `data` is whole bricks of `C`-channel samples (at least
-    /// the background brick, slot 0) followed by [`sparse_table_len`]`(res)` table entries, each
-    /// the `f32` bits of a stored brick's slot. Panics if `data` is not shaped so or a table entry
-    /// names a brick that is not stored (the loaders check both and return errors first).
+    /// the background brick, slot 0) followed by the brick table ([`crate::sparse`]). Panics if
+    /// `data` is not shaped so ([`crate::sparse::parts`]; the loaders check it and return errors
+    /// first).
     pub fn sparse(data: &'a [f32], res: [u32; 3], mapping: GridMapping) -> Self {
-        let brick = (BRICK * BRICK * BRICK) as usize * C;
-        let table = sparse_table_len(res).expect("sparse grid table overflows") as usize;
-        assert!(
-            data.len() >= table + brick && (data.len() - table).is_multiple_of(brick),
-            "sparse grid data does not match its resolution"
-        );
-        let slots = (data.len() - table) / brick;
-        assert!(
-            data[data.len() - table..]
-                .iter()
-                .all(|s| (s.to_bits() as usize) < slots),
-            "sparse grid table names a brick that is not stored"
-        );
+        if let Err(e) = crate::sparse::parts(data, res, C as u32) {
+            panic!("sparse grid data does not match its resolution: {e}");
+        }
         Self {
             data,
             res,
@@ -277,10 +254,7 @@ impl<'a, const C: usize> Grid<'a, C> {
     /// The stored samples without a sparse grid's brick table (all of `data` otherwise).
     pub fn samples(&self) -> &'a [f32] {
         match self.layout {
-            GridLayout::Sparse => {
-                let table = sparse_table_len(self.res).unwrap_or(0) as usize;
-                &self.data[..self.data.len() - table]
-            }
+            GridLayout::Sparse => &self.data[..crate::sparse::stored_values(self.data, self.res)],
             _ => self.data,
         }
     }
@@ -301,7 +275,7 @@ impl<'a, const C: usize> Grid<'a, C> {
     /// background brick).
     pub fn sample_slot(&self, x: u32, y: u32, z: u32) -> u32 {
         debug_assert_eq!(self.layout, GridLayout::Sparse);
-        sparse_index(self.data, self.res, x, y, z) >> (3 * BRICK_SHIFT)
+        crate::sparse::slot(self.data, self.res, [x, y, z].map(|v| v >> BRICK_SHIFT))
     }
 
     /// The same grid, in a texture of `texel`s when read by [`TextureTrilinear`].
@@ -845,6 +819,13 @@ mod tests {
         }
     }
 
+    /// `stored` bricks followed by the brick table that gives brick `i` of the box (x fastest)
+    /// slot `slots[i]`.
+    fn with_table(mut stored: Vec<f32>, res: [u32; 3], slots: &[u32]) -> Vec<f32> {
+        crate::sparse::BrickTable::from_slots(res, slots).append_to(&mut stored);
+        stored
+    }
+
     /// The sparse form of dense samples: bricks whose samples are all zero point at the
     /// background brick (slot 0, zeros), the others are stored in order.
     fn sparsify<const C: usize>(dense: &[f32], res: [u32; 3]) -> (Vec<f32>, usize) {
@@ -854,15 +835,14 @@ mod tests {
         let mut table = Vec::new();
         for b in bricked.chunks_exact(size) {
             if b.iter().all(|&v| v == 0.0) {
-                table.push(f32::from_bits(0));
+                table.push(0);
             } else {
-                table.push(f32::from_bits((stored.len() / size) as u32));
+                table.push((stored.len() / size) as u32);
                 stored.extend_from_slice(b);
             }
         }
         let slots = stored.len() / size;
-        stored.extend(table);
-        (stored, slots)
+        (with_table(stored, res, &table), slots)
     }
 
     /// A density with zero bricks: hashed values inside a ball, zero outside.
@@ -886,10 +866,12 @@ mod tests {
     #[test]
     fn sparse_lookups_are_bit_identical_to_dense() {
         let bounds = Aabb::new(Vec3::new(-1.0, 0.5, 2.0), Vec3::new(3.0, 1.5, 2.25));
-        for res in [[40, 33, 17], [24, 24, 24], [64, 9, 70]] {
+        // One block (128^3 samples) and several, some of them empty (uniform), some cut by the
+        // box's faces.
+        for res in [[40, 33, 17], [24, 24, 24], [64, 9, 70], [300, 20, 140]] {
             let one = ball::<1>(res);
             let (sparse, slots) = sparsify::<1>(&one, res);
-            let bricks = sparse_table_len(res).unwrap() as usize;
+            let bricks = crate::sparse::bricks(res).iter().product::<u32>() as usize;
             assert!(
                 slots < bricks,
                 "{res:?}: the test grid must have empty bricks"
@@ -933,12 +915,17 @@ mod tests {
     /// brick read once stands for every sample of every empty brick.
     #[test]
     fn sparse_majorants_equal_dense_majorants() {
-        let res = [64, 9, 70];
+        for res in [[64, 9, 70], [300, 20, 140]] {
+            sparse_majorants_equal_dense_majorants_at(res);
+        }
+    }
+
+    fn sparse_majorants_equal_dense_majorants_at(res: [u32; 3]) {
         let bounds = Aabb::new(Vec3::new(-1.0, 0.5, 2.0), Vec3::new(3.0, 1.5, 2.25));
         let dense = ball::<1>(res);
         let (sparse, _) = sparsify::<1>(&dense, res);
         let mapping = GridMapping::cell_centred(bounds, res);
-        for cells in [[16, 4, 16], [3, 1, 5], [64, 9, 70]] {
+        for cells in [[16, 4, 16], [3, 1, 5], res] {
             let n = cells.iter().product::<u32>() as usize;
             let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
             let grid = Grid::<1>::new(&dense, res, mapping);
@@ -950,11 +937,51 @@ mod tests {
         }
     }
 
+    /// Where every brick of a block reads one stored brick whose samples differ (no loader
+    /// writes that, but a table may say it), a majorant cell that covers part of the block reads
+    /// the parts of the brick its samples cover: the same bounds as the dense copy's.
     #[test]
-    #[should_panic(expected = "names a brick that is not stored")]
-    fn a_sparse_table_must_name_stored_bricks() {
+    fn a_block_of_one_varied_brick_has_the_majorants_of_its_dense_copy() {
+        let res = [200, 24, 136];
+        // Slot 1, hashed values, is every brick of the first block, painted as one region (as a
+        // tile is); the rest is the background.
         let mut data = vec![0.0; 512];
-        data.push(f32::from_bits(1));
+        data.extend((0..512).map(|i| hash(i + 7)));
+        let block = [crate::sparse::BLOCK; 3];
+        let mut plan = crate::sparse::TablePlan::new(res);
+        plan.paint([0; 3], block, 1);
+        let mut table = plan.into_table();
+        table.paint([0; 3], block, 1);
+        table.append_to(&mut data);
+        let bounds = Aabb::new(Vec3::ZERO, Vec3::new(2.0, 0.24, 1.36));
+        let mapping = GridMapping::cell_centred(bounds, res);
+        let sparse = Grid::<1>::sparse(&data, res, mapping);
+        assert_eq!(
+            crate::sparse::block(&data, res, [0, 0, 0]),
+            crate::sparse::Block::Uniform(1)
+        );
+        let mut dense = Vec::new();
+        for z in 0..res[2] {
+            for y in 0..res[1] {
+                for x in 0..res[0] {
+                    dense.push(sparse.sample(x, y, z)[0]);
+                }
+            }
+        }
+        let grid = Grid::<1>::new(&dense, res, mapping);
+        for cells in [[100, 12, 68], [33, 5, 17], [7, 3, 9], [1, 1, 1]] {
+            let len = cells.iter().product::<u32>() as usize;
+            let (mut a, mut b) = (vec![0.0; len], vec![0.0; len]);
+            crate::majorant::build_majorants(&grid, 1.0, bounds, cells, &mut a);
+            crate::majorant::build_majorants(&sparse, 1.0, bounds, cells, &mut b);
+            assert_eq!(a, b, "{cells:?}");
+        }
+    }
+
+    #[test]
+    #[should_panic(expected = "names brick 1, but 1 are stored")]
+    fn a_sparse_table_must_name_stored_bricks() {
+        let data = with_table(vec![0.0; 512], [8, 8, 8], &[1]);
         let mapping = GridMapping::cell_centred(Aabb::new(Vec3::ZERO, Vec3::ONE), [8, 8, 8]);
         Grid::<1>::sparse(&data, [8, 8, 8], mapping);
     }

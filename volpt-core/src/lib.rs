@@ -33,6 +33,7 @@ pub mod rng;
 pub mod sampling;
 pub mod scene;
 pub mod shape;
+pub mod sparse;
 pub mod spectral;
 pub mod tracking;
 pub mod variant;
@@ -46,8 +47,8 @@ pub use environment::{
 };
 pub use geometry::{Aabb, Ray};
 pub use grid::{
-    sparse_table_len, AnyLayout, DenseTrilinear, Grid, GridLayout, GridLookup, GridMapping,
-    GridPlacement, GridReads, TexelFormat, TextureTrilinear,
+    AnyLayout, DenseTrilinear, Grid, GridLayout, GridLookup, GridMapping, GridPlacement, GridReads,
+    TexelFormat, TextureTrilinear,
 };
 pub use majorant::MajorantGrid;
 pub use material::{Material, MaterialGrid};

@@ -12,6 +12,7 @@ use bytemuck::{Pod, Zeroable};
 use core::ops::RangeInclusive;
 
 use crate::grid::{Grid, GridLayout, BRICK};
+use crate::sparse::{self, BLOCK_SAMPLES};
 use crate::{Aabb, Ray, Vec3};
 
 /// Per-cell upper bounds of the extinction over `bounds`.
@@ -171,14 +172,100 @@ impl SlotMax {
     };
 }
 
-/// The largest sample of a [`GridLayout::Sparse`] grid in the index ranges `ranges`, brick by
-/// brick: the background brick holds one value, so it is read once, not once per sample (a
-/// 2048^3 box of a few percent stored bricks is otherwise billions of reads of the same value);
-/// and a brick that stands for a run of bricks (a uniform region: a VDB tile's, up to 4096^3
-/// voxels) is read once per run (`last`), not once per brick of the run (billions of reads of one
-/// brick for a 1024^3 tile). The same maximum as
-/// reading every sample, so a sparse grid's majorants equal its dense copy's.
+/// The largest sample of a [`GridLayout::Sparse`] grid in the index ranges `ranges`, block by
+/// block of the brick table ([`crate::sparse`]): a uniform block (the background, a VDB tile's
+/// region, up to 4096^3 voxels) is one stored brick read once per run of cells that share it
+/// (`last`), not once per brick it stands for (billions of reads of one brick for a 4096^3 tile);
+/// a mixed block is read brick by brick, the background brick (slot 0, one value) once, not
+/// once per sample. The same maximum as reading every sample, so a sparse grid's majorants
+/// equal its dense copy's.
 fn sparse_max(density: &Grid<'_, 1>, ranges: [RangeInclusive<u32>; 3], last: &mut SlotMax) -> f32 {
+    let blocks = |r: &RangeInclusive<u32>| (r.start() / BLOCK_SAMPLES)..=(r.end() / BLOCK_SAMPLES);
+    let part = |r: &RangeInclusive<u32>, k: u32| {
+        let o = k * BLOCK_SAMPLES;
+        (*r.start()).max(o)..=(*r.end()).min(o + (BLOCK_SAMPLES - 1))
+    };
+    let mut max = 0.0f32;
+    let [rx, ry, rz] = &ranges;
+    for kz in blocks(rz) {
+        for ky in blocks(ry) {
+            for kx in blocks(rx) {
+                let parts = [part(rx, kx), part(ry, ky), part(rz, kz)];
+                let m = match sparse::block(density.data, density.res, [kx, ky, kz]) {
+                    sparse::Block::Uniform(slot) => shared_brick_max(density, slot, parts, last),
+                    sparse::Block::Mixed => bricks_max(density, parts, last),
+                };
+                max = max.max(m);
+            }
+        }
+    }
+    max
+}
+
+/// [`SlotMax`] of the stored brick `slot`, from `last` if that is the brick it read last.
+fn slot_max(density: &Grid<'_, 1>, slot: u32, last: &mut SlotMax) -> SlotMax {
+    if slot != last.slot {
+        let brick = stored_brick(density, slot);
+        *last = SlotMax {
+            slot,
+            max: brick.iter().fold(0.0f32, |m, &v| m.max(v)),
+            uniform: brick.iter().all(|&v| v == brick[0]),
+        };
+    }
+    *last
+}
+
+/// The samples of stored brick `slot` of a sparse grid.
+fn stored_brick<'a>(density: &Grid<'a, 1>, slot: u32) -> &'a [f32] {
+    let samples = (BRICK * BRICK * BRICK) as usize;
+    &density.data[slot as usize * samples..][..samples]
+}
+
+/// The largest sample in `ranges` (inside one block) where every brick is stored brick `slot`:
+/// per axis, the places inside a brick that the range covers in any of its bricks (all 8 where
+/// it spans 8 samples or more).
+fn shared_brick_max(
+    density: &Grid<'_, 1>,
+    slot: u32,
+    ranges: [RangeInclusive<u32>; 3],
+    last: &mut SlotMax,
+) -> f32 {
+    if slot == 0 {
+        // The background brick is one value.
+        return density.data[0];
+    }
+    let brick = slot_max(density, slot, last);
+    if brick.uniform {
+        return brick.max;
+    }
+    let covered = |r: &RangeInclusive<u32>| -> [bool; BRICK as usize] {
+        let mut c = [r.end() - r.start() + 1 >= BRICK; BRICK as usize];
+        for i in r.clone().take(BRICK as usize) {
+            c[(i % BRICK) as usize] = true;
+        }
+        c
+    };
+    let [cx, cy, cz] = ranges.each_ref().map(covered);
+    if [cx, cy, cz].iter().all(|c| c.iter().all(|&v| v)) {
+        return brick.max;
+    }
+    let samples = stored_brick(density, slot);
+    let mut max = 0.0f32;
+    for (z, _) in cz.iter().enumerate().filter(|(_, &c)| c) {
+        for (y, _) in cy.iter().enumerate().filter(|(_, &c)| c) {
+            let row = (z * BRICK as usize + y) * BRICK as usize;
+            for (x, _) in cx.iter().enumerate().filter(|(_, &c)| c) {
+                max = max.max(samples[row + x]);
+            }
+        }
+    }
+    max
+}
+
+/// The largest sample in `ranges` (inside one mixed block), brick by brick: one table lookup
+/// per brick, not per sample, and one pass over a brick's 512 values per run of bricks that
+/// share it.
+fn bricks_max(density: &Grid<'_, 1>, ranges: [RangeInclusive<u32>; 3], last: &mut SlotMax) -> f32 {
     let [rx, ry, rz] = ranges;
     let bricks = |r: &RangeInclusive<u32>| (r.start() / BRICK)..=(r.end() / BRICK);
     let clip = |r: &RangeInclusive<u32>, o: u32| {
@@ -197,29 +284,20 @@ fn sparse_max(density: &Grid<'_, 1>, ranges: [RangeInclusive<u32>; 3], last: &mu
                     max = max.max(background);
                     continue;
                 }
-                // The brick's samples, read directly: one table lookup per brick, not per sample,
-                // and one pass over a brick's 512 values per run of bricks that share it.
-                let samples = (BRICK * BRICK * BRICK) as usize;
-                let brick = &density.data[slot as usize * samples..][..samples];
-                if slot != last.slot {
-                    *last = SlotMax {
-                        slot,
-                        max: brick.iter().fold(0.0f32, |m, &v| m.max(v)),
-                        uniform: brick.iter().all(|&v| v == brick[0]),
-                    };
-                }
+                let brick = slot_max(density, slot, last);
                 let (cx, cy, cz) = (clip(&rx, x0), clip(&ry, y0), clip(&rz, z0));
                 // Most bricks lie inside the cell's range; a uniform brick's every part has its
                 // one value.
-                if (whole(&cx) && whole(&cy) && whole(&cz)) || last.uniform {
-                    max = max.max(last.max);
+                if (whole(&cx) && whole(&cy) && whole(&cz)) || brick.uniform {
+                    max = max.max(brick.max);
                     continue;
                 }
+                let samples = stored_brick(density, slot);
                 for z in cz {
                     for y in cy.clone() {
                         let row = ((z * BRICK + y) * BRICK) as usize;
                         for x in cx.clone() {
-                            max = max.max(brick[row + x as usize]);
+                            max = max.max(samples[row + x as usize]);
                         }
                     }
                 }

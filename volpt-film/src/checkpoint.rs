@@ -160,7 +160,7 @@ impl Checkpoint {
                  {limit} bytes (raise it with --memory-limit)"
             )));
         }
-        let (file, length) = crate::regular::open_regular(path).map_err(io)?;
+        let (file, length) = crate::regular::open_regular(path).map_err(|e| io(e.into()))?;
         // Only a checkpoint of this film's size can be this render's: anything else is refused
         // before it is read, whatever its header claims.
         let expected_len = HEADER as u64 + sum_bytes + 8;

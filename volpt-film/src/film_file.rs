@@ -223,7 +223,7 @@ impl FilmFile {
             path: path.to_owned(),
             source,
         };
-        let (file, length) = crate::regular::open_regular(path).map_err(io)?;
+        let (file, length) = crate::regular::open_regular(path).map_err(|e| io(e.into()))?;
         let mut header = [0u8; HEADER as usize];
         if length < HEADER + 8 {
             return Err(corrupt(

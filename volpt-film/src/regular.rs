@@ -1,32 +1,53 @@
-//! Opening the files volpt reads its own formats from (film files, checkpoints) as regular files
-//! only: `open` on a FIFO blocks until a writer appears (for ever), and a device such as
-//! `/dev/zero` never ends. The kind is checked on the path before opening, and again on the open
-//! file, since the path may have been replaced in between.
+//! Opening the files volpt reads as regular files only: `open` on a FIFO blocks until a writer
+//! appears (for ever), and a device such as `/dev/zero` never ends. The kind is checked on the
+//! path before opening, and again on the open file, since the path may have been replaced in
+//! between. The one implementation: volpt's own formats here (film files, checkpoints) and every
+//! loader of `volpt-scene` (`volpt_scene::limits::open_regular`, which names the path in a
+//! `SceneError`).
 
 use std::fs::File;
 use std::io;
 use std::path::Path;
 
-/// Opens the regular file at `path` and returns it with its length; anything else is an
-/// [`io::ErrorKind::InvalidInput`] error that names what the path is, and is never opened.
-pub fn open_regular(path: &Path) -> io::Result<(File, u64)> {
+/// Why a path was not opened.
+#[derive(Debug, thiserror::Error)]
+pub enum OpenError {
+    /// The path is not a regular file: it was not opened.
+    #[error("expected a regular file, found {kind}")]
+    NotAFile { kind: &'static str },
+    #[error(transparent)]
+    Io(#[from] io::Error),
+}
+
+impl From<OpenError> for io::Error {
+    /// A path that is not a regular file is [`io::ErrorKind::InvalidInput`], named in the message.
+    fn from(e: OpenError) -> Self {
+        match e {
+            OpenError::NotAFile { .. } => {
+                io::Error::new(io::ErrorKind::InvalidInput, e.to_string())
+            }
+            OpenError::Io(e) => e,
+        }
+    }
+}
+
+/// Opens the regular file at `path` and returns it with its length; anything else is
+/// [`OpenError::NotAFile`], naming what the path is, and is never opened.
+pub fn open_regular(path: &Path) -> Result<(File, u64), OpenError> {
     let kind = std::fs::metadata(path)?.file_type();
     if !kind.is_file() {
-        return Err(not_a_file(kind));
+        return Err(OpenError::NotAFile {
+            kind: kind_name(kind),
+        });
     }
     let file = File::open(path)?;
     let metadata = file.metadata()?;
     if !metadata.is_file() {
-        return Err(not_a_file(metadata.file_type()));
+        return Err(OpenError::NotAFile {
+            kind: kind_name(metadata.file_type()),
+        });
     }
     Ok((file, metadata.len()))
-}
-
-fn not_a_file(kind: std::fs::FileType) -> io::Error {
-    io::Error::new(
-        io::ErrorKind::InvalidInput,
-        format!("expected a regular file, found {}", kind_name(kind)),
-    )
 }
 
 /// What a path that is not a regular file is, in words.
@@ -66,7 +87,7 @@ mod tests {
             .status()
             .unwrap();
         assert!(status.success());
-        let err = open_regular(&fifo).unwrap_err();
+        let err = io::Error::from(open_regular(&fifo).unwrap_err());
         assert_eq!(err.kind(), io::ErrorKind::InvalidInput);
         assert!(err.to_string().contains("FIFO"), "{err}");
         assert!(open_regular(dir.path())

@@ -14,6 +14,8 @@ use std::io::Read;
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 
+use volpt_film::regular::OpenError;
+
 use crate::error::SceneError;
 
 /// The default memory limit: 8 GiB, more than any of the included scenes needs by a factor of
@@ -85,29 +87,19 @@ pub fn bytes_of(count: u64, size: u64) -> Option<u64> {
     count.checked_mul(size)
 }
 
-/// Opens a regular file and returns it with its length; refuses anything else before opening it.
+/// Opens a regular file and returns it with its length; refuses anything else before opening it
+/// (`volpt_film::regular::open_regular`, the one check every reader of volpt's uses).
 pub fn open_regular(path: &Path) -> Result<(File, u64), SceneError> {
-    let io = |error| SceneError::Io {
-        path: path.to_path_buf(),
-        error,
-    };
-    let kind = std::fs::metadata(path).map_err(io)?.file_type();
-    if !kind.is_file() {
-        return Err(SceneError::NotAFile {
+    volpt_film::regular::open_regular(path).map_err(|e| match e {
+        OpenError::NotAFile { kind } => SceneError::NotAFile {
             path: path.to_path_buf(),
-            kind: kind_name(kind),
-        });
-    }
-    let file = File::open(path).map_err(io)?;
-    // Checked again on the open file: the path may have been replaced in between.
-    let metadata = file.metadata().map_err(io)?;
-    if !metadata.is_file() {
-        return Err(SceneError::NotAFile {
+            kind,
+        },
+        OpenError::Io(error) => SceneError::Io {
             path: path.to_path_buf(),
-            kind: kind_name(metadata.file_type()),
-        });
-    }
-    Ok((file, metadata.len()))
+            error,
+        },
+    })
 }
 
 /// Reads a whole regular file, within the memory limit, and no more than its length said.
@@ -137,27 +129,6 @@ pub fn read_text(path: &Path) -> Result<String, SceneError> {
             ),
         ),
     })
-}
-
-fn kind_name(kind: std::fs::FileType) -> &'static str {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        if kind.is_fifo() {
-            return "a FIFO (named pipe)";
-        }
-        if kind.is_char_device() || kind.is_block_device() {
-            return "a device";
-        }
-        if kind.is_socket() {
-            return "a socket";
-        }
-    }
-    if kind.is_dir() {
-        "a directory"
-    } else {
-        "something that is not a regular file"
-    }
 }
 
 /// Checks what an OpenEXR file's headers declare before a decoder allocates for it: every layer

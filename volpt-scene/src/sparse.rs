@@ -1,10 +1,14 @@
-//! Sparse grids ([`SampleLayout::Sparse`]): the stored 8^3 bricks of a volume and a table that
-//! says which brick of the box each one is, in `volpt_core::GridLayout::Sparse`'s layout, so that
-//! the renderer reads the description's `data` as it is. An empty brick costs one table entry (4
-//! bytes) instead of 512 samples, and the background brick (slot 0) is stored once.
+//! Sparse grids ([`SampleLayout::Sparse`]): the stored 8^3 bricks of a volume and a two-level
+//! table that says which stored brick each brick of the box reads, in
+//! `volpt_core::GridLayout::Sparse`'s layout ([`volpt_core::sparse`]), so that the renderer reads
+//! the description's `data` as it is. An empty brick costs at most one table entry (4 bytes)
+//! instead of 512 samples, a uniform 128^3 block (empty, or inside a tile) one entry in all, and
+//! the background brick (slot 0) is stored once.
 //!
 //! Everything that reads a grid's values reads [`GridDesc::samples`]: the stored samples without
 //! the table, whose entries are slot numbers in `f32` bits, not values.
+
+use volpt_core::sparse::{self as table, BrickTable};
 
 use crate::description::{GridDesc, SampleLayout};
 
@@ -15,14 +19,20 @@ pub const BRICK_SAMPLES: usize = (BRICK * BRICK * BRICK) as usize;
 
 /// Bricks along each axis of a grid of `res` samples.
 pub fn bricks(res: [u32; 3]) -> [u32; 3] {
-    res.map(|r| r.div_ceil(BRICK))
+    table::bricks(res)
 }
 
-/// Entries of the brick table of a grid of `res` samples, or `None` if that overflows.
-pub fn table_len(res: [u32; 3]) -> Option<u64> {
+/// Bricks of the box of a grid of `res` samples, or `None` if that overflows.
+pub fn box_bricks(res: [u32; 3]) -> Option<u64> {
     bricks(res)
         .iter()
         .try_fold(1u64, |acc, &b| acc.checked_mul(u64::from(b)))
+}
+
+/// Values a sparse grid of `res` samples takes besides its stored bricks and fine entries: the
+/// coarse table and the fine entries' count (`None`: more than `u64` holds).
+pub fn coarse_values(res: [u32; 3]) -> Option<u64> {
+    table::coarse_len(res).and_then(|c| c.checked_add(1))
 }
 
 /// Where sample `(x, y, z)` sits inside its brick (x fastest), before the channel count.
@@ -47,20 +57,8 @@ impl GridDesc {
     fn samples_len(&self) -> usize {
         match self.layout {
             SampleLayout::Dense => self.data.len(),
-            SampleLayout::Sparse => {
-                let table = table_len(self.resolution).unwrap_or(0) as usize;
-                self.data.len().saturating_sub(table)
-            }
+            SampleLayout::Sparse => table::stored_values(&self.data, self.resolution),
         }
-    }
-
-    /// A sparse grid's brick table: the stored slot of every brick of the box, x fastest.
-    pub fn brick_table(&self) -> impl Iterator<Item = u32> + '_ {
-        let samples = match self.layout {
-            SampleLayout::Dense => self.data.len(),
-            SampleLayout::Sparse => self.samples_len(),
-        };
-        self.data[samples..].iter().map(|v| v.to_bits())
     }
 
     /// Bytes the grid's `data` takes.
@@ -86,11 +84,8 @@ impl GridDesc {
                 ((z as usize * ry as usize + y as usize) * rx as usize + x as usize) * ch
             }
             SampleLayout::Sparse => {
-                let [bx, by, _] = bricks(self.resolution);
-                let brick = ((z / BRICK) as usize * by as usize + (y / BRICK) as usize)
-                    * bx as usize
-                    + (x / BRICK) as usize;
-                let slot = self.data[self.samples_len() + brick].to_bits() as usize;
+                let brick = [x, y, z].map(|v| v / BRICK);
+                let slot = table::slot(&self.data, self.resolution, brick) as usize;
                 (slot * BRICK_SAMPLES + inner(x, y, z)) * ch
             }
         };
@@ -133,37 +128,13 @@ impl GridDesc {
     }
 }
 
-/// Checks a sparse grid's shape: whole bricks (at least the background brick) then a table whose
-/// every entry names a stored brick, and fewer than 2^32 stored samples (the lookup's index is
-/// `u32`). `Err` says what is wrong.
+/// Checks a sparse grid's shape: whole bricks (at least the background brick), then a brick
+/// table whose every entry names a stored brick or its own fine entries, and fewer than 2^32
+/// stored samples (the lookup's index is `u32`). `Err` says what is wrong.
 pub fn check(grid: &GridDesc) -> Result<(), String> {
-    let table = table_len(grid.resolution).ok_or("the brick table overflows")? as usize;
-    let brick = BRICK_SAMPLES * grid.channels as usize;
-    let Some(stored) = grid.data.len().checked_sub(table) else {
-        return Err(format!(
-            "{} values cannot hold a brick table of {table} entries",
-            grid.data.len()
-        ));
-    };
-    if brick == 0 || stored < brick || !stored.is_multiple_of(brick) {
-        return Err(format!(
-            "{stored} stored values are not whole bricks of {brick} values (at least one)"
-        ));
-    }
-    let slots = stored / brick;
-    if (slots as u64) << 9 > u64::from(u32::MAX) {
-        return Err(format!("{slots} bricks: at most 2^23 bricks can be stored"));
-    }
-    if let Some((i, slot)) = grid
-        .brick_table()
-        .enumerate()
-        .find(|&(_, s)| s as usize >= slots)
-    {
-        return Err(format!(
-            "brick table entry {i} names brick {slot}, but {slots} are stored"
-        ));
-    }
-    Ok(())
+    table::parts(&grid.data, grid.resolution, grid.channels)
+        .map(|_| ())
+        .map_err(|e| e.to_string())
 }
 
 impl GridDesc {
@@ -180,7 +151,7 @@ impl GridDesc {
         let [bx, by, bz] = bricks(self.resolution);
         let size = BRICK_SAMPLES * ch;
         let mut bricks_data: Vec<Vec<f32>> = Vec::new();
-        let mut table = Vec::with_capacity((bx * by * bz) as usize);
+        let mut slots = Vec::with_capacity((bx * by * bz) as usize);
         let mut zero_slot = None;
         for kz in 0..bz {
             for ky in 0..by {
@@ -207,23 +178,23 @@ impl GridDesc {
                         bricks_data.push(brick);
                         bricks_data.len() - 1
                     };
-                    table.push(slot);
+                    slots.push(slot as u32);
                 }
             }
         }
         // Slot 0 is the brick empty regions point at: the zero brick, if there is one.
         if let Some(zero) = zero_slot.filter(|&z| z != 0) {
             bricks_data.swap(0, zero);
-            for slot in &mut table {
-                *slot = match *slot {
+            for slot in &mut slots {
+                *slot = match *slot as usize {
                     s if s == zero => 0,
-                    0 => zero,
-                    s => s,
+                    0 => zero as u32,
+                    s => s as u32,
                 };
             }
         }
         let mut data: Vec<f32> = bricks_data.into_iter().flatten().collect();
-        data.extend(table.into_iter().map(|s| f32::from_bits(s as u32)));
+        BrickTable::from_slots(self.resolution, &slots).append_to(&mut data);
         GridDesc {
             data,
             layout: SampleLayout::Sparse,

@@ -10,7 +10,7 @@
 //! the first render of a scene pays for the calibration (a few seconds, most of it JIT compilation).
 
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::time::Duration;
 
@@ -203,6 +203,15 @@ pub struct AutoCache {
     entries: Mutex<BTreeMap<String, Choice>>,
 }
 
+/// The bytes of the regular file at `path` (anything else is refused before it is opened).
+fn read_regular(path: &Path) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let (file, len) = volpt_film::regular::open_regular(path)?;
+    let mut bytes = Vec::new();
+    file.take(len).read_to_end(&mut bytes)?;
+    Ok(bytes)
+}
+
 impl AutoCache {
     /// The user's cache file, read if it exists; an unreadable cache is ignored with a warning
     /// (it only saves calibration time).
@@ -215,7 +224,8 @@ impl AutoCache {
         let entries = path
             .as_ref()
             .filter(|p| p.exists())
-            .and_then(|p| match std::fs::read(p) {
+            // A regular file only: a FIFO in its place would block the read for ever.
+            .and_then(|p| match read_regular(p) {
                 Ok(bytes) => serde_json::from_slice(&bytes)
                     .map_err(|e| tracing::warn!("ignoring the auto cache {}: {e}", p.display()))
                     .ok(),

@@ -232,7 +232,7 @@ fn grid_memory(name: &str, g: &GridDesc) -> String {
         SampleLayout::Dense => format!("{name} grid {} dense", mib(stored)),
         SampleLayout::Sparse => {
             let bricks = g.samples().len() / (512 * g.channels.max(1) as usize);
-            let table = volpt_scene::sparse::table_len(g.resolution).unwrap_or(0);
+            let table = volpt_scene::sparse::box_bricks(g.resolution).unwrap_or(0);
             let dense = g
                 .dense_bytes()
                 .map_or("more than 2^64 bytes".to_owned(), mib);

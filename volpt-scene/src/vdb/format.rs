@@ -360,6 +360,11 @@ pub fn topology(c: &mut Cursor<'_>, d: &Descriptor, version: u32) -> Result<Topo
     let root_dim = 1u32 << (LOG2[0] + LOG2[1] + LOG2[2]);
     for _ in 0..tiles {
         let origin = coord(c, "a root tile")?;
+        if origin.iter().any(|&o| o % root_dim as i32 != 0) {
+            return Err(format!(
+                "a root tile at {origin:?} is not aligned to {root_dim}"
+            ));
+        }
         let value = values(c, channels, "a root tile")?;
         c.u8("a root tile's state")?;
         if value != t.background {

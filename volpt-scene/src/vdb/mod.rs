@@ -2,8 +2,11 @@
 //!
 //! A VDB stores a volume as a tree whose leaves are 8^3 voxels, exactly volpt's bricks: each leaf
 //! becomes one stored brick, each constant tile one stored brick shared by every brick it covers,
-//! and every other brick of the box points at the background brick. So a cloud in a mostly empty
-//! box takes its leaves' memory plus 4 bytes per brick of the box, never the dense box.
+//! and every other brick of the box points at the background brick. The brick table has one entry
+//! per 128^3 block of the box, plus one per brick of the blocks that are not uniform (those that
+//! hold leaves or the edge of a tile, [`volpt_core::sparse`]): so a cloud in a mostly empty box
+//! takes its leaves' memory plus at most 4 bytes per brick of the box, never the dense box, and a
+//! tile of 4096^3 voxels loads in time and memory proportional to its blocks, not its bricks.
 //!
 //! The reader is volpt's own ([`format`], [`blosc`]): the one maintained-looking Rust reader,
 //! `vdb-rs` 0.6 (January 2024), panics on unsupported maps and old versions, allocates whatever
@@ -23,6 +26,8 @@ use std::path::Path;
 use crate::description::{Bounds, GridConvention, GridDesc, SampleLayout};
 use crate::error::{GridProblem, SceneError};
 use crate::limits;
+use volpt_core::sparse::TablePlan;
+
 use crate::sparse::{self, BRICK, BRICK_SAMPLES};
 
 /// The grid a density is read from unless a scene names another (the name Blender, Houdini and
@@ -230,21 +235,6 @@ fn sparse_grid(
         tile_slots.entry(key).or_insert(next);
     }
     let slots = 1 + tile_slots.len() as u64 + t.leaves.len() as u64;
-    let table = sparse::table_len(res);
-    let values = table.and_then(|table| {
-        slots
-            .checked_mul((BRICK_SAMPLES * ch) as u64)
-            .and_then(|v| v.checked_add(table))
-    });
-    limits::check_memory(
-        path,
-        &format!(
-            "{what}: {slots} bricks of {ch} channels and a brick table for a box of {} x {} x {} \
-             voxels",
-            res[0], res[1], res[2]
-        ),
-        values.and_then(|v| limits::bytes_of(v, 4)),
-    )?;
     if slots << 9 > u64::from(u32::MAX) {
         return Err(problem(
             path,
@@ -252,42 +242,75 @@ fn sparse_grid(
             format!("{slots} bricks: at most 2^23 bricks can be stored"),
         ));
     }
-    let table = table.unwrap() as usize;
+    let first_leaf = 1 + tile_slots.len();
+    // The regions of the box each node covers, in bricks, tiles first and leaves over them (as
+    // the tree reads: a node's children over its tiles), each with its stored brick.
+    let brick_of =
+        |o: [i32; 3]| [0, 1, 2].map(|i| ((i64::from(o[i]) - lo[i]) / i64::from(BRICK)) as u32);
+    let regions = || {
+        let tiles = t.tiles.iter().map(|tile| {
+            let key: Vec<u32> = tile.value.iter().map(|v| v.to_bits()).collect();
+            let from = brick_of(tile.origin);
+            (from, from.map(|b| b + tile.dim / BRICK), tile_slots[&key])
+        });
+        let leaves = t.leaves.iter().enumerate().map(|(i, &origin)| {
+            let from = brick_of(origin);
+            (from, from.map(|b| b + 1), (first_leaf + i) as u32)
+        });
+        tiles.chain(leaves)
+    };
+    // The brick table in two passes (`volpt_core::sparse::TablePlan`): which 128^3 blocks are
+    // uniform (4 bytes per block of the box, checked first), then the mixed blocks' entries.
+    let box_size = format!("a box of {} x {} x {} voxels", res[0], res[1], res[2]);
+    let coarse = sparse::coarse_values(res);
+    limits::check_memory(
+        path,
+        &format!("{what}: the brick table's blocks for {box_size}"),
+        coarse.and_then(|v| limits::bytes_of(v, 4)),
+    )?;
+    if coarse.is_none_or(|c| c > u64::from(u32::MAX)) {
+        return Err(problem(
+            path,
+            what,
+            format!("{box_size} has more than 2^32 blocks of 128^3 voxels"),
+        ));
+    }
+    let mut plan = TablePlan::new(res);
+    for (from, to, slot) in regions() {
+        plan.paint(from, to, slot);
+    }
+    let fine = plan.fine_len();
+    let values = slots
+        .checked_mul((BRICK_SAMPLES * ch) as u64)
+        .and_then(|v| v.checked_add(fine)?.checked_add(coarse?));
+    limits::check_memory(
+        path,
+        &format!(
+            "{what}: {slots} bricks of {ch} channels and a brick table of {} entries for \
+             {box_size}",
+            fine + coarse.unwrap_or(0)
+        ),
+        values.and_then(|v| limits::bytes_of(v, 4)),
+    )?;
+    if fine >= u64::from(volpt_core::sparse::UNIFORM) {
+        return Err(problem(
+            path,
+            what,
+            format!("{fine} brick table entries: at most 2^31 - 1"),
+        ));
+    }
     let brick = BRICK_SAMPLES * ch;
     let stored = slots as usize * brick;
-    let mut data = vec![0.0f32; stored + table];
+    let mut data = Vec::with_capacity(values.unwrap_or(0) as usize);
+    data.resize(stored, 0.0);
     for (i, v) in data[..brick].iter_mut().enumerate() {
         *v = t.background[i % ch];
     }
-    let bricks = sparse::bricks(res);
-    let brick_of = |o: [i64; 3]| {
-        let b = [0, 1, 2].map(|i| ((o[i] - lo[i]) / i64::from(BRICK)) as usize);
-        (b[2] * bricks[1] as usize + b[1]) * bricks[0] as usize + b[0]
-    };
     for (value, &slot) in &tile_slots {
         let at = slot as usize * brick;
         for (i, v) in data[at..at + brick].iter_mut().enumerate() {
             *v = f32::from_bits(value[i % ch]);
         }
-    }
-    for tile in &t.tiles {
-        let key: Vec<u32> = tile.value.iter().map(|v| v.to_bits()).collect();
-        let slot = f32::from_bits(tile_slots[&key]);
-        let n = (tile.dim / BRICK) as i64;
-        let origin = tile.origin.map(i64::from);
-        for z in 0..n {
-            for y in 0..n {
-                for x in 0..n {
-                    let o = [x, y, z].map(|v| v * i64::from(BRICK));
-                    data[stored + brick_of([0, 1, 2].map(|i| origin[i] + o[i]))] = slot;
-                }
-            }
-        }
-    }
-    let first_leaf = 1 + tile_slots.len();
-    for (i, origin) in t.leaves.iter().enumerate() {
-        let b = brick_of(origin.map(i64::from));
-        data[stored + b] = f32::from_bits((first_leaf + i) as u32);
     }
     format::leaf_buffers(c, t, |i, leaf| {
         let at = (first_leaf + i) * brick;
@@ -303,6 +326,11 @@ fn sparse_grid(
         }
     })
     .map_err(|e| problem(path, what, e))?;
+    let mut table = plan.into_table();
+    for (from, to, slot) in regions() {
+        table.paint(from, to, slot);
+    }
+    table.append_to(&mut data);
     let world = |i: usize, index: i64| {
         (t.transform.translation[i] + t.transform.scale[i] * (index as f64 - 0.5)) as f32
     };
