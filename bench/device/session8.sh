@@ -9,8 +9,8 @@
 #                                 # chromatic images, the GPU test binaries in tests-bin/; keeps the
 #                                 # binary in /tmp/session8 for the second call
 #   bash dev/session8.sh ab       # bin/volpt-before (main at 564edf8) against the kept binary:
-#                                 # ab-bin.sh on the grey box scenes (and bricked ones where the
-#                                 # script exists)
+#                                 # ab-bin.sh on the grey box scenes, then sparse-table.sh (the
+#                                 # two-level brick table: exact checks, tiles, bricked A/B)
 #
 # Each part writes under $OUT/<part>/; the summaries are gathered in $OUT/summary-<mode>.txt and the
 # rest packed in $OUT/<mode>.tar.gz.
@@ -52,10 +52,10 @@ checks)
 ab)
     cp "$KEEP/volpt" bin/volpt
     part ab-bin 240 env STRATEGIES="regeneration-sk regeneration-block-sk" TRIALS=3 bash ab-bin.sh
-    [ -f ab-bricked.sh ] && part ab-bricked 200 bash ab-bricked.sh
+    part sparse-table 300 bash sparse-table.sh
     ;;
 esac
-for f in "$OUT"/*/summary.txt "$OUT"/*/hostile.txt "$OUT"/ab-bin/ab-bin.txt; do
+for f in "$OUT"/*/summary.txt "$OUT"/*/hostile.txt "$OUT"/ab-bin/ab-bin.txt "$OUT"/*/sparse-table.txt; do
     [ -f "$f" ] && { echo "---- $f"; cat "$f"; } >>"$summary"
 done
 for d in "$OUT"/*/; do tail -n 3 "$d/stdout.txt" 2>/dev/null | sed "s|^|$(basename "$d"): |" >>"$summary"; done
