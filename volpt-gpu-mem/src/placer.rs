@@ -401,7 +401,8 @@ impl VolumePlacer {
                     self.held.push(Box::new(registration));
                     return Ok((address, PlacedIn::ZeroCopyInPlace));
                 }
-                // A small grid sharing a page with one registered before: copy it instead.
+                // Pages the caller registered already (only grids of `IN_PLACE_MIN_BYTES` or more
+                // get here, which own their pages): copy the grid instead.
                 Err(e) if HostRegistration::already_registered(&e) => {}
                 Err(e @ GpuMemError::OutOfPinnedMemory { .. }) => return Err(e),
                 // Registration is not supported everywhere (some virtualised or older systems):
