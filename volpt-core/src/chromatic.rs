@@ -45,6 +45,13 @@ pub struct ChromaticMedium<'a> {
     pub majorant: f32,
     /// Per-cell bounds of every channel ([`crate::majorant`]); `None` tracks with `majorant`.
     pub majorants: Option<MajorantGrid<'a>>,
+    /// Each channel's own bound over the medium (`extinction * max(density)`, or per channel
+    /// the largest of the materials present): its majorant where `majorants` is `None`, and
+    /// per cell `channel_majorant * cell bound / majorant` unless `channel_majorants` has it.
+    pub channel_majorant: Spectrum,
+    /// Each channel's bound per cell of `majorants`, three `f32`s a cell (a material-indexed
+    /// volume's, whose channels' bounds are not in proportion from cell to cell).
+    pub channel_majorants: Option<&'a [f32]>,
     /// The albedo where there is no albedo grid.
     pub albedo: Spectrum,
     pub albedo_grid: Option<Grid<'a, 3>>,
@@ -67,6 +74,8 @@ impl<'a> ChromaticMedium<'a> {
             density,
             majorant: extinction.max_element() * max_density,
             majorants: None,
+            channel_majorant: extinction * max_density,
+            channel_majorants: None,
             albedo,
             albedo_grid,
             materials: None,
@@ -81,6 +90,8 @@ impl<'a> ChromaticMedium<'a> {
             density: None,
             majorant: materials.max_extinction(),
             majorants: None,
+            channel_majorant: materials.max_extinction_rgb(),
+            channel_majorants: None,
             albedo: Spectrum::ZERO,
             albedo_grid: None,
             materials: Some(materials),
@@ -100,6 +111,29 @@ impl Medium for ChromaticMedium<'_> {
     #[inline]
     fn majorant_grid(&self) -> Option<&MajorantGrid<'_>> {
         self.majorants.as_ref()
+    }
+
+    /// A cell's from [`ChromaticMedium::channel_majorants`] where it has them; else the global
+    /// bounds scaled as the cell's bound of every channel is (`extinction * density` keeps the
+    /// channels in proportion), or for a material-indexed volume that bound in every channel.
+    #[inline(always)]
+    fn majorant_rgb(&self, bound: f32, cell: Option<usize>) -> Spectrum {
+        let Some(cell) = cell else {
+            return self.channel_majorant;
+        };
+        if let Some(channels) = self.channel_majorants {
+            let c = &channels[3 * cell..3 * cell + 3];
+            return Spectrum::new(c[0], c[1], c[2]);
+        }
+        if self.materials.is_some() {
+            // Materials' channels are not in proportion: only the bound of all holds for each.
+            return Spectrum::splat(bound);
+        }
+        if self.majorant > 0.0 {
+            self.channel_majorant * (bound / self.majorant)
+        } else {
+            Spectrum::ZERO
+        }
     }
 
     /// The largest channel's extinction.
@@ -157,6 +191,10 @@ impl<'a> TrackedMedium<'a> for ChromaticMedium<'a> {
         self.majorants = grid;
     }
 
+    fn track_channels_with(&mut self, channels: Option<&'a [f32]>) {
+        self.channel_majorants = channels;
+    }
+
     fn materials(&self) -> Option<MaterialGrid<'a>> {
         self.materials
     }
@@ -192,10 +230,14 @@ pub struct ChromaticParams {
     pub albedo_grid: GridParams,
     pub majorants: MajorantGridParams,
     pub materials: MaterialGridParams,
+    /// Device address of the per-cell channel majorants (three `f32`s a cell), and their count
+    /// (0: none).
+    pub channel_majorants: u64,
+    pub channel_majorants_len: u64,
     pub extinction: [f32; 3],
     pub majorant: f32,
     pub albedo: [f32; 3],
-    pub padding: u32,
+    pub channel_majorant: [f32; 3],
 }
 
 fn optional_grid<const C: usize>(
@@ -217,10 +259,12 @@ impl Component for ChromaticMedium<'_> {
             albedo_grid: optional_grid(self.albedo_grid.as_ref(), upload),
             majorants: MajorantGridParams::new(self.majorants.as_ref(), upload),
             materials: MaterialGridParams::new(self.materials.as_ref(), upload),
+            channel_majorants: self.channel_majorants.map_or(0, |c| upload.values(c)),
+            channel_majorants_len: self.channel_majorants.map_or(0, |c| c.len() as u64),
             extinction: self.extinction.to_array(),
             majorant: self.majorant,
             albedo: self.albedo.to_array(),
-            padding: 0,
+            channel_majorant: self.channel_majorant.to_array(),
         }
     }
 
@@ -233,6 +277,14 @@ impl Component for ChromaticMedium<'_> {
             majorant: p.majorant,
             // SAFETY: forwarded to the caller.
             majorants: unsafe { p.majorants.grid() },
+            channel_majorant: Spectrum::from_array(p.channel_majorant),
+            // SAFETY: forwarded to the caller (the address holds `channel_majorants_len` f32s).
+            channel_majorants: (p.channel_majorants_len > 0).then(|| unsafe {
+                core::slice::from_raw_parts(
+                    p.channel_majorants as *const f32,
+                    p.channel_majorants_len as usize,
+                )
+            }),
             albedo: Spectrum::from_array(p.albedo),
             // SAFETY: forwarded to the caller.
             albedo_grid: (p.albedo_grid.len > 0).then(|| unsafe { p.albedo_grid.grid::<3>() }),

@@ -378,6 +378,13 @@ impl Dda {
         )
     }
 
+    /// The index of the current cell in the grid's data (x fastest).
+    #[inline]
+    pub fn cell_index(&self, grid: &MajorantGrid<'_>) -> usize {
+        let [x, y, z] = self.cell;
+        ((z as u32 * grid.res[1] + y as u32) * grid.res[0] + x as u32) as usize
+    }
+
     /// Moves into the next cell along the ray, across the nearest boundary.
     #[inline]
     pub fn advance(&mut self, grid: &MajorantGrid<'_>, dir: Vec3) {

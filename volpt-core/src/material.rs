@@ -189,6 +189,22 @@ impl<'a> MaterialGrid<'a> {
             .fold(0.0, f32::max)
     }
 
+    /// Per channel, the largest extinction of any material the grid holds.
+    pub fn max_extinction_rgb(&self) -> Spectrum {
+        let present = self.present();
+        (0..MAX_MATERIALS)
+            .filter(|&k| present[k])
+            .map(|k| self.row_sigma_t(k))
+            .fold(Spectrum::ZERO, Spectrum::max)
+    }
+
+    /// The extinction of material `k`, scaled.
+    #[inline(always)]
+    fn row_sigma_t(&self, k: usize) -> Spectrum {
+        let r = k * MATERIAL_FLOATS;
+        Spectrum::new(self.table[r], self.table[r + 1], self.table[r + 2]) * self.scale
+    }
+
     /// Which materials the grid holds.
     pub fn present(&self) -> [bool; MAX_MATERIALS] {
         let mut present = [false; MAX_MATERIALS];
@@ -206,22 +222,51 @@ impl<'a> MaterialGrid<'a> {
 }
 
 /// Fills `out` (one value per cell of a `res` grid over `bounds`, x fastest) with the largest
-/// extinction of any channel a lookup of `grid` can return inside each cell: the largest of the
-/// materials of the voxels that overlap the cell grown by [`CELL_MARGIN`] (and one voxel more on
-/// every side, so that rounding at a voxel's face cannot escape it). Conservative by
-/// construction; outside the index grid's box the extinction is zero, below any bound.
+/// extinction of any channel a lookup of `grid` can return inside each cell
+/// ([`build_material_channel_majorants`]'s largest channel).
 pub fn build_material_majorants(
     grid: &MaterialGrid<'_>,
     bounds: Aabb,
     res: [u32; 3],
     out: &mut [f32],
 ) {
+    for_each_cell_bound(grid, bounds, res, out.len(), |i, bound| {
+        out[i] = bound.max_element()
+    });
+}
+
+/// Fills `out` (three values per cell of a `res` grid over `bounds`, x fastest) with each
+/// channel's largest extinction that a lookup of `grid` can return inside each cell: the largest
+/// of the materials of the voxels that overlap the cell grown by [`CELL_MARGIN`] (and one voxel
+/// more on every side, so that rounding at a voxel's face cannot escape it). Conservative by
+/// construction; outside the index grid's box the extinction is zero, below any bound.
+pub fn build_material_channel_majorants(
+    grid: &MaterialGrid<'_>,
+    bounds: Aabb,
+    res: [u32; 3],
+    out: &mut [f32],
+) {
+    assert_eq!(out.len() % 3, 0, "three channel majorants a cell");
+    for_each_cell_bound(grid, bounds, res, out.len() / 3, |i, bound| {
+        out[3 * i..3 * i + 3].copy_from_slice(&bound.to_array())
+    });
+}
+
+/// Calls `put(i, bound)` with each channel's bound of every cell `i` of a `res` grid over
+/// `bounds`, which must have `cells` cells.
+fn for_each_cell_bound(
+    grid: &MaterialGrid<'_>,
+    bounds: Aabb,
+    res: [u32; 3],
+    cells: usize,
+    mut put: impl FnMut(usize, Spectrum),
+) {
     assert_eq!(
-        out.len(),
+        cells,
         res[0] as usize * res[1] as usize * res[2] as usize,
         "majorant grid data does not match its resolution"
     );
-    let cells = MajorantGrid {
+    let grid_cells = MajorantGrid {
         data: &[],
         res,
         bounds,
@@ -229,16 +274,21 @@ pub fn build_material_majorants(
     let cell = bounds.extent() / Vec3::new(res[0] as f32, res[1] as f32, res[2] as f32);
     let voxel_scale = Vec3::new(grid.res[0] as f32, grid.res[1] as f32, grid.res[2] as f32)
         / grid.bounds.extent();
-    let largest = |k: u32| grid.table[k as usize * MATERIAL_FLOATS + 7] * grid.scale;
-    for (i, bound) in out.iter_mut().enumerate() {
+    // Each material's extinction, once (not once per voxel read).
+    let materials = grid.table.len() / MATERIAL_FLOATS;
+    let mut sigma_t = [Spectrum::ZERO; MAX_MATERIALS];
+    for (k, s) in sigma_t.iter_mut().enumerate().take(materials) {
+        *s = grid.row_sigma_t(k);
+    }
+    for i in 0..cells {
+        if grid.only != MaterialGrid::MIXED {
+            put(i, sigma_t[grid.only as usize]);
+            continue;
+        }
         let x = (i % res[0] as usize) as u32;
         let y = ((i / res[0] as usize) % res[1] as usize) as u32;
         let z = (i / (res[0] as usize * res[1] as usize)) as u32;
-        if grid.only != MaterialGrid::MIXED {
-            *bound = largest(grid.only);
-            continue;
-        }
-        let b = cells.cell_bounds(x, y, z);
+        let b = grid_cells.cell_bounds(x, y, z);
         let lo = ((b.min - cell * CELL_MARGIN - grid.bounds.min) * voxel_scale).floor();
         let hi = ((b.max + cell * CELL_MARGIN - grid.bounds.min) * voxel_scale).floor();
         let range = |a: usize| {
@@ -248,15 +298,15 @@ pub fn build_material_majorants(
             from as usize..=to as usize
         };
         let (nx, ny) = (grid.res[0] as usize, grid.res[1] as usize);
-        let mut max = 0.0f32;
+        let mut max = Spectrum::ZERO;
         for vz in range(2) {
             for vy in range(1) {
                 for vx in range(0) {
-                    max = max.max(largest(grid.index((vz * ny + vy) * nx + vx)));
+                    max = max.max(sigma_t[grid.index((vz * ny + vy) * nx + vx) as usize]);
                 }
             }
         }
-        *bound = max;
+        put(i, max);
     }
 }
 

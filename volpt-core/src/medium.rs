@@ -44,6 +44,15 @@ pub trait Medium {
         Spectrum::splat(self.sigma_t(p))
     }
 
+    /// Each channel's majorant in a region whose bound of every channel is `bound`: the
+    /// majorant-grid cell of index `cell`, or with `None` the whole medium ([`Medium::majorant`]).
+    /// A chromatic medium's hero channel samples its free flights at its own
+    /// ([`crate::tracking::spectral_delta_tracking`]); a grey medium's is `bound` in all three.
+    #[inline(always)]
+    fn majorant_rgb(&self, bound: f32, _cell: Option<usize>) -> Spectrum {
+        Spectrum::splat(bound)
+    }
+
     /// The extinction per channel if it is the same everywhere (transmittance is then exact).
     #[inline(always)]
     fn uniform_sigma_t_rgb(&self) -> Option<Spectrum> {
@@ -86,6 +95,13 @@ pub trait TrackedMedium<'a> {
     /// Tracks with `grid` (`None`: with the global majorant).
     fn track_with(&mut self, grid: Option<MajorantGrid<'a>>) {
         let _ = grid;
+    }
+
+    /// Tracks each channel with its own bound per cell of the majorant grid, three `f32`s a
+    /// cell (`None`: in proportion to the grid's bound of every channel); only a chromatic
+    /// medium's channels have their own.
+    fn track_channels_with(&mut self, channels: Option<&'a [f32]>) {
+        let _ = channels;
     }
 
     /// The material-indexed volume whose majorant grid tightens tracking

@@ -26,8 +26,29 @@ pub enum FreeFlight {
 /// named types whose method is always inlined, because the walk calls it from two loops and LLVM
 /// then keeps a closure's body as a function of its own, which on a GPU takes the medium, and the
 /// whole scene with it, by address into local memory (a ~500-byte stack frame per thread).
+///
+/// The walk samples the tentative collisions of a region (the whole ray, or a majorant-grid
+/// cell) at the rate [`TentativeCollision::rate`] returns for it, and reports where it leaves
+/// each region without stopping ([`TentativeCollision::leave`]): plain delta and ratio tracking
+/// sample at the medium's bound and ignore the regions; a chromatic path samples at its hero
+/// channel's own majorant and needs every channel's optical depth between events
+/// ([`spectral_delta_tracking`]).
 pub trait TentativeCollision {
     fn stop_at(&mut self, rng: &mut Rng, t: f32, majorant: f32, bits: u64) -> bool;
+
+    /// The rate of tentative collisions in a region whose bound of the extinction (of every
+    /// channel) is `bound`: the majorant-grid cell of index `cell`, or with `None` the whole ray
+    /// under the medium's global majorant. A region whose rate is not positive is crossed
+    /// without a step.
+    #[inline(always)]
+    fn rate(&mut self, bound: f32, _cell: Option<usize>) -> f32 {
+        bound
+    }
+
+    /// The walk leaves the current region at `t` (its end, or where the walk escapes) without
+    /// a collision after the last one it stopped at.
+    #[inline(always)]
+    fn leave(&mut self, _t: f32) {}
 }
 
 impl<F: FnMut(&mut Rng, f32, f32) -> bool> TentativeCollision for F {
@@ -64,8 +85,9 @@ pub fn walk_majorants<M: Medium>(
     mut at: impl TentativeCollision,
 ) -> FreeFlight {
     let Some(grid) = medium.majorant_grid() else {
-        let majorant = medium.majorant();
+        let majorant = at.rate(medium.majorant(), None);
         if majorant <= 0.0 {
+            at.leave(t_max);
             return FreeFlight::Escaped;
         }
         let majorant = normal_majorant(majorant);
@@ -75,6 +97,7 @@ pub fn walk_majorants<M: Medium>(
             let bits = rng.next_u64();
             t -= ln(1.0 - unit_f32(bits)) * inv_majorant;
             if t >= t_max {
+                at.leave(t_max);
                 return FreeFlight::Escaped;
             }
             if *steps >= max_steps {
@@ -93,7 +116,7 @@ pub fn walk_majorants<M: Medium>(
     // its cell. The same numbers drawn in the same order, the same arithmetic.
     let mut dda = Dda::new(grid, ray);
     let mut start = 0.0f32;
-    let mut cell = Cell::new(&dda, grid, t_max, start);
+    let mut cell = Cell::new(&dda, grid, t_max, start, &mut at);
     loop {
         if cell.majorant > 0.0 {
             let bits = rng.next_u64();
@@ -111,18 +134,20 @@ pub fn walk_majorants<M: Medium>(
                 continue;
             }
         }
+        at.leave(cell.end);
         // Anything but `end < t_max` ends the walk, a NaN `end` or `t_max` included.
         if cell.end.partial_cmp(&t_max) != Some(core::cmp::Ordering::Less) {
             return FreeFlight::Escaped;
         }
         start = start.max(cell.end);
         dda.advance(grid, ray.dir);
-        cell = Cell::new(&dda, grid, t_max, start);
+        cell = Cell::new(&dda, grid, t_max, start, &mut at);
     }
 }
 
-/// The majorant-grid walk's current cell: its bound (raised by [`normal_majorant`] where
-/// positive), the bound's reciprocal, where the walk leaves it and the distance sampled so far.
+/// The majorant-grid walk's current cell: its rate of tentative collisions (its bound, or what
+/// [`TentativeCollision::rate`] makes of it; raised by [`normal_majorant`] where positive), the
+/// rate's reciprocal, where the walk leaves it and the distance sampled so far.
 struct Cell {
     majorant: f32,
     inv_majorant: f32,
@@ -132,8 +157,15 @@ struct Cell {
 
 impl Cell {
     #[inline(always)]
-    fn new(dda: &Dda, grid: &crate::majorant::MajorantGrid<'_>, t_max: f32, start: f32) -> Self {
-        let (majorant, cell_end) = dda.segment(grid);
+    fn new(
+        dda: &Dda,
+        grid: &crate::majorant::MajorantGrid<'_>,
+        t_max: f32,
+        start: f32,
+        at: &mut impl TentativeCollision,
+    ) -> Self {
+        let (bound, cell_end) = dda.segment(grid);
+        let majorant = at.rate(bound, Some(dda.cell_index(grid)));
         // A cell of bound 0 (or NaN) is crossed without a step; its bound is left as it is.
         let majorant = if majorant > 0.0 {
             normal_majorant(majorant)
@@ -261,11 +293,20 @@ impl<M: Medium> TentativeCollision for &mut RatioProduct<'_, M> {
     }
 }
 
-/// Delta tracking of a chromatic medium ([`crate::chromatic`]): the tentative collisions of
-/// [`walk_majorants`] (one majorant for every channel), each real with probability `w_hero`, where
-/// `w = sigma_t(x) / majorant` per channel; each real or null collision rescales the path densities
-/// `r_u` by `w` or `1 - w` ([`rescale`]), the single-sample spectral MIS of Miller et al. 2019. A
-/// path whose `r_u` becomes zero stops at the collision (the caller ends it).
+/// Delta tracking of a chromatic medium ([`crate::chromatic`]) by the path's hero channel, with
+/// the single-sample spectral MIS of Miller, Georgiev and Jarosz 2019 in pbrt-v4's form (its
+/// `VolPathIntegrator`: the path's densities under every channel, rescaled, `r_u`).
+///
+/// Each channel `c` has its own majorant `m_c` per region ([`Medium::majorant_rgb`]: a homogeneous
+/// medium's is its exact `sigma_t,c`, so it has no null collision in any channel). The walk samples
+/// tentative collisions at the hero's rate `m_h`; one at `x` is real with probability
+/// `sigma_t,h(x) / m_h`. Under channel `c`'s own tracking the same event has density
+/// `exp(-tau_c) sigma_t,c(x)` (real) or `exp(-tau_c) (m_c - sigma_t,c(x))` (null), and reaching
+/// `t_max` has `exp(-tau_c)`, with `tau_c` the optical depth of `m_c` since the last event; each
+/// event rescales `r_u` by those ([`rescale`]). The throughput's factors are each channel's own
+/// ratio of contribution to density (the albedo at a real collision, 1 at a null one or the
+/// escape, whatever the majorants), as in a grey medium. A path whose `r_u` becomes zero stops at
+/// the collision (the caller ends it).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 pub fn spectral_delta_tracking<M: Medium>(
@@ -278,42 +319,100 @@ pub fn spectral_delta_tracking<M: Medium>(
     steps: &mut u32,
     max_steps: u32,
 ) -> FreeFlight {
-    walk_majorants(
+    let mut hero = SpectralAcceptance {
         medium,
         ray,
-        t_max,
-        rng,
-        steps,
-        max_steps,
-        SpectralAcceptance {
-            medium,
-            ray,
-            hero: hero as usize,
-            r_u,
-        },
-    )
+        hero: hero as usize,
+        r_u,
+        majorant: Spectrum::ZERO,
+        depth: Spectrum::ZERO,
+        last: 0.0,
+    };
+    let flight = walk_majorants(medium, ray, t_max, rng, steps, max_steps, &mut hero);
+    if flight == FreeFlight::Escaped {
+        rescale(hero.r_u, relative_transmittance(hero.depth));
+    }
+    flight
 }
 
-/// Spectral delta tracking's test and its rescaling of the path densities.
+/// Spectral delta tracking's state: the current region's majorant per channel, each channel's
+/// optical depth under its majorant since the path's last event (or the flight's start), and
+/// where that was.
 struct SpectralAcceptance<'a, M> {
     medium: &'a M,
     ray: &'a Ray,
     hero: usize,
     r_u: &'a mut Spectrum,
+    majorant: Spectrum,
+    depth: Spectrum,
+    last: f32,
 }
 
-impl<M: Medium> TentativeCollision for SpectralAcceptance<'_, M> {
+impl<M: Medium> TentativeCollision for &mut SpectralAcceptance<'_, M> {
+    #[inline(always)]
+    fn rate(&mut self, bound: f32, cell: Option<usize>) -> f32 {
+        let m = self.medium.majorant_rgb(bound, cell);
+        // The rates the walk samples at: positive ones raised as it raises its own, so that
+        // the hero's density here is that of its steps.
+        self.majorant = Spectrum::new(channel_rate(m.x), channel_rate(m.y), channel_rate(m.z));
+        self.majorant[self.hero]
+    }
+
+    #[inline(always)]
+    fn leave(&mut self, t: f32) {
+        self.depth += self.majorant * (t - self.last);
+        self.last = t;
+    }
+
     #[inline(always)]
     fn stop_at(&mut self, rng: &mut Rng, t: f32, majorant: f32, _bits: u64) -> bool {
-        let w = collision_probabilities(self.medium, self.ray.at(t), majorant);
-        let real = rng.next_f32() < w[self.hero];
-        rescale(self.r_u, if real { w } else { Spectrum::ONE - w });
-        real || *self.r_u == Spectrum::ZERO
+        self.leave(t);
+        // Each channel's real part of its majorant (clamped: a bound rounded below the
+        // extinction by an ulp takes it).
+        let real = self
+            .medium
+            .sigma_t_rgb(self.ray.at(t))
+            .max(Spectrum::ZERO)
+            .min(self.majorant);
+        let h = real[self.hero];
+        // A homogeneous medium's hero is always real: no random number for it.
+        let is_real = h >= majorant || rng.next_f32() * majorant < h;
+        let density = if is_real { real } else { self.majorant - real };
+        let scale = 1.0 / self.majorant.max_element();
+        rescale(
+            self.r_u,
+            relative_transmittance(self.depth) * density * scale,
+        );
+        self.depth = Spectrum::ZERO;
+        is_real || *self.r_u == Spectrum::ZERO
     }
 }
 
+/// A channel's majorant as [`walk_majorants`] samples it: raised by [`normal_majorant`] where
+/// positive, 0 where not, NaN kept (the step budget ends such a walk).
+#[inline(always)]
+fn channel_rate(m: f32) -> f32 {
+    if m > 0.0 {
+        normal_majorant(m)
+    } else if m <= 0.0 {
+        0.0
+    } else {
+        m
+    }
+}
+
+/// `exp(-tau_c)` per channel up to a common factor, the largest being 1: `exp(-(tau_c -
+/// min tau))`, which cannot overflow and underflows only for a channel whose density is below
+/// f32's range relative to another's (NaN stays NaN, which [`rescale`] turns into the end of
+/// the path).
+#[inline(always)]
+fn relative_transmittance(depth: Spectrum) -> Spectrum {
+    let d = depth - Spectrum::splat(depth.min_element());
+    Spectrum::new(exp(-d.x), exp(-d.y), exp(-d.z))
+}
+
 /// `sigma_t(p) / majorant` per channel, clamped to `[0, 1]`: each channel's probability that a
-/// tentative collision at `p` is real.
+/// tentative collision at `p` is real under one majorant for all channels.
 #[inline(always)]
 fn collision_probabilities<M: Medium>(medium: &M, p: crate::Vec3, majorant: f32) -> Spectrum {
     (medium.sigma_t_rgb(p) / majorant).clamp(Spectrum::ZERO, Spectrum::ONE)

@@ -3,10 +3,12 @@
 //!   medium of k (its extinction, albedo and phase asymmetry: the per-collision `g` is read);
 //! - through a layered slab of two materials whose channels are 5x apart, spectral ratio tracking
 //!   and spectral delta tracking estimate each channel's analytic transmittance
-//!   `exp(-sum_k sigma_k l_k)` (z-tests), with the global majorant and with the majorant grid;
+//!   `exp(-sum_k sigma_k l_k)` (z-tests), with the global majorants, with the majorant grid's
+//!   bound of every channel and with its per-channel bounds;
 //! - each channel of a render of a random 4^3 grid of three materials equals the grey render of
 //!   that channel's coefficients as nearest-sample grids (the per-channel identity);
-//! - the majorant grid bounds every channel of every point of its cells;
+//! - the majorant grid bounds every channel of every point of its cells, and each channel's own
+//!   bounds bound that channel;
 //! - on a table whose channels are 10^10 apart, with an empty material, every path's light is
 //!   finite and non-negative and its path densities stay in [0, 3].
 
@@ -15,7 +17,9 @@ mod common;
 use common::{Moments, TestRng, Z_MAX};
 use volpt_core::grid::{AnyLayout, GridLookup};
 use volpt_core::majorant::{build_majorants, MajorantGrid};
-use volpt_core::material::{build_material_majorants, Material, MATERIAL_FLOATS};
+use volpt_core::material::{
+    build_material_channel_majorants, build_material_majorants, Material, MATERIAL_FLOATS,
+};
 use volpt_core::path::{trace, Truncation};
 use volpt_core::rng::Rng;
 use volpt_core::tracking::{spectral_delta_tracking, spectral_ratio_tracking, FreeFlight};
@@ -147,6 +151,18 @@ struct Slab {
     indices: Vec<u32>,
     table: Vec<f32>,
     majorants: Vec<f32>,
+    channels: Vec<f32>,
+}
+
+/// How [`Slab::medium`] tracks.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Tracking {
+    /// Each channel's largest extinction over the volume.
+    Global,
+    /// A majorant grid whose cells bound every channel at once.
+    Grid,
+    /// A majorant grid and each channel's own bound per cell.
+    ChannelGrid,
 }
 
 const SLAB_A: Material = Material {
@@ -166,6 +182,7 @@ impl Slab {
             indices: pack(&[0, 0, 0, 1]),
             table: table(&[SLAB_A, SLAB_B]),
             majorants: vec![0.0; 8],
+            channels: vec![0.0; 24],
         }
     }
 
@@ -173,16 +190,27 @@ impl Slab {
         MaterialGrid::new(&self.indices, [1, 1, 4], bounds(), &self.table, 1.0)
     }
 
-    fn medium(&mut self, with_grid: bool) -> ChromaticMedium<'_> {
+    fn medium(&mut self, tracking: Tracking) -> ChromaticMedium<'_> {
         let res = [1, 1, 8];
         let grid = MaterialGrid::new(&self.indices, [1, 1, 4], bounds(), &self.table, 1.0);
         build_material_majorants(&grid, bounds(), res, &mut self.majorants);
+        build_material_channel_majorants(&grid, bounds(), res, &mut self.channels);
         // The cells of A and of B take their own material's bound (one voxel of margin).
         assert_eq!(self.majorants[0], 1.0);
         assert_eq!(self.majorants[7], 1.6);
+        assert_eq!(self.channels[..3], SLAB_A.sigma_t.to_array());
+        // B's last cell reads A's voxel below it too (the margin): each channel's larger.
+        assert_eq!(
+            self.channels[21..],
+            SLAB_A.sigma_t.max(SLAB_B.sigma_t).to_array()
+        );
         let mut medium = ChromaticMedium::indexed(self.grid());
-        if with_grid {
+        assert_eq!(medium.channel_majorant, Spectrum::new(1.6, 0.5, 1.0));
+        if tracking != Tracking::Global {
             medium.majorants = Some(MajorantGrid::new(&self.majorants, res, bounds()));
+        }
+        if tracking == Tracking::ChannelGrid {
+            medium.channel_majorants = Some(&self.channels);
         }
         medium
     }
@@ -211,9 +239,9 @@ fn assert_means(what: &str, moments: &[Moments; 3], expected: [f64; 3]) {
 #[test]
 fn a_layered_slab_transmits_each_channel_analytically() {
     let ray = Ray::new(Vec3::new(0.3, -0.2, -1.0), Vec3::Z);
-    for with_grid in [false, true] {
+    for tracking in [Tracking::Global, Tracking::Grid, Tracking::ChannelGrid] {
         let mut slab = Slab::new();
-        let medium = slab.medium(with_grid);
+        let medium = slab.medium(tracking);
         let (mut ratio, mut flight) = ([Moments::default(); 3], [Moments::default(); 3]);
         for i in 0..1 << 18 {
             let mut rng = Rng::new(7, i, 0);
@@ -241,11 +269,7 @@ fn a_layered_slab_transmits_each_channel_analytically() {
                 flight[c].push(if escaped { r_u[c] as f64 } else { 0.0 });
             }
         }
-        let what = if with_grid {
-            "majorant grid"
-        } else {
-            "global majorant"
-        };
+        let what = format!("{tracking:?}");
         assert_means(
             &format!("ratio tracking, {what}"),
             &ratio,
@@ -273,8 +297,11 @@ fn indexed_channels_are_grey_renders_of_their_materials() {
     let cells = [2, 2, 2];
     let mut majorants = vec![0.0; 8];
     build_material_majorants(&grid, bounds(), cells, &mut majorants);
+    let mut channels = vec![0.0; 24];
+    build_material_channel_majorants(&grid, bounds(), cells, &mut channels);
     let mut medium = ChromaticMedium::indexed(grid);
     medium.majorants = Some(MajorantGrid::new(&majorants, cells, bounds()));
+    medium.channel_majorants = Some(&channels);
     let paths = 1 << 18;
     for estimator in [Estimator::PathTracing, Estimator::NextEvent] {
         let chromatic = moments(&radiances(
@@ -376,12 +403,52 @@ fn the_majorant_grid_bounds_every_channel_inside_its_cells() {
     for _ in 0..200_000 {
         let mut u = || (rng.next_u64() >> 11) as f32 / (1u64 << 53) as f32 * 2.0 - 1.0;
         let p = Vec3::new(u(), u(), u());
-        let sigma = grid.sigma_t(p).max_element();
+        let sigma = grid.sigma_t(p);
         assert!(
-            sigma <= majorants.at_point(p),
+            sigma.max_element() <= majorants.at_point(p),
             "{p}: {sigma} > {}",
             majorants.at_point(p)
         );
+    }
+    // Each channel's own bounds, on both grids: the largest is the bound of every channel, each
+    // bounds its channel at every point of its cell, and on the slabs some are tighter.
+    for grid in [grid, slab_grid] {
+        let mut bound = vec![0.0; 36];
+        build_material_majorants(&grid, bounds(), cells, &mut bound);
+        let mut channels = vec![0.0; 3 * 36];
+        build_material_channel_majorants(&grid, bounds(), cells, &mut channels);
+        for (b, c) in bound.iter().zip(channels.chunks(3)) {
+            assert_eq!(*b, c[0].max(c[1]).max(c[2]));
+        }
+        let medium = ChromaticMedium {
+            majorants: Some(MajorantGrid::new(&bound, cells, bounds())),
+            channel_majorants: Some(&channels),
+            ..ChromaticMedium::indexed(grid)
+        };
+        for _ in 0..200_000 {
+            let mut u = || (rng.next_u64() >> 11) as f32 / (1u64 << 53) as f32 * 2.0 - 1.0;
+            let p = Vec3::new(u(), u(), u());
+            let sigma = grid.sigma_t(p);
+            let q = (p - bounds().min) / bounds().extent();
+            let cell = |a: usize| ((q[a] * cells[a] as f32) as u32).min(cells[a] - 1);
+            let index = ((cell(2) * cells[1] + cell(1)) * cells[0] + cell(0)) as usize;
+            let own = medium.majorant_rgb(bound[index], Some(index));
+            assert!(sigma.cmple(own).all(), "{p}: {sigma} > {own}");
+        }
+    }
+    let mut slab_channels = vec![0.0; 3 * 36];
+    build_material_channel_majorants(&slab_grid, bounds(), cells, &mut slab_channels);
+    assert!(slab_channels
+        .chunks(3)
+        .zip(&slab_bound)
+        .any(|(c, b)| c.iter().any(|v| v < b)));
+    // Without a grid each channel's bound is its largest over the materials present.
+    let global = ChromaticMedium::indexed(grid).majorant_rgb(grid.max_extinction(), None);
+    assert_eq!(global.max_element(), grid.max_extinction());
+    for k in 0..5 {
+        if bytes.contains(&(k as u8)) {
+            assert!((materials[k].sigma_t * 2.0).cmple(global).all());
+        }
     }
 }
 
@@ -399,11 +466,19 @@ fn extreme_tables_give_finite_light_and_bounded_path_densities() {
     let grid = MaterialGrid::new(&indices, [3, 3, 3], bounds(), &table, 1.0);
     let mut majorants = vec![0.0; 27];
     build_material_majorants(&grid, bounds(), [3, 3, 3], &mut majorants);
-    let mut medium = ChromaticMedium::indexed(grid);
-    medium.majorants = Some(MajorantGrid::new(&majorants, [3, 3, 3], bounds()));
-    for estimator in [Estimator::PathTracing, Estimator::NextEvent] {
+    let mut channels = vec![0.0; 81];
+    build_material_channel_majorants(&grid, bounds(), [3, 3, 3], &mut channels);
+    let global = ChromaticMedium::indexed(grid);
+    let mut with_grid = global;
+    with_grid.majorants = Some(MajorantGrid::new(&majorants, [3, 3, 3], bounds()));
+    let mut with_channels = with_grid;
+    with_channels.channel_majorants = Some(&channels);
+    for (medium, estimator) in [global, with_grid, with_channels]
+        .into_iter()
+        .flat_map(|m| [(m, Estimator::PathTracing), (m, Estimator::NextEvent)])
+    {
         let scene = scene(medium, NullBoundary, 0.0, estimator);
-        for sample in 0..2000 {
+        for sample in 0..700 {
             let mut path = PathState::from_camera(&scene, 1, 2, sample, 9);
             while path.alive {
                 volpt_core::path::step(&scene, &mut path);

@@ -45,7 +45,7 @@ use volpt_core::abi::SceneAbi;
 use volpt_core::grid::Grid;
 
 use volpt_core::majorant::MajorantGrid;
-use volpt_core::material::build_material_majorants;
+use volpt_core::material::build_material_channel_majorants;
 use volpt_core::math::tan;
 use volpt_core::path::Estimator;
 use volpt_core::{Aabb, PathSettings, PerspectiveCamera, Scene, Vec2, Vec3, VolumeScene};
@@ -163,6 +163,12 @@ macro_rules! factory {
             fn track_with(&mut self, grid: Option<MajorantGrid<'a>>) {
                 match self {
                     $(MediumPart::$Mv(m) => m.track_with(grid),)*
+                }
+            }
+
+            fn track_channels_with(&mut self, channels: Option<&'a [f32]>) {
+                match self {
+                    $(MediumPart::$Mv(m) => m.track_channels_with(channels),)*
                 }
             }
 
@@ -378,6 +384,9 @@ pub fn with_scene_cached<V: SceneVisitor>(
 pub struct Derived {
     /// Per-cell majorants and the grid's resolution, if the medium tracks with a grid.
     majorants: Option<Arc<Majorants>>,
+    /// Each channel's bound per cell of `majorants` (three a cell), for a medium whose channels'
+    /// bounds are not in proportion (a material-indexed volume's).
+    channel_majorants: Option<Vec<f32>>,
     bounds: Aabb,
     /// The environment's sampling distribution, for next-event estimation.
     distribution: Option<Vec<f32>>,
@@ -397,31 +406,41 @@ impl Derived {
     ) -> Self {
         // A material-indexed volume's bounds come from its index grid, replaced between renders
         // by a printing application: built anew each time, not cached.
+        // Its channels' bounds are not in proportion from cell to cell: each has its own.
         let indexed = |res: [u32; 3]| {
             parts.medium.materials().map(|grid| {
-                let mut data = vec![0.0; res.iter().map(|&r| r as usize).product()];
-                build_material_majorants(&grid, bounds, res, &mut data);
-                Arc::new(Majorants { data, res })
+                let cells = res.iter().map(|&r| r as usize).product::<usize>();
+                let mut channels = vec![0.0; 3 * cells];
+                build_material_channel_majorants(&grid, bounds, res, &mut channels);
+                let data = channels
+                    .chunks_exact(3)
+                    .map(|c| c[0].max(c[1]).max(c[2]))
+                    .collect();
+                (Arc::new(Majorants { data, res }), Some(channels))
             })
         };
         let majorants = (settings.majorant_resolution > 1)
             .then(|| MajorantGrid::resolution_for(bounds, settings.majorant_resolution))
             .and_then(|res| match parts.medium.density() {
-                Some((density, scale)) => Some(cache.majorants(&density, scale, bounds, res)),
+                Some((density, scale)) => {
+                    Some((cache.majorants(&density, scale, bounds, res), None))
+                }
                 None => indexed(res),
             })
             // A grid whose every cell has the global bound (a uniform density, as ad's) saves no
             // step and costs the walk: track with the global majorant.
-            .filter(|m| {
+            .filter(|(m, _)| {
                 let global = m.data.iter().copied().fold(0.0, f32::max);
                 m.data.iter().any(|&v| v < global)
             });
+        let (majorants, channel_majorants) = majorants.unzip();
         let distribution = match settings.estimator {
             Estimator::NextEvent => distribution(&parts.environment),
             Estimator::PathTracing => None,
         };
         Self {
             majorants,
+            channel_majorants: channel_majorants.flatten(),
             bounds,
             distribution,
         }
@@ -451,6 +470,8 @@ impl<'a> Parts<'a> {
             .as_ref()
             .map(|m| MajorantGrid::new(&m.data, m.res, derived.bounds));
         self.medium.track_with(grid);
+        self.medium
+            .track_channels_with(derived.channel_majorants.as_deref());
         if let Some(distribution) = &derived.distribution {
             self.environment.sample_from(distribution);
         }
