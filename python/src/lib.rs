@@ -682,15 +682,15 @@ impl SceneParameters {
         })
     }
 
-    /// The keys this scene has: every documented key it can get (not `medium.albedo` for an
-    /// albedo grid).
-    fn present(&self, py: Python<'_>) -> PyResult<Vec<&'static str>> {
-        let scene = self.scene(py)?;
-        Ok(PARAMS
-            .iter()
-            .map(|(k, _)| *k)
-            .filter(|k| scene.inner.get(k).is_ok())
-            .collect())
+    /// The keys this scene has, with what each is: every documented key it can get (not
+    /// `medium.albedo` for an albedo grid), then its materials' (`volpt::Scene::params`).
+    fn described(&self, py: Python<'_>) -> PyResult<Vec<(String, &'static str)>> {
+        Ok(self.scene(py)?.inner.params())
+    }
+
+    /// The keys this scene has.
+    fn present(&self, py: Python<'_>) -> PyResult<Vec<String>> {
+        Ok(self.described(py)?.into_iter().map(|(k, _)| k).collect())
     }
 }
 
@@ -702,7 +702,7 @@ impl SceneParameters {
 
     fn __setitem__(&self, py: Python<'_>, key: &str, value: Bound<'_, PyAny>) -> PyResult<()> {
         // The key first, so that a wrong key says so whatever the value.
-        if !PARAMS.iter().any(|(k, _)| *k == key) {
+        if !self.present(py)?.iter().any(|k| k == key) {
             return Err(to_py(
                 self.scene(py)?.inner.get(key).expect_err("unknown key"),
             ));
@@ -715,7 +715,7 @@ impl SceneParameters {
     }
 
     fn __contains__(&self, py: Python<'_>, key: &str) -> PyResult<bool> {
-        Ok(self.present(py)?.contains(&key))
+        Ok(self.present(py)?.iter().any(|k| k == key))
     }
 
     fn __len__(&self, py: Python<'_>) -> PyResult<usize> {
@@ -736,7 +736,7 @@ impl SceneParameters {
         let values = self
             .present(py)?
             .into_iter()
-            .map(|k| get_param(py, &scene.inner, k))
+            .map(|k| get_param(py, &scene.inner, &k))
             .collect::<PyResult<Vec<_>>>()?;
         PyList::new(py, values)
     }
@@ -746,7 +746,10 @@ impl SceneParameters {
         let items = self
             .present(py)?
             .into_iter()
-            .map(|k| Ok((k, get_param(py, &scene.inner, k)?)))
+            .map(|k| {
+                let value = get_param(py, &scene.inner, &k)?;
+                Ok((k, value))
+            })
             .collect::<PyResult<Vec<_>>>()?;
         PyList::new(py, items)
     }
@@ -785,8 +788,9 @@ impl SceneParameters {
         })?;
         // Every value converted before any is set; then set in order, undone on a refusal.
         let mut converted = Vec::with_capacity(pairs.len());
+        let present: Vec<String> = scene.inner.params().into_iter().map(|(k, _)| k).collect();
         for (key, value) in &pairs {
-            if !PARAMS.iter().any(|(k, _)| k == key) {
+            if !present.contains(key) {
                 return Err(to_py(scene.inner.get(key).expect_err("unknown key")));
             }
             converted.push((key.as_str(), param_from_py(key, value)?));
@@ -809,9 +813,8 @@ impl SceneParameters {
 
     /// Each key this scene has, with what it is and what it takes.
     fn describe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let present = self.present(py)?;
         let dict = PyDict::new(py);
-        for (key, what) in PARAMS.iter().filter(|(k, _)| present.contains(k)) {
+        for (key, what) in self.described(py)? {
             dict.set_item(key, what)?;
         }
         Ok(dict)
@@ -822,7 +825,7 @@ impl SceneParameters {
         let items: Vec<String> = self
             .present(py)?
             .into_iter()
-            .map(|k| match scene.inner.get(k) {
+            .map(|k| match scene.inner.get(&k) {
                 Ok(ParamValue::Int(v)) => format!("{k:?}: {v}"),
                 Ok(ParamValue::Float(v)) => format!("{k:?}: {v}"),
                 Ok(ParamValue::Rgb(v) | ParamValue::Vec3(v)) => {

@@ -5,8 +5,9 @@
 //!
 //! The voxels tile the grid's box (cell-centred, Mitsuba 3's convention) and are read nearest:
 //! the coefficients at `p` are those of the voxel containing `p`, constant inside it, with no
-//! medium outside the box. A majorant-grid cell's bound is the largest channel of the largest
-//! extinction among the materials of the voxels it may read ([`build_material_majorants`]).
+//! medium outside the box. A majorant-grid cell bounds each channel by that channel's largest
+//! extinction among the materials of the voxels it may read ([`build_material_channel_majorants`]),
+//! and every channel by the largest of those ([`build_material_majorants`]).
 //!
 //! [`crate::ChromaticMedium`] carries an optional table as a run-time branch: an indexed volume
 //! adds no kernel. A grid whose voxels all hold one material renders as that material's

@@ -615,16 +615,28 @@ impl MediumDesc {
         ),
     ];
 
-    /// The keys of a material-indexed volume's coefficients, `materials.<k>.sigma_s` and
+    /// The keys of a material-indexed volume's coefficients, `materials.<m>.sigma_s` and
     /// `.sigma_a` (RGB per world unit, before `medium.scale`) and `.g` (a number in (-1, 1)) for
-    /// every material `k` of its table (none for another medium): [`MediumDesc::param`] and
-    /// [`MediumDesc::set_param`] take them beside [`MediumDesc::PARAMS`].
-    pub fn material_params(&self) -> Vec<String> {
+    /// every material of its table (none for another medium), `<m>` its name (its index in the
+    /// table where another material before it has that name, or it has none), with what each
+    /// is: [`MediumDesc::param`] and [`MediumDesc::set_param`] take them beside
+    /// [`MediumDesc::PARAMS`], and take a material's index for `<m>` too.
+    pub fn material_params(&self) -> Vec<(String, &'static str)> {
         let DensityDesc::Indexed(indexed) = &self.density else {
             return Vec::new();
         };
-        (0..indexed.materials().len())
-            .flat_map(|k| MATERIAL_FIELDS.map(|field| format!("materials.{k}.{field}")))
+        let materials = indexed.materials();
+        materials
+            .iter()
+            .enumerate()
+            .flat_map(|(k, m)| {
+                let named = !m.name.is_empty() && material_index(materials, &m.name) == Some(k);
+                let id = if named { m.name.clone() } else { k.to_string() };
+                MATERIAL_FIELDS
+                    .into_iter()
+                    .zip(MATERIAL_FIELDS_ABOUT)
+                    .map(move |(field, about)| (format!("materials.{id}.{field}"), about))
+            })
             .collect()
     }
 
@@ -632,16 +644,14 @@ impl MediumDesc {
     /// [`MediumDesc::material_params`] (the phase's are [`PhaseDesc::param`]'s); `Some(Err(why))`
     /// where this medium has no such value.
     pub fn param(&self, key: &str) -> Option<Result<MediumParam, ParamRefused>> {
-        if let Some((k, field)) = material_key(key) {
+        if let Some((id, field)) = material_key(key) {
             let DensityDesc::Indexed(indexed) = &self.density else {
                 return Some(Err(NOT_INDEXED));
             };
-            let Some(m) = indexed.materials().get(k) else {
-                return Some(Err(ParamRefused::NotHere {
-                    needs: "a material of the table",
-                    found: "an index past its end",
-                }));
+            let Some(k) = material_index(indexed.materials(), id) else {
+                return Some(Err(NO_SUCH_MATERIAL));
             };
+            let m = &indexed.materials()[k];
             return Some(Ok(match field {
                 "sigma_s" => MediumParam::Rgb(m.sigma_s),
                 "sigma_a" => MediumParam::Rgb(m.sigma_a),
@@ -661,8 +671,8 @@ impl MediumDesc {
     /// Sets parameter `key` to `value`, if it is one of [`MediumDesc::PARAMS`] (`None`: the
     /// medium is left alone). `Some(Err(why))` refuses the value, leaving the medium as it was.
     pub fn set_param(&mut self, key: &str, value: MediumParam) -> Option<Result<(), ParamRefused>> {
-        if let Some((k, field)) = material_key(key) {
-            return Some(self.set_material_param(k, field, value));
+        if let Some((id, field)) = material_key(key) {
+            return Some(self.set_material_param(id, field, value));
         }
         Some(match key {
             "medium.scale" => match value {
@@ -814,12 +824,36 @@ impl MediumDesc {
 const MATERIAL_FIELDS: [&str; 3] = ["sigma_s", "sigma_a", "g"];
 
 /// `(k, field)` of a key `materials.<k>.<field>`.
-fn material_key(key: &str) -> Option<(usize, &str)> {
+fn material_key(key: &str) -> Option<(&str, &'static str)> {
     let rest = key.strip_prefix("materials.")?;
-    let (k, field) = rest.split_once('.')?;
+    let (id, field) = rest.rsplit_once('.')?;
     let field = MATERIAL_FIELDS.into_iter().find(|&f| f == field)?;
-    Some((k.parse().ok()?, field))
+    Some((id, field))
 }
+
+/// What each of [`MATERIAL_FIELDS`] is.
+const MATERIAL_FIELDS_ABOUT: [&str; 3] = [
+    "the material's scattering coefficient, RGB per world unit (before medium.scale), finite \
+     and >= 0",
+    "the material's absorption coefficient, RGB per world unit (before medium.scale), finite \
+     and >= 0",
+    "the material's Henyey-Greenstein asymmetry, in (-1, 1)",
+];
+
+/// The index of the material `id` names in `materials`: the first of that name, else the one at
+/// index `id`.
+fn material_index(materials: &[MaterialDesc], id: &str) -> Option<usize> {
+    materials
+        .iter()
+        .position(|m| m.name == id)
+        .or_else(|| id.parse().ok().filter(|&k: &usize| k < materials.len()))
+}
+
+/// A material parameter naming no material of the table.
+const NO_SUCH_MATERIAL: ParamRefused = ParamRefused::NotHere {
+    needs: "a material of the table (its name or its index)",
+    found: "no material of that name or index",
+};
 
 /// A material parameter of a medium that is not material-indexed.
 const NOT_INDEXED: ParamRefused = ParamRefused::NotHere {
@@ -828,22 +862,21 @@ const NOT_INDEXED: ParamRefused = ParamRefused::NotHere {
 };
 
 impl MediumDesc {
-    /// Sets `field` of material `k`; its phase variant follows the materials' asymmetries.
+    /// Sets `field` of the material `id` names; the phase variant follows the materials'
+    /// asymmetries.
     fn set_material_param(
         &mut self,
-        k: usize,
+        id: &str,
         field: &str,
         value: MediumParam,
     ) -> Result<(), ParamRefused> {
         let DensityDesc::Indexed(indexed) = &mut self.density else {
             return Err(NOT_INDEXED);
         };
-        let Some(mut m) = indexed.materials().get(k).cloned() else {
-            return Err(ParamRefused::NotHere {
-                needs: "a material of the table",
-                found: "an index past its end",
-            });
+        let Some(k) = material_index(indexed.materials(), id) else {
+            return Err(NO_SUCH_MATERIAL);
         };
+        let mut m = indexed.materials()[k].clone();
         match (field, value) {
             ("sigma_s", MediumParam::Rgb(v)) => m.sigma_s = v,
             ("sigma_a", MediumParam::Rgb(v)) => m.sigma_a = v,

@@ -392,3 +392,86 @@ fn an_unknown_preset_or_a_preset_with_coefficients_is_refused() {
     let message = load(&path).unwrap_err().to_string();
     assert!(message.contains("preset"), "{message}");
 }
+
+/// The materials' coefficients are parameters named by the material's name (or its index): listed
+/// with what each is, read, set (the phase variant follows the `g`s), and a bad value or an
+/// unknown material refused with the table left as it was.
+#[test]
+fn materials_coefficients_are_parameters_by_name_or_index() {
+    use volpt_scene::medium::{MediumParam, ParamRefused};
+    let (_dir, path) = raw_scene(&PRINT, "", MATERIALS);
+    let mut desc = load(&path).unwrap();
+    let medium = &mut desc.medium;
+    let keys: Vec<String> = medium
+        .material_params()
+        .into_iter()
+        .map(|(k, _)| k)
+        .collect();
+    assert_eq!(
+        keys,
+        [
+            "materials.cyan.sigma_s",
+            "materials.cyan.sigma_a",
+            "materials.cyan.g",
+            "materials.white.sigma_s",
+            "materials.white.sigma_a",
+            "materials.white.g",
+        ]
+    );
+    assert_eq!(
+        medium.param("materials.cyan.sigma_a"),
+        Some(Ok(MediumParam::Rgb([6.0, 0.8, 0.2])))
+    );
+    // The index names the same material.
+    assert_eq!(
+        medium.param("materials.0.sigma_a"),
+        medium.param("materials.cyan.sigma_a")
+    );
+    let set = |m: &mut volpt_scene::MediumDesc, key: &str, v| m.set_param(key, v);
+    assert_eq!(
+        set(
+            medium,
+            "materials.white.sigma_a",
+            MediumParam::Rgb([1.0, 2.0, 3.0])
+        ),
+        Some(Ok(()))
+    );
+    assert_eq!(
+        medium.param("materials.1.sigma_a"),
+        Some(Ok(MediumParam::Rgb([1.0, 2.0, 3.0])))
+    );
+    // Every g 0: the isotropic phase; one non-zero: Henyey-Greenstein with it.
+    set(medium, "materials.cyan.g", MediumParam::Float(0.0));
+    assert_eq!(medium.phase, PhaseDesc::Isotropic);
+    set(medium, "materials.white.g", MediumParam::Float(-0.4));
+    assert_eq!(medium.phase, PhaseDesc::HenyeyGreenstein { g: -0.4 });
+    let before = medium.clone();
+    for (key, value) in [
+        ("materials.cyan.sigma_s", MediumParam::Rgb([-1.0, 0.0, 0.0])),
+        (
+            "materials.cyan.sigma_s",
+            MediumParam::Rgb([f32::NAN, 0.0, 0.0]),
+        ),
+        ("materials.cyan.g", MediumParam::Float(1.0)),
+        ("materials.cyan.g", MediumParam::Rgb([0.1, 0.1, 0.1])),
+    ] {
+        assert!(
+            matches!(set(medium, key, value), Some(Err(ParamRefused::Value(_)))),
+            "{key} = {value:?}"
+        );
+    }
+    for key in ["materials.magenta.g", "materials.2.g"] {
+        assert!(
+            matches!(
+                set(medium, key, MediumParam::Float(0.1)),
+                Some(Err(ParamRefused::NotHere { .. }))
+            ),
+            "{key}"
+        );
+    }
+    assert_eq!(
+        format!("{:?}", medium),
+        format!("{before:?}"),
+        "a refusal changes nothing"
+    );
+}

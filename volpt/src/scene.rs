@@ -400,7 +400,19 @@ impl Scene {
             .inspect_err(|_| self.desc.film = before)
     }
 
-    /// The value of parameter `key` ([`PARAMS`]).
+    /// The parameters this scene has, with what each is: those of [`PARAMS`] it can get (not
+    /// `medium.albedo` beside an albedo grid), then a material-indexed volume's materials'
+    /// coefficients (`materials.<name>.sigma_s`, `.sigma_a`, `.g`; [`MediumDesc::material_params`]).
+    pub fn params(&self) -> Vec<(String, &'static str)> {
+        PARAMS
+            .iter()
+            .filter(|(key, _)| self.get(key).is_ok())
+            .map(|&(key, about)| (key.to_owned(), about))
+            .chain(self.desc.medium.material_params())
+            .collect()
+    }
+
+    /// The value of parameter `key` ([`PARAMS`], or a material's, [`Scene::params`]).
     pub fn get(&self, key: &str) -> Result<ParamValue, Error> {
         let d = &self.desc;
         let depth = |d: Option<u32>| ParamValue::Int(d.map_or(-1, i64::from));
@@ -432,8 +444,8 @@ impl Scene {
         (origin, target, self.up)
     }
 
-    /// Sets parameter `key` ([`PARAMS`]) to `value`. The scene is checked as a loaded one is; a
-    /// value it refuses leaves the scene as it was.
+    /// Sets parameter `key` ([`PARAMS`], or a material's, [`Scene::params`]) to `value`. The
+    /// scene is checked as a loaded one is; a value it refuses leaves the scene as it was.
     pub fn set(&mut self, key: &str, value: ParamValue) -> Result<(), Error> {
         let before = self.clone_light();
         self.changed();
@@ -517,7 +529,9 @@ impl Scene {
             "camera.fov" => {
                 d.camera.fov_degrees = float(&|v| v > 0.0 && v < 180.0, "degrees in (0, 180)")?
             }
-            _ if MediumDesc::PARAMS.iter().any(|&(k, _)| k == key) => {
+            _ if MediumDesc::PARAMS.iter().any(|&(k, _)| k == key)
+                || d.medium.material_params().iter().any(|(k, _)| k == key) =>
+            {
                 let medium = match value {
                     ParamValue::Int(v) => MediumParam::Float(v as f32),
                     ParamValue::Float(v) => MediumParam::Float(v),
@@ -668,7 +682,12 @@ impl Scene {
             integrator: d.integrator,
             medium: MediumDesc::PARAMS
                 .iter()
-                .filter_map(|&(key, _)| Some((key, d.medium.param(key)?.ok()?)))
+                .map(|&(key, _)| key.to_owned())
+                .chain(d.medium.material_params().into_iter().map(|(key, _)| key))
+                .filter_map(|key| {
+                    let value = d.medium.param(&key)?.ok()?;
+                    Some((key, value))
+                })
                 .collect(),
             phase: d.medium.phase,
             path: self.path,
@@ -684,7 +703,7 @@ impl Scene {
         d.integrator = l.integrator;
         for (key, value) in l.medium {
             // Each value was the medium's own, which its parameter takes.
-            let _ = d.medium.set_param(key, value);
+            let _ = d.medium.set_param(&key, value);
         }
         d.medium.phase = l.phase;
         self.path = l.path;
@@ -697,8 +716,8 @@ struct Light {
     camera: volpt_scene::CameraDesc,
     spp: u32,
     integrator: volpt_scene::IntegratorDesc,
-    /// The medium's parameters that it has ([`MediumDesc::param`]).
-    medium: Vec<(&'static str, MediumParam)>,
+    /// The medium's parameters that it has ([`MediumDesc::param`]), its materials' included.
+    medium: Vec<(String, MediumParam)>,
     phase: PhaseDesc,
     path: PathSettings,
     seed: u32,
