@@ -43,7 +43,7 @@ def films(volpt, scene, args, out_dir, tag):
         cmd = [volpt, "render", scene, "--backend", "cpu", "--seed", str(1000 + k),
                "--resolution", f"{args.resolution}x{args.resolution}",
                "--samples", f"0..{args.spp}", "--film", path]
-        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         images.append(read_film(path) / args.spp)
     return np.stack(images)
 

@@ -311,3 +311,69 @@ fn chromatic_extinction_comes_back_under_volpathmis() {
     }
     assert_eq!(loaded.medium.albedo, desc.medium.albedo);
 }
+
+/// A material-indexed volume, which Mitsuba 3 cannot read as a table, is written as its table
+/// expanded per voxel: RGB `gridvolume`s of the extinction (times `scale`) and the albedo, read
+/// `nearest`, cell-centred over the volume's box, under `volpathmis`; each voxel's values are its
+/// material's. A table whose materials' `g` differ (one phase per Mitsuba 3 medium) is refused.
+#[test]
+fn an_indexed_volume_is_written_as_rgb_grids_of_its_materials() {
+    use volpt_scene::material::{IndexedDesc, MaterialDesc};
+    let material = |name: &str, sigma_s: [f32; 3], sigma_a: [f32; 3], g: f32| MaterialDesc {
+        name: name.into(),
+        sigma_s,
+        sigma_a,
+        g,
+        colour: None,
+    };
+    let materials = vec![
+        material("cyan", [4.0, 6.0, 7.0], [6.0, 0.8, 0.2], 0.3),
+        material("white", [12.0, 12.0, 12.0], [0.02, 0.03, 0.05], 0.3),
+    ];
+    let bounds = Bounds {
+        min: [-1.0, -0.5, -0.25],
+        max: [1.0, 0.5, 0.25],
+    };
+    let indices = [0u8, 1, 1, 0, 1, 0, 0, 0, 1, 1, 0, 1];
+    let indexed = IndexedDesc::new(
+        Path::new("print.raw"),
+        materials.clone(),
+        [3, 2, 2],
+        bounds,
+        &indices,
+    )
+    .unwrap();
+    let mut medium = homogeneous(1.0, 0.8, indexed.phase());
+    medium.density = DensityDesc::Indexed(indexed);
+    medium.scale = 2.0;
+    let desc = cube_scene(8, 8, medium, BsdfDesc::Null, 1.0);
+    let dir = tempfile::tempdir().expect("temp dir");
+    write_mitsuba3(&desc, dir.path(), "exported").expect("export");
+    let xml = std::fs::read_to_string(dir.path().join("exported.xml")).unwrap();
+    assert!(xml.contains("<integrator type=\"volpathmis\">"), "{xml}");
+    assert!(xml.contains("<medium type=\"heterogeneous\""), "{xml}");
+    assert!(xml.contains("<float name=\"scale\" value=\"2\"/>"), "{xml}");
+    assert_eq!(xml.matches("value=\"nearest\"").count(), 2, "{xml}");
+    for (file, field) in [("exported-sigma_t.vol", 0), ("exported-albedo.vol", 1)] {
+        let vol = volpt_scene::vol::read_vol(&dir.path().join(file)).unwrap();
+        assert_eq!((vol.resolution, vol.channels), ([3, 2, 2], 3));
+        for (i, &k) in indices.iter().enumerate() {
+            let m = materials[k as usize].material();
+            let expected = if field == 0 { m.sigma_t } else { m.albedo };
+            assert_eq!(
+                vol.data[3 * i..3 * i + 3],
+                expected.to_array(),
+                "{file} voxel {i}"
+            );
+        }
+    }
+    // One material of another g: refused, naming why.
+    let mut other = materials;
+    other[1].g = -0.2;
+    let indexed =
+        IndexedDesc::new(Path::new("print.raw"), other, [3, 2, 2], bounds, &indices).unwrap();
+    let mut desc = desc;
+    desc.medium.density = DensityDesc::Indexed(indexed);
+    let err = write_mitsuba3(&desc, dir.path(), "refused").expect_err("g differ");
+    assert!(err.to_string().contains("one phase function"), "{err}");
+}

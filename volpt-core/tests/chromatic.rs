@@ -477,8 +477,8 @@ fn own_channel_majorants_lower_the_variance_at_equal_samples() {
                     PathState::from_camera(&scene, sample % 4, (sample / 4) % 4, sample / 16, 1);
                 trace(&scene, &mut path);
                 steps += path.tracking_steps as u64;
-                for c in 0..3 {
-                    m[c].push(path.radiance[c] as f64);
+                for (m, r) in m.iter_mut().zip(path.radiance.to_array()) {
+                    m.push(r as f64);
                 }
             }
             *v = [0, 1, 2].map(|c| m[c].variance());

@@ -12,8 +12,9 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 use volpt_core::material::{Material, MATERIAL_FLOATS, MAX_MATERIALS};
+use volpt_core::Spectrum;
 
-use crate::description::{Bounds, GridDesc, SampleLayout};
+use crate::description::{Bounds, GridConvention, GridDesc, SampleLayout};
 use crate::error::{MaterialProblem, SceneError};
 use crate::phase::PhaseDesc;
 use crate::toml_scene::OneOrThree;
@@ -274,6 +275,24 @@ impl IndexedDesc {
             Some(m) => PhaseDesc::HenyeyGreenstein { g: m.g },
             None => PhaseDesc::Isotropic,
         }
+    }
+
+    /// The volume as the RGB grids of its materials' extinction (before the medium's scale)
+    /// and albedo, voxel by voxel, cell-centred over its box (read nearest, they are the same
+    /// medium): what Mitsuba 3, which has no material table, reads. 24 bytes a voxel.
+    pub fn expanded_grids(&self) -> (GridDesc, GridDesc) {
+        let rows: Vec<Material> = self.materials.iter().map(MaterialDesc::material).collect();
+        let expand = |field: fn(&Material) -> Spectrum| GridDesc {
+            resolution: self.resolution,
+            channels: 3,
+            bounds: self.bounds,
+            convention: GridConvention::Cell,
+            data: (0..self.voxels())
+                .flat_map(|i| field(&rows[self.index(i) as usize]).to_array())
+                .collect(),
+            layout: SampleLayout::Dense,
+        };
+        (expand(|m| m.sigma_t), expand(|m| m.albedo))
     }
 
     /// Bytes on a GPU: one per voxel (rounded up to a word), and the table.

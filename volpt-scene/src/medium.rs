@@ -102,6 +102,11 @@ pub enum AlbedoDesc {
 const DEFAULT_SIGMA_T: f32 = 1.0;
 const DEFAULT_ALBEDO: f32 = 0.75;
 
+/// Writes a grid's file for a Mitsuba 3 scene and returns the `gridvolume` that reads it; its
+/// arguments: the grid, what it holds, Mitsuba's parameter, its `filter_type`.
+pub(crate) type GridWriter<'a> =
+    dyn FnMut(&GridDesc, &str, &str, &str) -> Result<String, SceneError> + 'a;
+
 impl MediumDesc {
     /// Mitsuba's interior `<medium>`: `homogeneous` or `heterogeneous`, with its phase function.
     ///
@@ -564,10 +569,10 @@ impl MediumDesc {
 
     /// The `<medium>`'s type, its extinction and its albedo elements in a Mitsuba 3 scene; `grid`
     /// writes a grid's file and returns the `gridvolume` that reads it (its arguments: the grid,
-    /// what it holds, Mitsuba's parameter).
+    /// what it holds, Mitsuba's parameter, its `filter_type`).
     pub(crate) fn to_mitsuba3(
         &self,
-        grid: &mut dyn FnMut(&GridDesc, &str, &str) -> Result<String, SceneError>,
+        grid: &mut GridWriter<'_>,
     ) -> Result<(&'static str, String, String), SceneError> {
         let (medium_type, sigma_t) = match &self.density {
             DensityDesc::Constant(d) => (
@@ -585,19 +590,29 @@ impl MediumDesc {
                 };
                 ("homogeneous", rgb_element("sigma_t", &unit))
             }
-            DensityDesc::Grid(g) => ("heterogeneous", grid(g, "density", "sigma_t")?),
-            DensityDesc::Indexed(_) => {
-                return Err(SceneError::Export {
-                    path: PathBuf::from("medium"),
-                    reason: "a material-indexed volume has no Mitsuba 3 form (Mitsuba 3 reads \
-                             no material table); export it as RGB grids instead"
-                        .into(),
-                })
+            DensityDesc::Grid(g) => ("heterogeneous", grid(g, "density", "sigma_t", "trilinear")?),
+            // Mitsuba 3 reads no material table: the table expanded per voxel, read nearest.
+            DensityDesc::Indexed(indexed) => {
+                let g = indexed.materials().first().map_or(0.0, |m| m.g);
+                if indexed.materials().iter().any(|m| m.g != g) {
+                    return Err(SceneError::Export {
+                        path: PathBuf::from("medium"),
+                        reason: "the materials' Henyey-Greenstein g differ, and a Mitsuba 3 \
+                                 medium has one phase function: give them one g to export"
+                            .into(),
+                    });
+                }
+                let (sigma_t, albedo) = indexed.expanded_grids();
+                return Ok((
+                    "heterogeneous",
+                    grid(&sigma_t, "sigma_t", "sigma_t", "nearest")?,
+                    grid(&albedo, "albedo", "albedo", "nearest")?,
+                ));
             }
         };
         let albedo = match &self.albedo {
             AlbedoDesc::Constant(rgb) => rgb_element("albedo", rgb),
-            AlbedoDesc::Grid(g) => grid(g, "albedo", "albedo")?,
+            AlbedoDesc::Grid(g) => grid(g, "albedo", "albedo", "trilinear")?,
         };
         Ok((medium_type, sigma_t, albedo))
     }

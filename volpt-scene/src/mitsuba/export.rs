@@ -11,6 +11,10 @@
 //!   only place the medium is looked up, the trilinear fields are identical.
 //! - **No Russian roulette** (`rr_depth` unset) is `rr_depth = 10^9`: Mitsuba 3 refuses values below
 //!   1, and no path of a finite render reaches that depth.
+//! - **Material-indexed volumes** (Mitsuba 3 reads no material table) are written as their
+//!   table expanded per voxel: RGB grids of the extinction and the albedo, read `nearest` as the
+//!   table is. Mitsuba 3 has one phase function per medium: a table whose materials' `g` differ
+//!   is refused.
 //! - **Environment maps** are written with Mitsuba 3's row convention (rows from pole to pole). A
 //!   Mitsuba 0.6 map (cell-centred rows) would move by half a row, so it is refused rather than
 //!   silently changed.
@@ -54,32 +58,33 @@ pub fn write_mitsuba3(
     let xml_path = dir.join(format!("{name}.xml"));
     let mut written = vec![xml_path.clone()];
     // Writes `<name>-<what>.vol` and returns the `gridvolume` that reads it as Mitsuba's `param`.
-    let mut grid = |grid: &GridDesc, what: &str, param: &str| -> Result<String, SceneError> {
-        let file = format!("{name}-{what}.vol");
-        // Mitsuba's .vol is dense: a sparse grid is written densified, within the memory limit.
-        let [x, y, z] = grid.resolution;
-        crate::limits::check_grid_memory(
-            &dir.join(&file),
-            [x, y, z],
-            grid.channels,
-            grid.dense_bytes().unwrap_or(u64::MAX) / 4,
-        )?;
-        let dense = grid.densified();
-        let grid = &dense;
-        let (bbox, to_world) = cell_centred_box(grid);
-        let path = dir.join(&file);
-        write_vol(
-            &path,
-            &VolGrid {
-                resolution: grid.resolution,
-                channels: grid.channels,
-                bbox,
-                data: grid.data.clone(),
-            },
-        )?;
-        written.push(path);
-        Ok(grid_volume(param, &file, &to_world))
-    };
+    let mut grid =
+        |grid: &GridDesc, what: &str, param: &str, filter: &str| -> Result<String, SceneError> {
+            let file = format!("{name}-{what}.vol");
+            // Mitsuba's .vol is dense: a sparse grid is written densified, within the memory limit.
+            let [x, y, z] = grid.resolution;
+            crate::limits::check_grid_memory(
+                &dir.join(&file),
+                [x, y, z],
+                grid.channels,
+                grid.dense_bytes().unwrap_or(u64::MAX) / 4,
+            )?;
+            let dense = grid.densified();
+            let grid = &dense;
+            let (bbox, to_world) = cell_centred_box(grid);
+            let path = dir.join(&file);
+            write_vol(
+                &path,
+                &VolGrid {
+                    resolution: grid.resolution,
+                    channels: grid.channels,
+                    bbox,
+                    data: grid.data.clone(),
+                },
+            )?;
+            written.push(path);
+            Ok(grid_volume(param, &file, filter, &to_world))
+        };
 
     let medium = &desc.medium;
     let (medium_type, sigma_t, albedo) = medium.to_mitsuba3(&mut grid)?;
@@ -219,10 +224,10 @@ pub(crate) fn rgb_element(name: &str, rgb: &[f32; 3]) -> String {
     )
 }
 
-fn grid_volume(param: &str, file: &str, to_world: &Matrix4) -> String {
+fn grid_volume(param: &str, file: &str, filter: &str, to_world: &Matrix4) -> String {
     format!(
         "<volume type=\"gridvolume\" name=\"{param}\">\n                <string name=\"filename\" value=\"{file}\"/>\n                \
-         <string name=\"filter_type\" value=\"trilinear\"/>\n                {}\n            </volume>",
+         <string name=\"filter_type\" value=\"{filter}\"/>\n                {}\n            </volume>",
         matrix_transform(to_world, "                ")
     )
 }
