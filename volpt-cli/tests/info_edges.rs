@@ -49,6 +49,7 @@ fn scene(g: f32, last: f32, last_green: f32, int_ior: f32) -> SceneDescription {
             ],
             fov_degrees: 30.0,
             fov_axis: FovAxis::X,
+            projection: Projection::Perspective,
         },
         film: FilmDesc {
             width: 8,

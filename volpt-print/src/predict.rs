@@ -10,12 +10,9 @@
 //! black lower hemisphere: not offered yet). Paths are unlimited in length with Russian roulette
 //! from depth 5 (Mitsuba's defaults).
 //!
-//! **Camera.** One pixel per surface texel, looking straight down: a pinhole placed 1000 print
-//! widths above the print's centre whose field of view spans its top face exactly. Its rays meet
-//! the surface within 1/2000 rad of vertical, so a path entering a texel's top face at depth `d`
-//! is displaced by at most `d / 2000` from where an orthographic camera's would be (1.4 um at
-//! the thesis's 2.7 mm depth, against 42 um texels); an orthographic sensor replaces it when
-//! volpt-core has one. The pinhole needs square texels (`sx = sy`).
+//! **Camera.** One pixel per surface texel, looking straight down: Mitsuba's `orthographic`
+//! sensor over the print's top face, its film spanning the face exactly, whatever the texels'
+//! aspect.
 //!
 //! **Chromatic extinction.** The inks' extinction differs between R, G and B, which volpt's grid
 //! media do not carry yet (material-indexed volumes, issue 38, will); the prediction is rendered
@@ -38,16 +35,13 @@ use thiserror::Error;
 use volpt::scene_files::{
     AlbedoDesc, BoundaryDesc, Bounds, BsdfDesc, CameraDesc, DensityDesc, EnvironmentDesc, FilmDesc,
     FovAxis, GridConvention, GridDesc, GridLookup, GridStorage, IntegratorDesc, MediumDesc,
-    PhaseDesc, SampleLayout, SceneBuilder, SceneDescription, SceneError,
+    PhaseDesc, Projection, SampleLayout, SceneBuilder, SceneDescription, SceneError,
 };
 use volpt::{Backend, Quiet, RenderRequest, RenderSettings, Scene};
 
 use crate::colour::LinearRgb;
 use crate::compensate::Predictor;
 use crate::print::VoxelPrint;
-
-/// How far above the print the pinhole sits, in print widths.
-const DISTANCE_IN_WIDTHS: f64 = 1000.0;
 
 #[derive(Debug, Error)]
 pub enum PredictError {
@@ -108,14 +102,6 @@ impl RenderPredictor {
     }
 
     fn geometry(&self, print: &VoxelPrint) -> Result<Geometry, PredictError> {
-        let [sx, sy, _] = print.voxel_size();
-        if sx != sy {
-            return Err(PredictError::Print {
-                field: "voxel_size",
-                expected: "square texels (x = y) for the pinhole top view".into(),
-                found: format!("{:?}", print.voxel_size()),
-            });
-        }
         let g = print.materials()[0].g;
         if let Some(m) = print.materials().iter().find(|m| m.g != g) {
             return Err(PredictError::Print {
@@ -185,22 +171,26 @@ impl SceneBuilder for PrintScene<'_> {
             data,
             layout: SampleLayout::Dense,
         };
-        let distance = DISTANCE_IN_WIDTHS * size[0].max(size[1]);
-        let origin = [0.5 * size[0], 0.5 * size[1], size[2] + distance];
-        // Mitsuba's look-at frame: columns left, up, view direction, origin. Looking down -z
-        // with +y up puts +x to the image's right and +y at its top.
+        // Mitsuba's camera frame, columns left, up, view direction and origin: looking down -z
+        // with +y up puts +x to the image's right and +y at its top. The orthographic film spans
+        // camera-space x in [-1, 1] and y in [-h/w, h/w]: scaling x by half the print's width and
+        // y by w/h times half its height maps the film onto the top face, one pixel per texel.
+        let aspect = f64::from(w) / f64::from(h);
+        let half = [0.5 * size[0], 0.5 * size[1] * aspect];
+        let above = size[2] + sz;
         let to_world = [
-            [-1.0, 0.0, 0.0, origin[0] as f32],
-            [0.0, 1.0, 0.0, origin[1] as f32],
-            [0.0, 0.0, -1.0, origin[2] as f32],
+            [-half[0] as f32, 0.0, 0.0, (0.5 * size[0]) as f32],
+            [0.0, half[1] as f32, 0.0, (0.5 * size[1]) as f32],
+            [0.0, 0.0, -1.0, above as f32],
             [0.0, 0.0, 0.0, 1.0],
         ];
-        let fov_x = 2.0 * (0.5 * size[0] / distance).atan();
         Ok(SceneDescription {
             camera: CameraDesc {
                 to_world,
-                fov_degrees: fov_x.to_degrees() as f32,
+                // Unused by an orthographic camera.
+                fov_degrees: 0.0,
                 fov_axis: FovAxis::X,
+                projection: Projection::Orthographic,
             },
             film: FilmDesc {
                 width: w,
