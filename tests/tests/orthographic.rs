@@ -71,7 +71,10 @@ fn an_orthographic_view_of_a_homogeneous_slab_is_uniform_over_its_face() {
     ));
     let (chi2, dof) = chi_square(&pinhole);
     eprintln!("wide pinhole: chi2 {chi2:.1} over {dof} degrees of freedom");
-    assert!(chi2 > bound(dof), "the control should be non-uniform: chi2 {chi2:.1}");
+    assert!(
+        chi2 > bound(dof),
+        "the control should be non-uniform: chi2 {chi2:.1}"
+    );
 }
 
 #[test]
@@ -84,5 +87,8 @@ fn an_orthographic_sensor_takes_no_field_of_view() {
     );
     std::fs::write(&path, xml).unwrap();
     let e = volpt_scene::load_mitsuba(&path).unwrap_err().to_string();
-    assert!(e.contains("no field of view on an orthographic sensor"), "{e}");
+    assert!(
+        e.contains("no field of view on an orthographic sensor"),
+        "{e}"
+    );
 }

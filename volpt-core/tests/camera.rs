@@ -120,16 +120,33 @@ fn orthographic_rays_are_parallel_and_start_where_the_film_maps_them() {
     let axis = d(c.axis_z).normalize();
     let start = |px, py, u| {
         let r = c.generate_ray(px, py, u);
-        assert!((d(r.dir) - axis).length() < 1e-6, "({px}, {py}): direction {}", r.dir);
+        assert!(
+            (d(r.dir) - axis).length() < 1e-6,
+            "({px}, {py}): direction {}",
+            r.dir
+        );
         d(r.origin)
     };
     let film = |x: f64, y: f64| d(c.origin) + d(c.axis_x) * x + d(c.axis_y) * y;
     let (hx, hy) = (1.0, 8.0 / 12.0);
-    let close = |a: DVec3, b: DVec3, what: &str| assert!((a - b).length() < 1e-5, "{what}: {a} vs {b}");
+    let close =
+        |a: DVec3, b: DVec3, what: &str| assert!((a - b).length() < 1e-5, "{what}: {a} vs {b}");
     close(start(0, 0, Vec2::ZERO), film(hx, hy), "top left");
-    close(start(c.width - 1, c.height - 1, Vec2::ONE), film(-hx, -hy), "bottom right");
-    close(start(c.width / 2, c.height / 2, Vec2::ZERO), film(0.0, 0.0), "centre");
+    close(
+        start(c.width - 1, c.height - 1, Vec2::ONE),
+        film(-hx, -hy),
+        "bottom right",
+    );
+    close(
+        start(c.width / 2, c.height / 2, Vec2::ZERO),
+        film(0.0, 0.0),
+        "centre",
+    );
     // One pixel across is 2 / width of the film's x extent.
     let step = start(1, 0, Vec2::ZERO) - start(0, 0, Vec2::ZERO);
-    close(step, d(c.axis_x) * (-2.0 * hx / f64::from(c.width)), "one pixel");
+    close(
+        step,
+        d(c.axis_x) * (-2.0 * hx / f64::from(c.width)),
+        "one pixel",
+    );
 }

@@ -510,9 +510,24 @@ impl Scene {
                     _ => up = value,
                 }
                 self.up = up;
-                self.desc.camera.to_world = look_at(origin, target, up).ok_or_else(|| {
+                let before = self.desc.camera.to_world;
+                let mut to_world = look_at(origin, target, up).ok_or_else(|| {
                     wrong("a camera whose direction (target - origin) and up are non-zero and not parallel")
                 })?;
+                // An orthographic film's extent is its frame's scale: moving it keeps that.
+                if self.desc.camera.projection == volpt_scene::description::Projection::Orthographic
+                {
+                    for j in 0..3 {
+                        let scale = (0..3).map(|i| before[i][j].powi(2)).sum::<f32>().sqrt();
+                        (0..3).for_each(|i| to_world[i][j] *= scale);
+                    }
+                }
+                self.desc.camera.to_world = to_world;
+            }
+            "camera.fov"
+                if d.camera.projection == volpt_scene::description::Projection::Orthographic =>
+            {
+                return Err(wrong("no field of view: the camera is orthographic (its to_world scale sets the extent)"));
             }
             "camera.fov" => {
                 d.camera.fov_degrees = float(&|v| v > 0.0 && v < 180.0, "degrees in (0, 180)")?

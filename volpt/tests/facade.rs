@@ -173,6 +173,55 @@ fn the_camera_moves_as_a_lookat_in_the_scene_file_does() {
     }
 }
 
+/// The example's sensor made orthographic (its film 1.4 units wide), at `origin` looking at
+/// `target`.
+fn orthographic_example(dir: &Path, origin: &str, target: &str) -> PathBuf {
+    edited_example(
+        dir,
+        &[
+            (
+                r#"<sensor type="perspective">"#,
+                r#"<sensor type="orthographic">"#,
+            ),
+            (r#"<float name="fov" value="30"/>"#, ""),
+            (
+                r#"<lookat origin="3.2, 2.4, 4" target="0, -0.1, 0" up="0, 1, 0"/>"#,
+                &format!(
+                    r#"<scale value="0.7"/><lookat origin="{origin}" target="{target}" up="0, 1, 0"/>"#
+                ),
+            ),
+        ],
+    )
+}
+
+#[test]
+fn an_orthographic_camera_moved_keeps_its_extent_and_takes_no_field_of_view() {
+    let dir = tempfile::tempdir().unwrap();
+    let example = orthographic_example(dir.path(), "3.2, 2.4, 4", "0, -0.1, 0");
+    let mut scene = Scene::load(example, &small()).unwrap();
+    scene
+        .set("camera.origin", ParamValue::Vec3([2.0, 3.0, 3.0]))
+        .unwrap();
+    let e = scene
+        .set("camera.fov", ParamValue::Float(25.0))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("orthographic"), "{e}");
+    // Moving the origin kept the direction (the target moved with it) and the film's scale.
+    let moved = tempfile::tempdir().unwrap();
+    let reloaded = Scene::load(
+        orthographic_example(moved.path(), "2, 3, 3", "-1.2, 0.5, -1"),
+        &small(),
+    )
+    .unwrap();
+    let (a, b) = (scene.description().camera, reloaded.description().camera);
+    for (ra, rb) in a.to_world.iter().zip(&b.to_world) {
+        for (x, y) in ra.iter().zip(rb) {
+            assert!((x - y).abs() < 1e-5, "{:?} vs {:?}", a.to_world, b.to_world);
+        }
+    }
+}
+
 #[test]
 fn bad_parameters_are_refused_by_name_and_change_nothing() {
     let mut scene = Scene::load(example(), &small()).unwrap();
