@@ -617,6 +617,41 @@ impl Scene {
             return Ok(());
         }
         let old = std::mem::replace(self.grid_values(name), values);
+        self.renew_data(name, |scene| *scene.grid_values(name) = old)
+    }
+
+    /// Replaces the material index of every voxel of the medium's material-indexed volume
+    /// ([`volpt_scene::material::IndexedDesc::set_indices`]: one byte per voxel, x fastest, each below the
+    /// table's length) — a printing application's next iteration. New indices are new data, as
+    /// [`Scene::set_grid`]'s new values are; the same indices change nothing; a refusal (a medium
+    /// without indices, the wrong count, an index past the table) leaves the scene as it was.
+    pub fn set_indices(&mut self, indices: &[u8]) -> Result<(), Error> {
+        let DensityDesc::Indexed(volume) = &mut self.desc.medium.density else {
+            return Err(Error::Grid {
+                grid: "indices".to_owned(),
+                expected: "a material-indexed medium".to_owned(),
+                found: "a medium without material indices".to_owned(),
+            });
+        };
+        let old = volume.clone();
+        volume
+            .set_indices(indices)
+            .map_err(|problem| volpt_scene::SceneError::Material {
+                path: self.source.clone().into(),
+                problem,
+            })?;
+        if *volume == old {
+            return Ok(());
+        }
+        self.renew_data("indices", |scene| {
+            scene.desc.medium.density = DensityDesc::Indexed(old);
+        })
+    }
+
+    /// Checks the scene after grid `name`'s data changed, as a loaded scene's are: if it passes,
+    /// the data is new (its own identity: nothing kept of the old data is read again), else
+    /// `restore` puts the old data back and the check's error names the grid.
+    fn renew_data(&mut self, name: &str, restore: impl FnOnce(&mut Self)) -> Result<(), Error> {
         let checked = volpt_scene::validate::validate(&self.desc, &self.source)
             .map_err(|error| match error {
                 volpt_scene::SceneError::InvalidScene {
@@ -624,7 +659,11 @@ impl Scene {
                     expected,
                     found,
                     ..
-                } => wrong(format!("{expected} (the scene's {field})"), found),
+                } => Error::Grid {
+                    grid: name.to_owned(),
+                    expected: format!("{expected} (the scene's {field})"),
+                    found,
+                },
                 error => Error::Scene(error),
             })
             .and_then(|checked| {
@@ -632,13 +671,12 @@ impl Scene {
             });
         match checked {
             Ok(checked) => {
-                // New values, new identity: nothing kept of the old values is read again.
                 self.data = Arc::new(DataFacts::new(checked));
                 self.changed();
                 Ok(())
             }
             Err(error) => {
-                *self.grid_values(name) = old;
+                restore(self);
                 Err(error)
             }
         }

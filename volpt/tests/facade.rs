@@ -415,3 +415,60 @@ fn a_scene_rendered_again_after_its_scale_changes_renders_as_one_loaded_at_that_
         .unwrap();
     assert_eq!(render(&scene, 0..6).sums, render(&fresh, 0..6).sums);
 }
+
+/// A TOML scene of a 3 x 2 x 2 print of two materials with `indices` (one byte per voxel).
+fn indexed_scene(dir: &Path, indices: &[u8]) -> PathBuf {
+    std::fs::write(dir.join("print.raw"), indices).unwrap();
+    let text = r##"[volume]
+file = "print.raw"
+format = "raw"
+resolution = [3, 2, 2]
+type = "u8"
+bounds = [[0.0, 0.0, 0.0], [3.0, 2.0, 2.0]]
+[boundary]
+bsdf = "dielectric"
+[[materials]]
+name = "cyan"
+sigma_s = [4.0, 6.0, 7.0]
+sigma_a = [6.0, 0.8, 0.2]
+g = 0.3
+[[materials]]
+name = "white"
+sigma_t = 12.0
+albedo = [0.99, 0.98, 0.97]
+"##;
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn new_indices_render_as_the_scene_loaded_with_them_and_refused_ones_change_nothing() {
+    let (before, after) = (
+        [0, 1, 1, 0, 0, 1, 1, 1, 0, 0, 0, 1],
+        [1, 1, 0, 0, 1, 0, 0, 1, 1, 0, 1, 1],
+    );
+    let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let mut scene = Scene::load(indexed_scene(a.path(), &before), &small()).unwrap();
+    let reloaded = Scene::load(indexed_scene(b.path(), &after), &small()).unwrap();
+    let original = scene.fingerprint();
+    assert_ne!(original, reloaded.fingerprint());
+    // Refusals: the wrong count, an index past the table; the scene stays as it was.
+    let e = scene.set_indices(&after[..11]).unwrap_err().to_string();
+    assert!(e.contains("12") && e.contains("11"), "{e}");
+    let mut past = after;
+    past[4] = 2;
+    let e = scene.set_indices(&past).unwrap_err().to_string();
+    assert!(e.contains('2'), "{e}");
+    assert_eq!(scene.fingerprint(), original);
+    // The same indices change nothing; new ones render as the scene loaded with them.
+    scene.set_indices(&before).unwrap();
+    assert_eq!(scene.fingerprint(), original);
+    scene.set_indices(&after).unwrap();
+    assert_eq!(scene.fingerprint(), reloaded.fingerprint());
+    assert_eq!(render(&scene, 0..6).sums, render(&reloaded, 0..6).sums);
+    // A medium without indices has none to replace.
+    let mut cube = Scene::load(example(), &small()).unwrap();
+    let e = cube.set_indices(&after).unwrap_err().to_string();
+    assert!(e.contains("material-indexed"), "{e}");
+}
