@@ -33,9 +33,14 @@ echo "== $(date -u +%Y-%m-%dT%H:%MZ) $(nvidia-smi --query-gpu=name,driver_versio
 case $mode in
 checks)
     cp bin/volpt "$KEEP/volpt"
-    part quick-all 240 env STRATEGIES_LIMIT=120 bash quick-all.sh
-    [ -f materials.sh ] && part materials 90 bash materials.sh
-    part chromatic 100 env FILMS=${FILMS:-8} bash chromatic.sh
+    # CHECKS picks the parts (all by default); EXTRA adds scripts of this folder.
+    for check in ${CHECKS:-quick-all materials chromatic}; do
+        case $check in
+        quick-all) part quick-all 240 env STRATEGIES_LIMIT=120 bash quick-all.sh ;;
+        materials) part materials 90 bash materials.sh ;;
+        chromatic) part chromatic 100 env FILMS=${FILMS:-8} bash chromatic.sh ;;
+        esac
+    done
     for extra in ${EXTRA:-}; do
         [ -f "$extra" ] && part "$(basename "$extra" .sh)" 120 bash "$extra"
     done

@@ -297,7 +297,12 @@ impl<'a, const C: usize> Grid<'a, C> {
         match self.layout {
             GridLayout::Dense => self.interpolate(p, dense_index, self.lookup, None),
             GridLayout::Bricked => self.interpolate(p, bricked_index, self.lookup, None),
-            GridLayout::Sparse => self.sparse_lookup(p, None),
+            GridLayout::Sparse => self.interpolate(
+                p,
+                |res, x, y, z| sparse_index(self.data, res, x, y, z),
+                self.lookup,
+                None,
+            ),
         }
     }
 
@@ -309,23 +314,13 @@ impl<'a, const C: usize> Grid<'a, C> {
         match self.layout {
             GridLayout::Dense => self.interpolate(p, dense_index, self.lookup, Some(bits)),
             GridLayout::Bricked => self.interpolate(p, bricked_index, self.lookup, Some(bits)),
-            GridLayout::Sparse => self.sparse_lookup(p, Some(bits)),
+            GridLayout::Sparse => self.interpolate(
+                p,
+                |res, x, y, z| sparse_index(self.data, res, x, y, z),
+                self.lookup,
+                Some(bits),
+            ),
         }
-    }
-
-    /// The sparse layout's lookup: the point mapped here, the reads in [`sparse_read`].
-    #[inline(always)]
-    fn sparse_lookup(&self, p: Vec3, bits: Option<u64>) -> [f32; C] {
-        if !self.mapping.bounds.contains(p) {
-            return [0.0; C];
-        }
-        let q = self
-            .mapping
-            .to_index_space(p)
-            .max(Vec3::ZERO)
-            .min(self.max_index());
-        let [rx, ry, rz] = self.res;
-        sparse_read::<C>(self.data, rx, ry, rz, q.x, q.y, q.z, self.lookup, bits).channels()
     }
 
     /// [`Grid::lookup`] of a dense grid with trilinear reconstruction, the grid's `layout` and
@@ -339,7 +334,11 @@ impl<'a, const C: usize> Grid<'a, C> {
     /// The index-space coordinates of the last sample along each axis.
     #[inline(always)]
     fn max_index(&self) -> Vec3 {
-        max_index(self.res)
+        Vec3::new(
+            (self.res[0] - 1) as f32,
+            (self.res[1] - 1) as f32,
+            (self.res[2] - 1) as f32,
+        )
     }
 
     #[inline(always)]
@@ -350,110 +349,29 @@ impl<'a, const C: usize> Grid<'a, C> {
         if !self.mapping.bounds.contains(p) {
             return [0.0; C];
         }
+        let at = |x: u32, y: u32, z: u32| {
+            let i = index(self.res, x, y, z) as usize * C;
+            let mut v = [0.0; C];
+            v.copy_from_slice(&self.data[i..i + C]);
+            v
+        };
+        let max_index = self.max_index();
         let q = self
             .mapping
             .to_index_space(p)
             .max(Vec3::ZERO)
-            .min(self.max_index());
-        reconstruct(self.data, self.res, q, index, lookup, bits)
-    }
-}
-
-/// The index-space coordinates of the last sample along each axis of a grid of `res` samples.
-#[inline(always)]
-fn max_index(res: [u32; 3]) -> Vec3 {
-    Vec3::new(
-        (res[0] - 1) as f32,
-        (res[1] - 1) as f32,
-        (res[2] - 1) as f32,
-    )
-}
-
-/// The value at index-space `q` (clamped into the grid) of the samples in `data`, which `index`
-/// places, reconstructed as `lookup` says (with `bits` for [`GridLookup::Stochastic`]).
-#[inline(always)]
-fn reconstruct<I, const C: usize>(
-    data: &[f32],
-    res: [u32; 3],
-    q: Vec3,
-    index: I,
-    lookup: GridLookup,
-    bits: Option<u64>,
-) -> [f32; C]
-where
-    I: Fn([u32; 3], u32, u32, u32) -> u32,
-{
-    let at = |x: u32, y: u32, z: u32| {
-        let i = index(res, x, y, z) as usize * C;
-        let mut v = [0.0; C];
-        v.copy_from_slice(&data[i..i + C]);
-        v
-    };
-    let max_index = max_index(res);
-    match (lookup, bits) {
-        (GridLookup::Nearest, _) => {
-            let n = q.round();
-            at(n.x as u32, n.y as u32, n.z as u32)
+            .min(max_index);
+        match (lookup, bits) {
+            (GridLookup::Nearest, _) => {
+                let n = q.round();
+                at(n.x as u32, n.y as u32, n.z as u32)
+            }
+            (GridLookup::Stochastic, Some(bits)) => {
+                let [x, y, z] = stochastic_corner(q, max_index, self.res, bits);
+                at(x, y, z)
+            }
+            _ => trilinear(q, max_index, self.res, at),
         }
-        (GridLookup::Stochastic, Some(bits)) => {
-            let [x, y, z] = stochastic_corner(q, max_index, res, bits);
-            at(x, y, z)
-        }
-        _ => trilinear(q, max_index, res, at),
-    }
-}
-
-/// The reads of a [`GridLayout::Sparse`] lookup at index-space `(qx, qy, qz)`: each corner's
-/// brick through the two-level brick table ([`crate::sparse::slot`]), then its sample.
-///
-/// Out of line on the GPU, where the kernels that read any layout carry it beside the dense and
-/// bricked reads: inlined, its 8 two-level table walks per lookup site made those kernels ~650-1070
-/// PTX instructions larger and the bricked scenes 4-15% slower though they never run it (H200,
-/// 2026-11-28, `bench/results/2026-11-28-h200-session8/`). Its arguments are scalars and its
-/// result a scalar pair ([`SparseValue`]), so the call moves nothing into local memory (a grid
-/// passed by address would take the scene with it; an array of three `f32` comes back through
-/// memory).
-#[cfg_attr(target_arch = "nvptx64", inline(never))]
-#[cfg_attr(not(target_arch = "nvptx64"), inline(always))]
-#[allow(clippy::too_many_arguments)]
-fn sparse_read<const C: usize>(
-    data: &[f32],
-    rx: u32,
-    ry: u32,
-    rz: u32,
-    qx: f32,
-    qy: f32,
-    qz: f32,
-    lookup: GridLookup,
-    bits: Option<u64>,
-) -> SparseValue {
-    SparseValue::of::<C>(reconstruct(
-        data,
-        [rx, ry, rz],
-        Vec3::new(qx, qy, qz),
-        |res, x, y, z| sparse_index(data, res, x, y, z),
-        lookup,
-        bits,
-    ))
-}
-
-/// Up to three channels' bits as a pair of integers: what Rust's ABI returns in registers, where it
-/// returns a `[f32; 3]` through memory.
-#[derive(Clone, Copy)]
-struct SparseValue(u64, u32);
-
-impl SparseValue {
-    #[inline(always)]
-    fn of<const C: usize>(v: [f32; C]) -> Self {
-        const { assert!(C <= 3, "a sparse grid has at most three channels") };
-        let bits = |c: usize| if c < C { v[c].to_bits() } else { 0 };
-        SparseValue(u64::from(bits(0)) | (u64::from(bits(1)) << 32), bits(2))
-    }
-
-    #[inline(always)]
-    fn channels<const C: usize>(self) -> [f32; C] {
-        let words = [self.0 as u32, (self.0 >> 32) as u32, self.1];
-        core::array::from_fn(|c| f32::from_bits(words[c]))
     }
 }
 
