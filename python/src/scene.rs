@@ -43,7 +43,7 @@ pub struct Scene {
 /// `strategy=` and `math=`, opened for this render.
 enum Chosen<'py> {
     Given(PyRef<'py, Backend>),
-    Opened(Backend),
+    Opened(Box<Backend>),
 }
 
 impl std::ops::Deref for Chosen<'_> {
@@ -88,7 +88,10 @@ fn choose<'py>(
             ..GpuOptions::default()
         },
     };
-    Ok(Chosen::Opened(Backend::open(backend.py(), options)?))
+    Ok(Chosen::Opened(Box::new(Backend::open(
+        backend.py(),
+        options,
+    )?)))
 }
 
 #[pymethods]

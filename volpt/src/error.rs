@@ -20,7 +20,8 @@ pub enum Error {
         with: &'static str,
         with_value: String,
         why: String,
-        instead: Option<(&'static str, String)>,
+        /// Boxed: the error stays small enough to return everywhere.
+        instead: Option<Box<(&'static str, String)>>,
     },
     /// A film of another size than the scene renders.
     #[error("the film is {}x{} but the scene renders {}x{}", film.0, film.1, scene.0, scene.1)]
@@ -109,7 +110,7 @@ impl Error {
                 with,
                 with_value,
                 why,
-                instead: Some((instead, value.to_string())),
+                instead: Some(Box::new((instead, value.to_string()))),
             },
             other => other,
         }
@@ -161,7 +162,7 @@ fn conflict_text(
     with: &str,
     with_value: &str,
     why: &str,
-    instead: &Option<(&'static str, String)>,
+    instead: &Option<Box<(&'static str, String)>>,
     spell: &dyn Fn(&str, Option<&str>) -> String,
 ) -> String {
     let text = format!(
@@ -169,7 +170,7 @@ fn conflict_text(
         spell(key, Some(value)),
         spell(with, Some(with_value))
     );
-    match instead {
+    match instead.as_deref() {
         Some((other, v)) => format!(
             "{text} (use {}, or drop {})",
             spell(other, Some(v)),

@@ -271,7 +271,7 @@ fn conflicts_between_settings_are_typed_with_both_keys() {
         majorant_resolution: Some(8),
         ..RenderSettings::default()
     };
-    let error = Scene::load(&cube, &settings).err().expect("refused");
+    let error = Scene::load(&cube, &settings).expect_err("refused");
     let flags = error.spelled(&|key, value| {
         let flag = format!("--{}", key.replace('_', "-"));
         value.map_or(flag.clone(), |v| format!("{flag} {v}"))
