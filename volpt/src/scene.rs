@@ -19,7 +19,7 @@ use volpt_scene::{
 };
 
 use crate::settings::RenderSettings;
-use crate::Error;
+use crate::{Error, Named};
 
 /// A scene ready to render: its description, the path settings and variant choice it renders with,
 /// and its seed.
@@ -805,22 +805,28 @@ fn check_lookup(
     let texture = matches!(lookup, GridLookup::Texture | GridLookup::TextureHalf);
     let sparse = (desc.medium.grids()).any(|(_, g)| g.layout == SampleLayout::Sparse);
     if texture && sparse {
-        return Err(Error::Settings(
-            "--lookup texture and texture-f16 read dense grids, and this scene's grid is kept \
-             sparse (a VDB): use trilinear, stochastic or nearest lookups, or read the VDB dense \
-             (sparse = \"never\" in a TOML scene)"
+        return Err(Error::Setting {
+            key: GridLookup::KEY,
+            expected: "a lookup of sparse grids for this scene's grid, kept sparse (a VDB): \
+                       trilinear, stochastic or nearest (textures hold dense grids; a TOML scene \
+                       reads a VDB dense with sparse = \"never\")"
                 .to_owned(),
-        ));
+            found: lookup.name().to_owned(),
+        });
     }
     if lookup != GridLookup::TextureHalf {
         return Ok(());
     }
     for (name, largest) in desc.medium.largest_values(checked) {
         if largest > HALF_MAX {
-            return Err(Error::Settings(format!(
-                "--lookup texture-f16: the medium's largest {name} is {largest}, above half \
-                 precision's largest value, {HALF_MAX} (use --lookup texture: f32 texels)"
-            )));
+            return Err(Error::Setting {
+                key: GridLookup::KEY,
+                expected: format!(
+                    "a lookup that holds the medium's largest {name}, {largest}: texture (f32 \
+                     texels), not texture-f16, whose largest value is {HALF_MAX}"
+                ),
+                found: lookup.name().to_owned(),
+            });
         }
     }
     Ok(())
