@@ -34,7 +34,7 @@ def kernels(path):
 
 def stats(body):
     regs = sum(int(m.group(1)) for l in body for m in [re.search(r"\.reg \.\w+ \t?%\w+<(\d+)>", l)] if m)
-    depot = max([int(m.group(1)) for l in body for m in [re.search(r"__local_depot\d+\[(\d+)\]", l)] if m] or [0])
+    depot = max([int(m.group(1)) for l in body for m in [re.search(r"__local_depot\d*\[(\d+)\]", l)] if m] or [0])
     inst = sum(1 for l in body if l.startswith("\t") and l.strip().endswith(";") and not l.strip().startswith("."))
     return inst, regs, depot
 

@@ -295,9 +295,9 @@ fn assemble(path: &Path, params: Vec<(String, String)>) {
 /// wrote must pass the lookup's checks, the majorant grid is built from it, and no lookup may
 /// exceed its cell's majorant (delta tracking's one requirement of the majorants).
 fn read_sparse(path: &Path) {
-    use volpt::core::grid::{Grid, GridMapping};
-    use volpt::core::majorant::{build_majorants, MajorantGrid};
-    use volpt::core::{Aabb, Vec3};
+    use volpt_core::grid::{Grid, GridMapping};
+    use volpt_core::majorant::{build_majorants, MajorantGrid};
+    use volpt_core::{Aabb, Vec3};
     use volpt_scene::vdb::{read_vdb, Sparsity, VdbOptions};
     let options = VdbOptions {
         sparsity: Sparsity::Always,
@@ -479,7 +479,7 @@ pub fn seeds(target: Target) -> Vec<Vec<u8>> {
                     .expect("write a film seed")
                 }),
                 written("render.ckpt", &|p| {
-                    volpt::film::Checkpoint::write_film(p, 7, 3, 5, &film(2, 2))
+                    volpt_film::Checkpoint::write_film(p, 7, 3, 5, &film(2, 2))
                         .expect("write a checkpoint seed")
                 }),
             ]

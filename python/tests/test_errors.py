@@ -49,7 +49,8 @@ def test_unknown_parameter_value_is_the_scene_files_error(tmp_path):
         # The library's bound and words (volpt::MAJORANT_RESOLUTION), the key in Python's spelling.
         ({"majorant_resolution": 0}, 'settings["majorant_resolution"]: expected 1 to 1024 cells, found 0'),
         ({"majorant_resolution": 1025}, 'settings["majorant_resolution"]: expected 1 to 1024 cells, found 1025'),
-        ({"tracking": "global", "majorant_resolution": 8}, "--tracking global uses one majorant; --majorant-resolution 8 asks for a grid"),
+        # A conflict of two settings: typed in the library, each key in Python's spelling.
+        ({"tracking": "global", "majorant_resolution": 8}, 'settings["majorant_resolution"] = 8 with settings["tracking"] = \'global\': global tracking uses one majorant'),
     ],
 )
 def test_bad_settings(settings, message):
@@ -73,8 +74,8 @@ def scene():
     "kwargs,message",
     [
         ({"backend": "gpu"}, "backend: expected one of cpu, cuda, found \"gpu\""),
-        ({"strategy": "regeneration-sk"}, "--strategy regeneration-sk schedules GPU work; the CPU backend has no strategies"),
-        ({"math": "fast"}, "--math fast chooses the GPU's kernels; the CPU backend always computes exactly"),
+        ({"strategy": "regeneration-sk"}, "strategy='regeneration-sk' with backend='cpu': a strategy schedules GPU work, and the CPU backend has no strategies"),
+        ({"math": "fast"}, "math='fast' with backend='cpu': math chooses the GPU's kernels, and the CPU backend always computes exactly"),
         ({"backend": "cuda", "strategy": "quick"}, "strategy: expected one of auto, "),
         ({"backend": "cuda", "math": "sloppy"}, "math: expected one of exact, fast, found \"sloppy\""),
         ({"spp": 0}, "spp: expected an integer from 1 to 4294967295, found int 0"),

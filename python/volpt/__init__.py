@@ -2,12 +2,15 @@
 
     import volpt
     scene = volpt.load("scenes/example/cube.xml", spp=16)   # -D spp=16
-    film = scene.render(seed=1)                             # the CPU; backend="cuda" for a GPU
+    film = scene.render(seed=1)                             # the CPU
+    gpu = volpt.Backend("cuda", math="exact")               # a GPU, opened once, reused
+    film = scene.render(seed=1, backend=gpu)
     image = film.image()                                    # numpy float32 (H, W, 3), linear
     scene.params["medium.scale"] = 2.0                      # no reload of the grids
     film.write("cube.exr")
 
-The classes are ``Scene``, ``SceneParameters`` (``scene.params``) and ``Film``; the exceptions are
+The classes are ``Scene``, ``SceneParameters`` (``scene.params``), ``Backend`` and ``Film`` (which
+pickles); the exceptions are
 in ``volpt.errors``. Everything renders through the Rust library ``volpt``, bit for bit as the
 ``volpt`` command line does.
 """
@@ -16,7 +19,7 @@ import os
 from typing import Any, Mapping, Optional
 
 from . import errors
-from ._volpt import PARAMS, SETTINGS, STRATEGIES, Film, Scene, SceneParameters, __version__
+from ._volpt import PARAMS, SETTINGS, STRATEGIES, Backend, Film, Scene, SceneParameters, __version__
 from ._volpt import load as _load
 from ._volpt import merge, read_exr
 from .errors import (
@@ -87,6 +90,7 @@ __all__ = [
     "read_exr",
     "Scene",
     "SceneParameters",
+    "Backend",
     "Film",
     "PARAMS",
     "SETTINGS",

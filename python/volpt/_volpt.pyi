@@ -88,7 +88,7 @@ class Scene:
         spp: Optional[int] = None,
         seed: Optional[int] = None,
         samples: Optional[Union[range, Tuple[int, int]]] = None,
-        backend: str = "cpu",
+        backend: Union[str, Backend, None] = None,
         strategy: Optional[str] = None,
         math: Optional[str] = None,
         progress: Optional[Progress] = None,
@@ -100,10 +100,13 @@ class Scene:
         image equals ``volpt render``'s bit for bit for the same scene, seed and backend, and
         films of disjoint ranges merge (``volpt.merge``) into the whole render's.
 
-        ``backend``: ``"cpu"`` (every core) or ``"cuda"`` (GPU 0; opened once per process and
-        reused). ``strategy`` (``STRATEGIES``; default: ``auto``'s cached choice or
-        regeneration-sk, as ``volpt render``) and ``math`` (``"fast"``, the default, statistically
-        equal, or ``"exact"``, the CPU's bits) are the GPU's; the CPU refuses them.
+        ``backend``: a ``Backend`` (opened once and reused: a GPU's kernels load once, and
+        ``auto``'s calibrations are kept), or a kind's name, opened for this render: ``"cpu"``
+        (every core, the default) or ``"cuda"`` (GPU 0) with ``strategy`` (``STRATEGIES``;
+        default: ``auto``'s choice or regeneration-sk, as ``volpt render``) and ``math``
+        (``"fast"``, the default, statistically equal, or ``"exact"``, the CPU's bits), which are
+        the GPU's: the CPU refuses them. A ``Backend``'s options are its own: ``strategy`` or
+        ``math`` beside one raises ``SettingsError``.
 
         ``progress``: ``True`` draws a bar on stderr; a callable is called ``progress(done,
         total)`` (paths) between chunks of samples, on the calling thread; an exception it raises
@@ -142,9 +145,57 @@ class SceneParameters:
     def describe(self) -> Dict[str, str]:
         """Each key this scene has, with what it is and the values it takes."""
 
+class Backend:
+    """The CPU or GPUs a render runs on, with every option ``volpt render`` has, opened once and
+    reused by the renders given it (``scene.render(backend=...)``): a GPU's kernels load once,
+    and ``auto``'s calibrations are kept per scene. Renders on one backend may run in several
+    threads at once."""
+
+    def __init__(
+        self,
+        kind: str = "cpu",
+        *,
+        strategy: Optional[str] = None,
+        math: Optional[str] = None,
+        max_registers: Optional[int] = None,
+        refill_at: Optional[int] = None,
+        tiles: Optional[Tuple[int, int]] = None,
+        volume_memory: Optional[str] = None,
+        device_memory_budget: Optional[int] = None,
+        bricked: bool = False,
+        gpus: Union[None, str, int, Sequence[int]] = None,
+    ) -> None:
+        """Opens the backend ``kind`` (``"cpu"``, ``"cuda"``), with ``volpt render``'s options
+        of the same names: ``strategy`` (``STRATEGIES``), ``math`` (``"fast"``, ``"exact"``),
+        ``max_registers`` (16 to 255) and ``refill_at`` (1 to 32; regeneration-sk's), ``tiles``
+        ((columns, rows) of the image, each rendered by its own launches), ``volume_memory``
+        (``"auto"``, ``"device"``, ``"zero-copy"``, ``"managed"``), ``device_memory_budget``
+        (bytes the grids may take on the GPU), ``bricked`` (grids in 8^3 bricks) and ``gpus``
+        (``"all"``, a GPU's number or several: one render on several GPUs). Each bound is the
+        library's, in the CLI's words. Raises ``SettingsError`` for an option out of range or
+        that does not apply (a GPU option with ``"cpu"``), ``RenderError`` where the GPU cannot
+        be opened (no GPU, a build without GPU kernels)."""
+    @property
+    def kind(self) -> str: ...
+    @property
+    def devices(self) -> int:
+        """The devices that render together: 1 but for several GPUs."""
+    @property
+    def device_name(self) -> str: ...
+    @property
+    def strategy(self) -> Optional[str]:
+        """The strategy asked for (``"auto"`` or a fixed one); ``None`` on the CPU."""
+    @property
+    def math(self) -> Optional[str]:
+        """The GPU's math; ``None`` on the CPU."""
+    @property
+    def gpus(self) -> Union[None, str, List[int]]:
+        """The GPUs asked for: ``None`` (GPU 0), ``"all"`` or their numbers."""
+
 class Film:
     """The per-pixel sums of one render's samples ``samples``, with the render's fingerprint and
-    seed."""
+    seed. Films pickle (as ``to_bytes``), so they pass between processes (Ray's tasks) as they
+    are; the render's ``elapsed``, ``paths`` and ``notes`` stay behind."""
 
     @property
     def sums(self) -> npt.NDArray[np.float64]:
@@ -190,6 +241,12 @@ class Film:
         or a checkpoint, checked as ``volpt merge`` checks it (magic, length, checksum, ranges).
         A film of several ranges (a merge with ``--allow-gaps``) raises ``CheckpointError``, as
         does a damaged file."""
+    def to_bytes(self) -> bytes:
+        """The film in volpt's film file format (``VOLPTFL1``), as ``save_film`` writes it."""
+    @staticmethod
+    def from_bytes(data: bytes) -> Film:
+        """The film of ``to_bytes``' bytes, checked as a film file is (magic, length, checksum,
+        one sample range). Raises ``CheckpointError``."""
     @staticmethod
     def load(path: Union[str, os.PathLike[str]], scene: Optional[Scene] = None) -> Film:
         """Reads a film saved by ``Film.save`` or ``volpt render --checkpoint``. With ``scene``,

@@ -14,7 +14,7 @@ Needs Ray (``pip install 'volpt[ray]'``, or ``pip install ray``), imported only 
 called. The tasks need the same ``volpt`` installed on every node, and the scene at the same path
 on every node (a shared file system, or the same files copied to each): a scene is a file that
 names others (grids, a sky map), so the tasks read it where they run rather than receive it. The
-films come back through Ray's object store as bytes of volpt's film file format (``VOLPTFL1``, what
+films come back through Ray's object store pickled as bytes of volpt's film file format (``VOLPTFL1``, what
 ``volpt render --film`` writes): no shared file system is needed for them, and their checksum is
 verified when the driver reads them.
 
@@ -26,7 +26,6 @@ A task whose worker process or node dies is run again by Ray (``max_retries``); 
 import os
 import socket
 import sys
-import tempfile
 from dataclasses import dataclass
 from typing import Any, Callable, Dict, List, Mapping, Optional, Tuple, Union
 
@@ -78,25 +77,6 @@ def _import_ray() -> Any:
     return ray
 
 
-def _film_bytes(film: "_volpt.Film") -> bytes:
-    """The film in the film file format (``Film.save_film``), as bytes."""
-    with tempfile.TemporaryDirectory(prefix="volpt-part-") as d:
-        path = os.path.join(d, "part.vfilm")
-        film.save_film(path)
-        with open(path, "rb") as f:
-            return f.read()
-
-
-def _film_from_bytes(data: bytes) -> "_volpt.Film":
-    """The film of ``_film_bytes``'s bytes, checked (magic, length, checksum) as ``volpt merge``
-    checks a film file."""
-    with tempfile.TemporaryDirectory(prefix="volpt-part-") as d:
-        path = os.path.join(d, "part.vfilm")
-        with open(path, "wb") as f:
-            f.write(data)
-        return _volpt.Film.load_film(path)
-
-
 def _render_part(
     scene_path: str,
     settings: Dict[str, Any],
@@ -104,9 +84,10 @@ def _render_part(
     samples: Tuple[int, int],
     seed: Optional[int],
     backend: str,
-) -> Tuple[bytes, Dict[str, Any]]:
-    """One task: loads the scene where it runs, renders ``samples`` and returns the film's bytes
-    with where and how long it rendered."""
+) -> Tuple["_volpt.Film", Dict[str, Any]]:
+    """One task: loads the scene where it runs, renders ``samples`` and returns the film (Ray
+    pickles it as the film file's bytes, checked as ``volpt merge`` checks a film file) with
+    where and how long it rendered."""
     from . import load  # the package's, with its keyword parameters
 
     scene = load(scene_path, settings, **params)
@@ -118,7 +99,7 @@ def _render_part(
     except Exception:  # outside Ray (a direct call): the host's name
         node, node_id = socket.gethostname(), ""
     where = {"node": node, "node_id": node_id, "pid": os.getpid(), "seconds": film.elapsed}
-    return _film_bytes(film), where
+    return film, where
 
 
 def _reason(error: BaseException) -> str:
@@ -131,13 +112,6 @@ def _reason(error: BaseException) -> str:
         text = str(error)
     lines = text.strip().splitlines()
     return lines[0] if lines else type(error).__name__
-
-
-def _write_atomically(path: str, data: bytes) -> None:
-    tmp = f"{path}.tmp{os.getpid()}"
-    with open(tmp, "wb") as f:
-        f.write(data)
-    os.replace(tmp, path)
 
 
 def _print_progress(part: PartDone) -> None:
@@ -258,13 +232,12 @@ def render(
             ref = ready[0]
             i = pending.pop(ref)
             try:
-                data, where = ray.get(ref)
+                film, where = ray.get(ref)
             except VolptError:
                 raise  # the task's own error (Ray's exception is also of the task's class)
             except Exception as e:  # the worker or node died beyond the retries, and the like
                 failed.append((i, e))
                 continue
-            film = _film_from_bytes(data)
             if first is None:
                 first = (i, film.fingerprint, where["node"])
             elif film.fingerprint != first[1]:
@@ -275,8 +248,7 @@ def render(
                     f"Every node must read the same scene files at {scene}"
                 )
             if parts_dir is not None:
-                _write_atomically(os.path.join(parts_dir, f"part-{i:04d}.vfilm"), data)
-            del data
+                film.save_film(os.path.join(parts_dir, f"part-{i:04d}.vfilm"))
             arrived[i] = film
             # Parts are added in the order of their ranges, as soon as the ones before are in:
             # the same partition gives the same bits whatever order the parts arrive in.

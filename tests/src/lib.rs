@@ -44,6 +44,7 @@ pub fn cube_scene(
             to_world: look_at([2.0, 1.5, 2.5]),
             fov_degrees: 45.0,
             fov_axis: FovAxis::X,
+            projection: Projection::Perspective,
         },
         film: FilmDesc { width, height },
         spp: 16,

@@ -377,3 +377,30 @@ fn an_indexed_volume_is_written_as_rgb_grids_of_its_materials() {
     let err = write_mitsuba3(&desc, dir.path(), "refused").expect_err("g differ");
     assert!(err.to_string().contains("one phase function"), "{err}");
 }
+
+#[test]
+fn an_orthographic_camera_comes_back_with_its_extent() {
+    let mut desc = cube_scene(
+        16,
+        12,
+        homogeneous(2.0, 0.5, PhaseDesc::Isotropic),
+        BsdfDesc::Null,
+        1.0,
+    );
+    desc.camera.projection = Projection::Orthographic;
+    // The frame scaled by 1.5: the film spans 3 x 2.25 units, and the scale must come back.
+    for row in desc.camera.to_world.iter_mut().take(3) {
+        row[0] *= 1.5;
+        row[1] *= 1.5;
+    }
+    let dir = tempfile::tempdir().expect("temp dir");
+    let text = {
+        let loaded = export_and_load(&desc, dir.path());
+        assert_eq!(loaded.camera.projection, Projection::Orthographic);
+        assert_matrix_close(&loaded.camera.to_world, &desc.camera.to_world);
+        assert_eq!(loaded.film, desc.film);
+        std::fs::read_to_string(dir.path().join("exported.xml")).unwrap()
+    };
+    assert!(text.contains(r#"<sensor type="orthographic">"#), "{text}");
+    assert!(!text.contains(r#"name="fov""#), "{text}");
+}

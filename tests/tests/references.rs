@@ -56,6 +56,7 @@ fn scene(
             to_world: look_at(camera_at),
             fov_degrees: fov,
             fov_axis: FovAxis::X,
+            projection: Projection::Perspective,
         },
         film: FilmDesc { width, height },
         spp: 1,

@@ -2,7 +2,7 @@
 //! and standard deviation of the render time and the throughputs derived from it.
 
 use serde::Serialize;
-use volpt_render::RenderStats;
+use volpt::RenderStats;
 
 #[derive(Debug, Serialize)]
 pub struct BenchReport {

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Result};
 use clap::Args;
 use volpt::metrics::{z_test, ZTest, Z_BOUND};
-use volpt_render::Image;
+use volpt::Image;
 
 #[derive(Args)]
 pub struct CompareArgs {
@@ -42,9 +42,7 @@ fn parse_bound(s: &str) -> Result<f64, String> {
 /// Reads an EXR after checking what its header claims against the memory limit, and refuses
 /// non-finite pixels: a render holding NaN or Inf is broken, whatever the other image holds.
 fn read(path: &Path) -> Result<Image> {
-    // `Image` keeps three f32 per pixel beside the decoded channels.
-    volpt_scene::limits::check_exr(path, "the image", 12)?;
-    let image = Image::read_exr(path)?;
+    let image = volpt::read_exr(path, "the image")?;
     if let Some(i) = image
         .pixels
         .iter()

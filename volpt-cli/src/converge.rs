@@ -28,13 +28,11 @@ use std::time::Duration;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
+use volpt::scene_files::description::{AlbedoDesc, BsdfDesc, EnvironmentDesc};
 use volpt::{
-    Accumulation, Backend, Estimator, Film, Image, Math, Named, PathSettings, Quiet, RenderRequest,
-    Roulette, Scene, Strategy, StrategyChoice,
+    Accumulation, Backend, Estimator, Film, GridLookup, Math, Named, PathSettings, Quiet,
+    RenderRequest, RenderSettings, Roulette, Scene, SceneDescription, Strategy, StrategyChoice,
 };
-use volpt_render::path_settings;
-use volpt_scene::description::{AlbedoDesc, BsdfDesc, EnvironmentDesc};
-use volpt_scene::{GridLookup, SceneDescription};
 
 use volpt::metrics::{errors_of_halves, Reference};
 
@@ -104,26 +102,27 @@ pub enum Choice {
 }
 
 impl Choice {
+    /// Sets the choice in `config`: path settings as [`RenderSettings`] over the scene's
+    /// (`scene`), which checks them ([`RenderSettings::path_over`]).
     fn apply(self, config: &mut Configuration, scene: &PathSettings) {
-        let depth = |d: Option<u32>| d.unwrap_or(PathSettings::UNLIMITED);
         let settings = &mut config.settings;
         match self {
             Choice::Roulette(true) if scene.rr_depth == PathSettings::UNLIMITED => {
-                settings.rr_depth = PathSettings::default().rr_depth
+                settings.rr_depth = Some(Some(PathSettings::default().rr_depth))
             }
-            Choice::Roulette(true) => settings.rr_depth = scene.rr_depth,
-            Choice::Roulette(false) => settings.rr_depth = PathSettings::UNLIMITED,
-            Choice::RrDepth(d) => settings.rr_depth = depth(d),
-            Choice::MaxDepth(d) => settings.max_depth = depth(d),
-            Choice::Estimator(e) => settings.estimator = e,
-            Choice::MajorantResolution(r) => settings.majorant_resolution = r,
+            Choice::Roulette(true) => settings.rr_depth = Some(Some(scene.rr_depth)),
+            Choice::Roulette(false) => settings.rr_depth = Some(None),
+            Choice::RrDepth(d) => settings.rr_depth = Some(d),
+            Choice::MaxDepth(d) => settings.max_depth = Some(d),
+            Choice::Estimator(e) => settings.estimator = Some(e),
+            Choice::MajorantResolution(r) => settings.majorant_resolution = Some(r),
             Choice::Lookup(lookup) => config.lookup = Some(lookup),
             Choice::Accumulation(accumulation) => config.accumulation = accumulation,
             Choice::Strategy(strategy) => {
                 config.sampling.gpu.strategy = Some(StrategyChoice::Fixed(strategy))
             }
             Choice::Math(math) => config.sampling.gpu.math = Some(math),
-            Choice::RouletteRule(rule) => settings.roulette = rule,
+            Choice::RouletteRule(rule) => settings.roulette = Some(rule),
         }
     }
 
@@ -198,7 +197,8 @@ fn parse_setting(s: &str) -> Result<Vec<Choice>, String> {
 #[derive(Clone)]
 struct Configuration {
     label: String,
-    settings: PathSettings,
+    /// Its path settings over the scene's (the others are left `None`).
+    settings: RenderSettings,
     /// The grid lookup; `None` keeps the scene's (or `--lookup`'s).
     lookup: Option<GridLookup>,
     accumulation: Accumulation,
@@ -208,14 +208,13 @@ struct Configuration {
 
 /// Every combination of the settings' values (the scene's own settings if there are none).
 fn configurations(
-    desc: &SceneDescription,
+    scene: &PathSettings,
     sampling: &SamplingArgs,
     settings: &[Vec<Choice>],
 ) -> Vec<Configuration> {
-    let scene = path_settings(desc);
     let mut out = vec![Configuration {
         label: String::new(),
-        settings: scene,
+        settings: RenderSettings::default(),
         lookup: None,
         accumulation: Accumulation::F64,
         sampling: sampling.clone(),
@@ -226,7 +225,7 @@ fn configurations(
             .flat_map(|c| {
                 values.iter().map(move |choice| {
                     let mut config = c.clone();
-                    choice.apply(&mut config, &scene);
+                    choice.apply(&mut config, scene);
                     config.label = if c.label.is_empty() {
                         choice.label()
                     } else {
@@ -260,9 +259,7 @@ impl Row {
         self.mse.sqrt()
     }
     fn bias(&self) -> f64 {
-        (self.mse - self.variance - self.reference_variance)
-            .max(0.0)
-            .sqrt()
+        volpt::metrics::bias(self.mse, self.variance, self.reference_variance)
     }
     fn efficiency(&self) -> f64 {
         1.0 / (self.mse * self.time_s)
@@ -305,7 +302,11 @@ fn add_batch(
 pub fn run(args: &ConvergeArgs) -> Result<()> {
     let scene = args.scene.load(Some(&args.sampling))?;
     let seed = scene.seed();
-    let configurations = configurations(scene.description(), &args.sampling, &args.settings);
+    let configurations = configurations(&scene.path_settings(), &args.sampling, &args.settings);
+    // Every configuration's path settings checked before anything renders.
+    let paths = (configurations.iter())
+        .map(|c| c.settings.path_over(scene.path_settings()))
+        .collect::<Result<Vec<_>, _>>()?;
     // Before the reference, so that a configuration a backend cannot render costs nothing.
     if let Some(c) = configurations
         .iter()
@@ -324,7 +325,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     let (w, h) = scene.resolution();
 
     let mut results = Vec::new();
-    for (k, config) in configurations.iter().enumerate() {
+    for (k, (config, path)) in configurations.iter().zip(paths).enumerate() {
         let bar = ProgressBar::new((args.time * 1000.0) as u64);
         bar.set_style(
             ProgressStyle::with_template("{spinner} {prefix} [{elapsed_precise}] {wide_bar} {msg}")
@@ -340,7 +341,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         // The configuration's lookup, if it names one; else `--lookup`'s, else its backend's
         // default.
         let request = RenderRequest {
-            path: Some(config.settings),
+            path: Some(path),
             lookup: config.lookup,
             ..RenderRequest::default()
         };
@@ -400,9 +401,7 @@ fn reference(args: &ConvergeArgs, scene: &Scene, backend: &Backend) -> Result<Re
     let desc = scene.description();
     let (w, h) = (desc.film.width, desc.film.height);
     if let Some(path) = &args.reference {
-        // What the header claims, against the memory limit, before the decoder allocates it.
-        volpt_scene::limits::check_exr(path, "the reference image", 12)?;
-        let image = Image::read_exr(path)?;
+        let image = volpt::read_exr(path, "the reference image")?;
         if (image.width, image.height) != (w, h) {
             bail!(
                 "{}: the reference is {}x{} but the render is {w}x{h}",
@@ -429,29 +428,35 @@ fn reference(args: &ConvergeArgs, scene: &Scene, backend: &Backend) -> Result<Re
     } else {
         backend.default_lookup(scene)
     };
-    let key = reference_key(args, desc, lookup);
-    let cached = [0, 1].map(|half| args.out.join(format!("reference-{key:016x}-{half}.exr")));
+    let seed = scene.seed();
+    let spp = args.reference_spp.div_ceil(2);
+    // Seeds no batch of the runs uses (they count up from the base seed).
+    let requests = [0, 1].map(|half| {
+        RenderRequest::samples(0..spp)
+            .with_path(reference_settings(scene))
+            .with_lookup(lookup)
+            .with_seed(seed.wrapping_sub(1 + half))
+    });
+    // Named by what makes a render the same render (the library's fingerprint of the scene, its
+    // grids and the request) and by its samples and seed: a changed scene renders a new one.
+    let cached = requests.iter().enumerate().map(|(half, request)| {
+        let fingerprint = backend.fingerprint(scene, request)?;
+        let seed = request.seed.unwrap_or(seed);
+        let name = format!("reference-{fingerprint:016x}-{seed:08x}-{spp}spp-{half}.exr");
+        anyhow::Ok(args.out.join(name))
+    });
+    let cached = cached.collect::<Result<Vec<_>>>()?;
     if cached.iter().all(|p| p.exists()) {
         tracing::info!(path = %cached[0].display(), "using the cached reference");
-        let [a, b] = [&cached[0], &cached[1]].map(|p| {
-            volpt_scene::limits::check_exr(p, "the cached reference", 12)?;
-            anyhow::Ok(Image::read_exr(p)?)
-        });
+        let [a, b] = [&cached[0], &cached[1]].map(|p| volpt::read_exr(p, "the cached reference"));
         return Ok(Reference::from_halves(&a?, &b?));
     }
     tracing::info!(spp = args.reference_spp, "rendering the reference");
-    let seed = scene.seed();
-    let spp = args.reference_spp.div_ceil(2);
     let mut halves = Vec::new();
-    for (half, path) in cached.iter().enumerate() {
-        let request = RenderRequest::samples(0..spp)
-            .with_path(reference_settings(desc))
-            .with_lookup(lookup)
-            // Seeds no batch of the runs uses (they count up from the base seed).
-            .with_seed(seed.wrapping_sub(1 + half as u32));
+    for (request, path) in requests.iter().zip(&cached) {
         let terminal = crate::backend::Terminal::new(true);
         let mut film = scene.film();
-        backend.render(scene, &mut film, &request, &terminal)?;
+        backend.render(scene, &mut film, request, &terminal)?;
         terminal.finish();
         let image = film.image(spp);
         image.write_exr(path)?;
@@ -462,8 +467,8 @@ fn reference(args: &ConvergeArgs, scene: &Scene, backend: &Backend) -> Result<Re
 
 /// The scene's settings with Russian roulette from depth 5 at the latest: roulette is unbiased,
 /// and without it a reference of a high-albedo scene costs many times more.
-fn reference_settings(desc: &SceneDescription) -> PathSettings {
-    let scene = path_settings(desc);
+fn reference_settings(scene: &Scene) -> PathSettings {
+    let scene = scene.path_settings();
     PathSettings {
         rr_depth: scene.rr_depth.min(PathSettings::default().rr_depth),
         ..scene
@@ -485,22 +490,6 @@ fn white_furnace(desc: &SceneDescription) -> Option<[f32; 3]> {
         }
         _ => None,
     }
-}
-
-/// FNV-1a of everything the reference depends on, so that a changed scene renders a new one.
-fn reference_key(args: &ConvergeArgs, desc: &SceneDescription, lookup: GridLookup) -> u64 {
-    let key = format!(
-        "{:?} {:?} {:?} {:?} {} {}",
-        std::fs::canonicalize(&args.scene.scene).unwrap_or_else(|_| args.scene.scene.clone()),
-        args.scene.settings(None).config(),
-        lookup,
-        reference_settings(desc),
-        args.reference_spp,
-        args.sampling.seed
-    );
-    key.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
-        (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)
-    })
 }
 
 /// Writes `bytes` to `dir/name`.
@@ -577,10 +566,9 @@ fn write_plots(dir: &Path, title: &str, results: &[(String, Vec<Row>)]) -> Resul
 pub fn replot(dir: &Path, title: &str) -> Result<()> {
     let path = dir.join("converge.csv");
     // A regular file only: a FIFO named converge.csv would block the read for ever.
-    let text = volpt::film::regular::open_regular(&path)
-        .map_err(std::io::Error::from)
-        .and_then(|(file, _)| std::io::read_to_string(file))
-        .with_context(|| format!("reading {}", path.display()))?;
+    let (file, _) = volpt::limits::open_regular(&path)?;
+    let text =
+        std::io::read_to_string(file).with_context(|| format!("reading {}", path.display()))?;
     let results = parse_csv(&text).with_context(|| format!("{}", path.display()))?;
     for path in write_plots(dir, title, &results)? {
         println!("wrote {}", path.display());
@@ -697,7 +685,7 @@ mod tests {
         };
         let mut config = Configuration {
             label: String::new(),
-            settings: scene,
+            settings: RenderSettings::default(),
             lookup: None,
             accumulation: Accumulation::F64,
             sampling,
@@ -711,7 +699,8 @@ mod tests {
         ] {
             choice.apply(&mut config, &scene);
         }
-        let s = config.settings;
+        // Checked and applied over the scene's by the library.
+        let s = config.settings.path_over(scene).unwrap();
         assert_eq!((s.max_depth, s.rr_depth), (3, PathSettings::UNLIMITED));
         assert_eq!(config.lookup, Some(GridLookup::Nearest));
         assert_eq!(config.accumulation, Accumulation::F32);

@@ -2,9 +2,7 @@
 
 use std::path::Path;
 
-use volpt_core::PathSettings;
-use volpt_render::factory::Effects;
-use volpt_scene::SceneDescription;
+use volpt::{Effects, PathSettings, SceneDescription};
 
 pub fn describe(
     path: &Path,

@@ -16,10 +16,9 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand};
 use tracing_subscriber::EnvFilter;
 use volpt::{
-    Backend, BackendOptions, Effects, Estimator, GridLookup, Image, Named, RenderSettings,
-    RenderStats, Roulette, Scene, Tracking, Variant,
+    preview_path, Backend, BackendOptions, Effects, Estimator, GridLookup, Image, Math, Named,
+    RenderSettings, RenderStats, Roulette, Scene, Tracking, Variant,
 };
-use volpt_render::image::preview_path;
 
 use backend::{BackendKind, GpuArgs, Terminal};
 
@@ -35,7 +34,7 @@ struct Cli {
     /// The most memory one piece of loaded data (a grid, a map, the film) may take, in bytes or
     /// with a K, M, G suffix (powers of 1024); input that claims more is refused before it is read.
     #[arg(long, global = true, value_name = "BYTES", value_parser = parse_bytes,
-          default_value_t = volpt_scene::limits::DEFAULT_MEMORY_LIMIT)]
+          default_value_t = volpt::limits::DEFAULT_MEMORY_LIMIT)]
     memory_limit: u64,
 }
 
@@ -65,8 +64,8 @@ enum Command {
     Selftest {
         /// Which kernels: `exact` must give the CPU's bits, `fast` the documented accuracy of
         /// its approximate instructions.
-        #[arg(long, value_enum, default_value_t = volpt_cuda::Math::Exact)]
-        math: volpt_cuda::Math,
+        #[arg(long, value_parser = named::<Math>(), default_value = Math::Exact.name())]
+        math: Math,
     },
     /// Serve an interactive viewer as a web page: orbit, pan and zoom, progressive refinement,
     /// parameters, snapshots (open the printed URL; over SSH, `ssh -L PORT:localhost:PORT HOST`).
@@ -381,19 +380,22 @@ fn main() -> Result<()> {
     run().map_err(spelled_as_flags)
 }
 
-/// A library error of one setting, its key spelled as the flag that sets it
-/// (`majorant_resolution`: `--majorant-resolution`); any other error as it is.
+/// A library error, each setting's key spelled as the flag that sets it
+/// (`majorant_resolution`: `--majorant-resolution`, `--max-registers 8`); any other error as it
+/// is.
 fn spelled_as_flags(error: anyhow::Error) -> anyhow::Error {
     match error.downcast_ref::<volpt::Error>() {
-        Some(volpt::Error::Setting {
-            key,
-            expected,
-            found,
-        }) if error.chain().count() == 1 => anyhow::anyhow!(
-            "--{}: expected {expected}, found {found}",
-            key.replace('_', "-")
-        ),
+        Some(library) if error.chain().count() == 1 => anyhow::anyhow!(library.spelled(&flag)),
         _ => error,
+    }
+}
+
+/// A setting's flag, with its value where it has one: `--max-registers 8`.
+fn flag(key: &str, value: Option<&str>) -> String {
+    let flag = format!("--{}", key.replace('_', "-"));
+    match value {
+        Some(value) => format!("{flag} {value}"),
+        None => flag,
     }
 }
 
@@ -405,7 +407,7 @@ fn run() -> Result<()> {
         .with_writer(std::io::stderr)
         .init();
     let cli = Cli::parse();
-    volpt_scene::limits::set_memory_limit(cli.memory_limit);
+    volpt::limits::set_memory_limit(cli.memory_limit);
     match cli.command {
         Command::Render(args) => render_command(args),
         Command::Merge(args) => merge_command(args),
@@ -430,13 +432,15 @@ fn run() -> Result<()> {
         }) => {
             let scene = args.load(None)?;
             let name = name.unwrap_or_else(|| export_name(&args.scene));
-            for path in volpt_scene::mitsuba::write_mitsuba3(scene.description(), &out, &name)? {
+            for path in
+                volpt::scene_files::mitsuba::write_mitsuba3(scene.description(), &out, &name)?
+            {
                 println!("wrote {}", path.display());
             }
             Ok(())
         }
         Command::Scene(SceneCommand::Generate { dir }) => {
-            for path in volpt_scene::generate::generate_scene_inputs(&dir)? {
+            for path in volpt::scene_files::generate::generate_scene_inputs(&dir)? {
                 println!("wrote {}", path.display());
             }
             Ok(())
@@ -633,9 +637,9 @@ fn merge_command(args: MergeArgs) -> Result<()> {
             eprintln!(
                 "warning: samples {} are in no film; the image averages the {} samples per pixel \
                  held ({})",
-                volpt::film::film_file::format_ranges(&merged.missing),
+                volpt::format_ranges(&merged.missing),
                 merged.film.samples(),
-                volpt::film::film_file::format_ranges(&merged.film.ranges)
+                volpt::format_ranges(&merged.film.ranges)
             );
         }
         merged.film
@@ -648,7 +652,7 @@ fn merge_command(args: MergeArgs) -> Result<()> {
         film.seed,
         film.film.width,
         film.film.height,
-        volpt::film::film_file::format_ranges(&film.ranges),
+        volpt::format_ranges(&film.ranges),
         film.samples()
     );
     if let Some(path) = &args.film {
@@ -689,7 +693,7 @@ fn preview_for(output: &Path) -> Result<Option<PathBuf>> {
 fn configuration(
     backend: &volpt::Backend,
     scene: &volpt::Scene,
-    ran: Option<volpt::cuda::Schedule>,
+    ran: Option<volpt::Schedule>,
 ) -> String {
     let mut s = backend.device_name();
     match (backend.strategy(), ran) {
@@ -702,7 +706,7 @@ fn configuration(
         (None, _) => {}
     }
     if let Some(cap @ Some(_)) = ran.map(|ran| ran.max_registers) {
-        let _ = write!(s, " with {}", volpt::auto::registers(cap));
+        let _ = write!(s, " with {}", volpt::registers(cap));
     }
     if let Some(math) = backend.math() {
         let _ = write!(s, ", {math} math");
@@ -710,8 +714,11 @@ fn configuration(
     let medium = &scene.description().medium;
     let grids = matches!(
         medium.density,
-        volpt_scene::description::DensityDesc::Grid(_)
-    ) || matches!(medium.albedo, volpt_scene::description::AlbedoDesc::Grid(_));
+        volpt::scene_files::description::DensityDesc::Grid(_)
+    ) || matches!(
+        medium.albedo,
+        volpt::scene_files::description::AlbedoDesc::Grid(_)
+    );
     if grids {
         let _ = write!(s, ", {} lookup", lookup_name(medium.lookup));
     }
@@ -759,7 +766,7 @@ fn summary(
 }
 
 /// What the safety bounds of the path settings cost the image, if they cut any path.
-fn truncation_warning(c: &volpt_core::PathCounters) -> Option<String> {
+fn truncation_warning(c: &volpt::PathCounters) -> Option<String> {
     (c.truncated > 0).then(|| {
         format!(
             "warning: {} of {} paths reached a safety bound and were dropped (the image is biased \
@@ -831,8 +838,8 @@ fn bench_command(args: BenchArgs) -> Result<()> {
     Ok(())
 }
 
-fn selftest(math: volpt_cuda::Math) -> Result<()> {
-    let renderer = volpt_cuda::CudaRenderer::new(0, math)?;
+fn selftest(math: Math) -> Result<()> {
+    let renderer = volpt::CudaRenderer::new(0, math)?;
     let mut failed = 0;
     for test in renderer.selftest()? {
         if test.failures.is_empty() {

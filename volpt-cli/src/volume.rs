@@ -2,7 +2,7 @@
 //! (docs/out-of-core.md).
 
 use clap::Args;
-use volpt_gpu_mem::VolumeMemory;
+use volpt::VolumeMemory;
 
 #[derive(Args, Clone, Debug, Default)]
 pub struct VolumeArgs {

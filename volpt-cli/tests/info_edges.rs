@@ -8,9 +8,9 @@
 use std::path::Path;
 use std::process::Command;
 
-use volpt_render::factory::Simplification;
-use volpt_scene::description::*;
-use volpt_scene::mitsuba::{write_mitsuba3, NO_ROULETTE_DEPTH};
+use volpt::scene_files::description::*;
+use volpt::scene_files::mitsuba::{write_mitsuba3, NO_ROULETTE_DEPTH};
+use volpt::scene_files::Simplification;
 
 /// A unit cube of 3x2x4 density samples of 2 (the last one `last`), a 2x2x2 albedo grid of
 /// (0.9, 0.7, 0.8) (green of the last sample `last_green`), Henyey-Greenstein `g`, a smooth
@@ -31,7 +31,7 @@ fn scene(g: f32, last: f32, last_green: f32, int_ior: f32) -> SceneDescription {
         let at = data.len() - last.len();
         data[at..].copy_from_slice(last);
         GridDesc {
-            layout: volpt_scene::SampleLayout::Dense,
+            layout: volpt::scene_files::SampleLayout::Dense,
             resolution,
             channels: sample.len() as u32,
             bounds,
@@ -49,6 +49,7 @@ fn scene(g: f32, last: f32, last_green: f32, int_ior: f32) -> SceneDescription {
             ],
             fov_degrees: 30.0,
             fov_axis: FovAxis::X,
+            projection: Projection::Perspective,
         },
         film: FilmDesc {
             width: 8,

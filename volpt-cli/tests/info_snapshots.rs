@@ -84,7 +84,7 @@ fn generated_thesis_scenes() {
         )
         .expect("copy scene");
     }
-    volpt_scene::generate::generate_scene_inputs(&scenes).expect("generate grids");
+    volpt::scene_files::generate::generate_scene_inputs(&scenes).expect("generate grids");
     insta::assert_snapshot!(
         "cgg-logo",
         info(dir.path(), "scenes/cgg-logo/scene.xml", &[])

@@ -108,6 +108,10 @@ pub struct CameraParams {
     pub tan_half_fov: [f32; 2],
     pub width: u32,
     pub height: u32,
+    /// 1 for an orthographic camera, 0 for a pinhole.
+    pub orthographic: u32,
+    /// Keeps the camera a multiple of 8 bytes ([`SceneParams::LAYOUT`]); always 0.
+    pub pad: u32,
 }
 
 impl From<&PerspectiveCamera> for CameraParams {
@@ -120,6 +124,8 @@ impl From<&PerspectiveCamera> for CameraParams {
             tan_half_fov: c.tan_half_fov.to_array(),
             width: c.width,
             height: c.height,
+            orthographic: u32::from(c.orthographic),
+            pad: 0,
         }
     }
 }
@@ -135,6 +141,7 @@ impl From<&CameraParams> for PerspectiveCamera {
             tan_half_fov: Vec2::from_array(c.tan_half_fov),
             width: c.width,
             height: c.height,
+            orthographic: c.orthographic != 0,
         }
     }
 }

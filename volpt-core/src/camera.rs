@@ -1,4 +1,5 @@
-//! The pinhole perspective camera, in Mitsuba's conventions.
+//! The camera, in Mitsuba's conventions: a pinhole (`perspective`) or, as a run-time branch of
+//! the same type, Mitsuba's `orthographic` sensor.
 
 use crate::{Ray, Vec2, Vec3};
 
@@ -12,10 +13,15 @@ pub struct PerspectiveCamera {
     pub axis_x: Vec3,
     pub axis_y: Vec3,
     pub axis_z: Vec3,
-    /// `tan(fov_x / 2)` and `tan(fov_y / 2)`.
+    /// `tan(fov_x / 2)` and `tan(fov_y / 2)`; for an orthographic camera, the film's half
+    /// extents in camera space instead: `(1, height / width)`, as Mitsuba 3 spans them.
     pub tan_half_fov: Vec2,
     pub width: u32,
     pub height: u32,
+    /// Mitsuba's `orthographic` sensor: parallel rays along `axis_z` from the film's position
+    /// `axis_x * x + axis_y * y` (camera-space `(x, y, 0)`; Mitsuba starts them at its near clip,
+    /// 0.01 along the axis, which differs only for a medium closer than that to the film).
+    pub orthographic: bool,
 }
 
 impl PerspectiveCamera {
@@ -26,6 +32,10 @@ impl PerspectiveCamera {
         let sy = (py as f32 + u.y) / self.height as f32;
         let x = (1.0 - 2.0 * sx) * self.tan_half_fov.x;
         let y = (1.0 - 2.0 * sy) * self.tan_half_fov.y;
+        if self.orthographic {
+            let origin = self.origin + self.axis_x * x + self.axis_y * y;
+            return Ray::new(origin, crate::math::normalize(self.axis_z));
+        }
         let dir = crate::math::normalize(self.axis_x * x + self.axis_y * y + self.axis_z);
         Ray::new(self.origin, dir)
     }

@@ -141,6 +141,8 @@ fn scene() -> Furnace {
             tan_half_fov: Vec2::new(0.3, 0.225),
             width: 8,
             height: 6,
+            // Not the default: the flag must survive the encoding too.
+            orthographic: true,
         },
         bounds: Aabb::new(Vec3::new(-1.0, -0.5, 0.0), Vec3::new(2.0, 1.5, 3.0)),
         medium: HomogeneousMedium {
@@ -194,6 +196,7 @@ fn a_scene_survives_the_device_encoding() {
         (b.origin, b.axis_x, b.axis_y, b.axis_z, b.tan_half_fov)
     );
     assert_eq!((a.width, a.height), (b.width, b.height));
+    assert_eq!(a.orthographic, b.orthographic);
     assert_eq!(decoded.bounds, scene.bounds);
     assert_eq!(decoded.settings, scene.settings);
     assert_eq!(decoded.medium.sigma_t, scene.medium.sigma_t);

@@ -19,6 +19,7 @@ fn camera() -> PerspectiveCamera {
         tan_half_fov: Vec2::new(0.75, 0.5),
         width: 12,
         height: 8,
+        orthographic: false,
     }
 }
 
@@ -104,4 +105,48 @@ fn jitter_covers_exactly_its_pixel() {
         assert!((corner.0 - right.0 - step.0).abs() < 1e-6 && (right.1 - corner.1).abs() < 1e-6);
         assert!((corner.1 - down.1 - step.1).abs() < 1e-6 && (down.0 - corner.0).abs() < 1e-6);
     }
+}
+
+/// Mitsuba 3's `orthographic` sensor: every ray along the camera's axis, starting on the film
+/// plane at camera-space `(x, y)` with `x` in [-1, 1] (image left to right: +1 to -1) and `y` in
+/// [-h/w, h/w], scaled by the to-world transform; `u` moves the start across its pixel.
+#[test]
+fn orthographic_rays_are_parallel_and_start_where_the_film_maps_them() {
+    let c = PerspectiveCamera {
+        orthographic: true,
+        tan_half_fov: Vec2::new(1.0, 8.0 / 12.0),
+        ..camera()
+    };
+    let axis = d(c.axis_z).normalize();
+    let start = |px, py, u| {
+        let r = c.generate_ray(px, py, u);
+        assert!(
+            (d(r.dir) - axis).length() < 1e-6,
+            "({px}, {py}): direction {}",
+            r.dir
+        );
+        d(r.origin)
+    };
+    let film = |x: f64, y: f64| d(c.origin) + d(c.axis_x) * x + d(c.axis_y) * y;
+    let (hx, hy) = (1.0, 8.0 / 12.0);
+    let close =
+        |a: DVec3, b: DVec3, what: &str| assert!((a - b).length() < 1e-5, "{what}: {a} vs {b}");
+    close(start(0, 0, Vec2::ZERO), film(hx, hy), "top left");
+    close(
+        start(c.width - 1, c.height - 1, Vec2::ONE),
+        film(-hx, -hy),
+        "bottom right",
+    );
+    close(
+        start(c.width / 2, c.height / 2, Vec2::ZERO),
+        film(0.0, 0.0),
+        "centre",
+    );
+    // One pixel across is 2 / width of the film's x extent.
+    let step = start(1, 0, Vec2::ZERO) - start(0, 0, Vec2::ZERO);
+    close(
+        step,
+        d(c.axis_x) * (-2.0 * hx / f64::from(c.width)),
+        "one pixel",
+    );
 }

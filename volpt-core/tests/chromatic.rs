@@ -48,6 +48,7 @@ fn camera() -> PerspectiveCamera {
         tan_half_fov: Vec2::new(0.15, 0.15),
         width: 4,
         height: 4,
+        orthographic: false,
     }
 }
 

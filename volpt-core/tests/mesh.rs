@@ -385,6 +385,7 @@ fn camera() -> PerspectiveCamera {
         tan_half_fov: Vec2::new(0.35, 0.3),
         width: 24,
         height: 20,
+        orthographic: false,
     }
 }
 

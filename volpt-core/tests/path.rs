@@ -31,6 +31,7 @@ fn camera() -> PerspectiveCamera {
         tan_half_fov: Vec2::new(0.6, 0.45),
         width: 8,
         height: 6,
+        orthographic: false,
     }
 }
 

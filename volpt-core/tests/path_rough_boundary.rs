@@ -32,6 +32,7 @@ fn rough_furnace(
             tan_half_fov: Vec2::new(0.6, 0.45),
             width: 8,
             height: 6,
+            orthographic: false,
         },
         bounds: Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0)),
         medium: HomogeneousMedium {

@@ -50,6 +50,25 @@ pub enum CheckpointError {
         expected: String,
         found: String,
     },
+    /// A film of samples that do not start at 0, which a checkpoint cannot hold.
+    #[error(
+        "{}: a checkpoint holds samples 0..n of every pixel; this film holds samples {}..{} \
+         (merge it with the films of the samples before it first)",
+        path.display(), samples.start, samples.end
+    )]
+    NotFromZero {
+        path: PathBuf,
+        samples: std::ops::Range<u32>,
+    },
+}
+
+/// What a checkpoint's header says: whose render it is and the film's size.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Header {
+    pub fingerprint: u64,
+    pub width: u32,
+    pub height: u32,
+    pub seed: u32,
 }
 
 /// FNV-1a, 64 bit: a checksum against damaged files, and the scene fingerprint's hash.
@@ -75,14 +94,8 @@ impl Fnv {
 }
 
 /// Appends `sums` (little-endian `f64`) and an FNV-1a checksum of everything before it to
-/// `header`, and writes the whole to `path` atomically: to a temporary file beside it, then
-/// renamed, so that an interruption while writing leaves the previous file intact. The tail of
-/// checkpoints and film files alike.
-pub(crate) fn write_sums_atomically(
-    mut bytes: Vec<u8>,
-    sums: &[[f64; 3]],
-    path: &Path,
-) -> std::io::Result<()> {
+/// `header`: the tail of checkpoints and film files alike.
+pub(crate) fn sealed(mut bytes: Vec<u8>, sums: &[[f64; 3]]) -> Vec<u8> {
     for sum in sums {
         for c in sum {
             bytes.extend_from_slice(&c.to_le_bytes());
@@ -91,11 +104,17 @@ pub(crate) fn write_sums_atomically(
     let mut fnv = Fnv::default();
     fnv.write(&bytes);
     bytes.extend_from_slice(&fnv.finish().to_le_bytes());
+    bytes
+}
+
+/// Writes `bytes` to `path` atomically: to a temporary file beside it, then renamed, so that an
+/// interruption while writing leaves the previous file intact.
+pub(crate) fn write_atomically(bytes: &[u8], path: &Path) -> std::io::Result<()> {
     let mut name = path.file_name().unwrap_or_default().to_owned();
     name.push(".partial");
     let partial = path.with_file_name(name);
     let mut file = std::fs::File::create(&partial)?;
-    file.write_all(&bytes)?;
+    file.write_all(bytes)?;
     file.sync_all()?;
     std::fs::rename(&partial, path)
 }
@@ -126,7 +145,43 @@ impl Checkpoint {
         for v in [film.width, film.height, seed, samples] {
             bytes.extend_from_slice(&v.to_le_bytes());
         }
-        write_sums_atomically(bytes, &film.sums, path).map_err(io)
+        write_atomically(&sealed(bytes, &film.sums), path).map_err(io)
+    }
+
+    /// The header of the checkpoint at `path`, unchecked but for its magic: what a caller that
+    /// knows no render reads it as ([`Checkpoint::read`] then checks the whole file against it).
+    pub fn header(path: &Path) -> Result<Header, CheckpointError> {
+        let corrupt = |problem: String| CheckpointError::Corrupt {
+            path: path.to_owned(),
+            problem,
+        };
+        let (file, length) =
+            crate::regular::open_regular(path).map_err(|e| CheckpointError::Io {
+                path: path.to_owned(),
+                source: e.into(),
+            })?;
+        let mut header = [0u8; HEADER];
+        if length < HEADER as u64 {
+            return Err(corrupt(format!(
+                "{length} bytes, shorter than a checkpoint's header ({HEADER})"
+            )));
+        }
+        file.take(HEADER as u64)
+            .read_exact(&mut header)
+            .map_err(|source| CheckpointError::Io {
+                path: path.to_owned(),
+                source,
+            })?;
+        if &header[..8] != MAGIC {
+            return Err(corrupt("it does not start with VOLPTCK1".into()));
+        }
+        let u32_at = |i: usize| u32::from_le_bytes(header[i..i + 4].try_into().expect("4 bytes"));
+        Ok(Header {
+            fingerprint: u64::from_le_bytes(header[8..16].try_into().expect("8 bytes")),
+            width: u32_at(16),
+            height: u32_at(20),
+            seed: u32_at(24),
+        })
     }
 
     /// Reads the checkpoint at `path` and checks that it belongs to a render of `fingerprint` and

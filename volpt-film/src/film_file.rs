@@ -27,11 +27,13 @@ use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
-use crate::checkpoint::{write_sums_atomically, Fnv};
+use crate::checkpoint::{sealed, write_atomically, Fnv};
 use crate::{Accumulation, Film};
 
 /// The film file's magic; the last byte is the format's version.
 pub const MAGIC: &[u8; 8] = b"VOLPTFL1";
+/// What errors of a film read from or encoded to bytes ([`FilmFile::from_bytes`]) name as its path.
+pub const BYTES: &str = "<film bytes>";
 /// A checkpoint's magic (`crate::checkpoint`): read as a film of samples `0..n`.
 const CHECKPOINT_MAGIC: &[u8; 8] = b"VOLPTCK1";
 /// Magic, fingerprint, width, height, seed, and the range count or (checkpoint) sample count.
@@ -71,6 +73,16 @@ pub enum FilmFileError {
         field: &'static str,
         expected: String,
         found: String,
+    },
+    /// A film of several sample ranges where one range was asked for.
+    #[error(
+        "{}: the film holds samples {}, not one range (merge it with the films of the samples \
+         between them first)",
+        path.display(), format_ranges(ranges)
+    )]
+    NotOneRange {
+        path: PathBuf,
+        ranges: Vec<Range<u32>>,
     },
     /// A film (its sums and its list of sample ranges) larger than the caller's memory limit
     /// (`--memory-limit`).
@@ -167,10 +179,27 @@ impl FilmFile {
     /// Writes the film to `path` atomically (a temporary file beside it, then renamed), so that an
     /// interruption leaves no half-written film under the name.
     pub fn write(&self, path: &Path) -> Result<(), FilmFileError> {
-        let io = |source| FilmFileError::Io {
+        let bytes = self.encode(path)?;
+        write_atomically(&bytes, path).map_err(|source| FilmFileError::Io {
             path: path.to_owned(),
             source,
-        };
+        })
+    }
+
+    /// The film file's bytes, as [`FilmFile::write`] writes them: how a film travels between
+    /// processes (Python's pickling) without a file. Errors name the film [`BYTES`].
+    pub fn to_bytes(&self) -> Result<Vec<u8>, FilmFileError> {
+        self.encode(Path::new(BYTES))
+    }
+
+    /// The film of [`FilmFile::to_bytes`]'s bytes, checked as [`FilmFile::read`] checks a file
+    /// (magic, length against `limit`, checksum, ranges).
+    pub fn from_bytes(bytes: &[u8], limit: u64) -> Result<Self, FilmFileError> {
+        Self::read_from(bytes, bytes.len() as u64, Path::new(BYTES), limit)
+    }
+
+    /// The bytes of the film file, or why it has none; `path` names it in errors.
+    fn encode(&self, path: &Path) -> Result<Vec<u8>, FilmFileError> {
         if let Some(problem) = ranges_problem(&self.ranges) {
             return Err(FilmFileError::Invalid {
                 path: path.to_owned(),
@@ -204,7 +233,7 @@ impl FilmFile {
             bytes.extend_from_slice(&r.start.to_le_bytes());
             bytes.extend_from_slice(&r.end.to_le_bytes());
         }
-        write_sums_atomically(bytes, &self.film.sums, path).map_err(io)
+        Ok(sealed(bytes, &self.film.sums))
     }
 
     /// Reads the film file (or checkpoint) at `path`, refusing one whose sample ranges and sums
@@ -213,6 +242,21 @@ impl FilmFile {
     /// The file is read as a stream (its checksum computed as it goes), so that nothing but the
     /// film itself is allocated, and a list of ranges is refused at its first bad range.
     pub fn read(path: &Path, limit: u64) -> Result<Self, FilmFileError> {
+        let (file, length) = crate::regular::open_regular(path).map_err(|e| FilmFileError::Io {
+            path: path.to_owned(),
+            source: e.into(),
+        })?;
+        // `take`: a file that grows while it is read stops at its length here.
+        Self::read_from(file.take(length), length, path, limit)
+    }
+
+    /// Reads a film file of `length` bytes from `file`, named `path` in errors.
+    fn read_from(
+        file: impl Read,
+        length: u64,
+        path: &Path,
+        limit: u64,
+    ) -> Result<Self, FilmFileError> {
         let corrupt = |field, expected: String, found: String| FilmFileError::Corrupt {
             path: path.to_owned(),
             field,
@@ -223,7 +267,6 @@ impl FilmFile {
             path: path.to_owned(),
             source,
         };
-        let (file, length) = crate::regular::open_regular(path).map_err(|e| io(e.into()))?;
         let mut header = [0u8; HEADER as usize];
         if length < HEADER + 8 {
             return Err(corrupt(
@@ -232,8 +275,7 @@ impl FilmFile {
                 format!("{length} bytes"),
             ));
         }
-        // `take`: a file that grows while it is read stops at the length checked here.
-        let mut file = BufReader::with_capacity(1 << 16, file.take(length));
+        let mut file = BufReader::with_capacity(1 << 16, file);
         file.read_exact(&mut header).map_err(io)?;
         let magic = &header[..8];
         let checkpoint = magic == CHECKPOINT_MAGIC;
@@ -430,6 +472,38 @@ mod tests {
         assert_eq!(&bytes[..8], MAGIC);
         assert_eq!(FilmFile::read(&path, u64::MAX).unwrap(), example());
         assert_eq!(example().samples(), 7);
+    }
+
+    /// The bytes a film travels as between processes are the file's, read back with the
+    /// file's checks.
+    #[test]
+    fn a_films_bytes_are_its_files_and_read_back_bit_for_bit() {
+        let dir = tempfile::tempdir().unwrap();
+        let (_, file_bytes) = written(dir.path());
+        let bytes = example().to_bytes().unwrap();
+        assert_eq!(bytes, file_bytes);
+        assert_eq!(FilmFile::from_bytes(&bytes, u64::MAX).unwrap(), example());
+        let mut damaged = bytes.clone();
+        damaged[40] ^= 1;
+        let error = FilmFile::from_bytes(&damaged, u64::MAX).unwrap_err();
+        assert!(
+            error
+                .to_string()
+                .starts_with("<film bytes>: not a volpt film file")
+                && error.to_string().contains("checksum"),
+            "{error}"
+        );
+        assert!(matches!(
+            FilmFile::from_bytes(&bytes, 10),
+            Err(FilmFileError::TooLarge { .. })
+        ));
+        assert!(matches!(
+            FilmFile::from_bytes(&bytes[..bytes.len() - 1], u64::MAX),
+            Err(FilmFileError::Corrupt {
+                field: "length",
+                ..
+            })
+        ));
     }
 
     #[test]

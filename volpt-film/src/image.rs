@@ -39,6 +39,23 @@ impl Image {
         self.pixels[(y * self.width + x) as usize]
     }
 
+    /// Writes the image as its file name's extension says: OpenEXR (`.exr`) or the PNG preview
+    /// (`.png`); another name is refused.
+    pub fn write(&self, path: &Path) -> Result<(), ImageError> {
+        let extension = path.extension().and_then(|e| e.to_str());
+        match extension.map(str::to_ascii_lowercase).as_deref() {
+            Some("exr") => self.write_exr(path),
+            Some("png") => self.write_png(path),
+            _ => Err(ImageError::Io {
+                path: path.to_owned(),
+                source: std::io::Error::new(
+                    std::io::ErrorKind::InvalidInput,
+                    "expected a file name ending in .exr or .png",
+                ),
+            }),
+        }
+    }
+
     pub fn write_exr(&self, path: &Path) -> Result<(), ImageError> {
         exr::prelude::write_rgb_file(path, self.width as usize, self.height as usize, |x, y| {
             let [r, g, b] = self.pixels[y * self.width as usize + x];

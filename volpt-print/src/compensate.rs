@@ -27,6 +27,7 @@
 //! orthographic top view, one pixel per surface texel).
 
 use thiserror::Error;
+use volpt::metrics::quantile;
 
 use crate::colour::{ciede2000, Lab, LinearRgb};
 use crate::halftone::{naive_mix, Halftone};
@@ -84,7 +85,8 @@ pub struct Iteration {
     /// CIEDE2000 of each texel's prediction against the target.
     pub delta_e: Vec<f64>,
     pub mean: f64,
-    /// 95th percentile (nearest rank) of `delta_e`.
+    /// 95th percentile of `delta_e` ([`volpt::metrics::quantile`]: linear between order
+    /// statistics, as NumPy's default).
     pub p95: f64,
 }
 
@@ -107,18 +109,6 @@ pub enum CompensateError<E: std::error::Error + 'static> {
         expected: String,
         found: String,
     },
-}
-
-/// The 95th percentile of `values` by nearest rank (the smallest value at least 95% of them do
-/// not exceed).
-pub fn percentile_95(values: &[f64]) -> f64 {
-    if values.is_empty() {
-        return f64::NAN;
-    }
-    let mut sorted = values.to_vec();
-    sorted.sort_by(f64::total_cmp);
-    let rank = (0.95 * sorted.len() as f64).ceil() as usize;
-    sorted[rank.clamp(1, sorted.len()) - 1]
 }
 
 /// The print whose surface texels aim for `aims` (`width` x `height`).
@@ -218,7 +208,7 @@ pub fn compensate<P: Predictor>(
         let iteration = Iteration {
             aims: std::mem::take(&mut aims),
             prediction,
-            p95: percentile_95(&delta_e),
+            p95: quantile(&delta_e, 0.95),
             delta_e,
             mean,
         };

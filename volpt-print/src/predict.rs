@@ -10,21 +10,16 @@
 //! black lower hemisphere: not offered yet). Paths are unlimited in length with Russian roulette
 //! from depth 5 (Mitsuba's defaults).
 //!
-//! **Camera.** One pixel per surface texel, looking straight down: a pinhole placed 1000 print
-//! widths above the print's centre whose field of view spans its top face exactly. Its rays meet
-//! the surface within 1/2000 rad of vertical, so a path entering a texel's top face at depth `d`
-//! is displaced by at most `d / 2000` from where an orthographic camera's would be (1.4 um at
-//! the thesis's 2.7 mm depth, against 42 um texels); an orthographic sensor replaces it when
-//! volpt-core has one. The pinhole needs square texels (`sx = sy`).
+//! **Camera.** One pixel per surface texel, looking straight down: Mitsuba's `orthographic`
+//! sensor over the print's top face, its film spanning the face exactly, whatever the texels'
+//! aspect.
 //!
-//! **Chromatic extinction.** The inks' extinction differs between R, G and B, which volpt's grid
-//! media do not carry yet (material-indexed volumes, issue 38, will); the prediction is rendered
-//! instead as three grey media, channel `c` with extinction `sigma_t[c]` and albedo
-//! `sigma_s[c] / sigma_t[c]` per voxel, taking channel `c` of each. That is exact in
-//! expectation: each channel of a chromatic render equals the grey render made with that
-//! channel's coefficients (the per-channel identity the materials issue tests). The scene is
-//! built once per print geometry; later predictions replace its grids ([`volpt::Scene::set_grid`]),
-//! so the backend re-uploads exactly what changed.
+//! **Materials.** The print is rendered as what it is: a material-indexed volume (volpt-scene's
+//! [`IndexedDesc`]: one byte per voxel naming a row of the material table, each material with its
+//! RGB `sigma_s`, `sigma_a` and its own `g`), one chromatic render giving the three channels. The
+//! scene is built once per print geometry and table; later predictions replace its indices
+//! ([`volpt::Scene::set_indices`]), so a backend re-uploads exactly what changed (one byte a
+//! voxel).
 //!
 //! **Noise.** Each prediction is an unbiased render of `spp` samples per texel and channel, made
 //! as two independent halves (seeds `seed` and `seed + 1`, the same each time: one print always
@@ -34,31 +29,26 @@
 //! `step` times the prediction's error, so a standard error well below the error the loop is
 //! removing is what "enough samples" means.
 
+use std::path::Path;
+
 use thiserror::Error;
+use volpt::scene_files::material::{IndexedDesc, MaterialDesc};
 use volpt::scene_files::{
     AlbedoDesc, BoundaryDesc, Bounds, BsdfDesc, CameraDesc, DensityDesc, EnvironmentDesc, FilmDesc,
-    FovAxis, GridConvention, GridDesc, GridLookup, GridStorage, IntegratorDesc, MediumDesc,
-    PhaseDesc, SampleLayout, SceneBuilder, SceneDescription, SceneError,
+    FovAxis, GridLookup, GridStorage, IntegratorDesc, MediumDesc, Projection, SceneBuilder,
+    SceneDescription, SceneError,
 };
 use volpt::{Backend, Quiet, RenderRequest, RenderSettings, Scene};
 
 use crate::colour::LinearRgb;
 use crate::compensate::Predictor;
+use crate::material::Material;
 use crate::print::VoxelPrint;
-
-/// How far above the print the pinhole sits, in print widths.
-const DISTANCE_IN_WIDTHS: f64 = 1000.0;
 
 #[derive(Debug, Error)]
 pub enum PredictError {
     #[error(transparent)]
     Volpt(#[from] volpt::Error),
-    #[error("the print: {field}: expected {expected}, found {found}")]
-    Print {
-        field: &'static str,
-        expected: String,
-        found: String,
-    },
 }
 
 /// Renders prints from above with volpt (see the module docs).
@@ -74,12 +64,12 @@ pub struct RenderPredictor {
     standard_error: Vec<LinearRgb>,
 }
 
-/// What fixes a prediction's scene apart from its grids' values.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// What fixes a prediction's scene apart from its voxels' indices.
+#[derive(Clone, Debug, PartialEq)]
 struct Geometry {
     resolution: [u32; 3],
     voxel_size: [f64; 3],
-    g: f32,
+    materials: Vec<MaterialDesc>,
     boundary: BsdfDesc,
     spp: u32,
 }
@@ -107,57 +97,28 @@ impl RenderPredictor {
         &self.standard_error
     }
 
-    fn geometry(&self, print: &VoxelPrint) -> Result<Geometry, PredictError> {
-        let [sx, sy, _] = print.voxel_size();
-        if sx != sy {
-            return Err(PredictError::Print {
-                field: "voxel_size",
-                expected: "square texels (x = y) for the pinhole top view".into(),
-                found: format!("{:?}", print.voxel_size()),
-            });
+    /// The scene a prediction of `print` renders (the module docs): to inspect it, export it
+    /// (volpt-scene's Mitsuba 3 writer) or render it otherwise.
+    pub fn description(&self, print: &VoxelPrint) -> Result<SceneDescription, SceneError> {
+        PrintScene {
+            print,
+            geometry: self.geometry(print),
         }
-        let g = print.materials()[0].g;
-        if let Some(m) = print.materials().iter().find(|m| m.g != g) {
-            return Err(PredictError::Print {
-                field: "materials.g",
-                expected: format!("one g for every material (the first's, {g})"),
-                found: format!("{} for {}", m.g, m.name),
-            });
-        }
-        Ok(Geometry {
+        .build(&[])
+    }
+
+    fn geometry(&self, print: &VoxelPrint) -> Geometry {
+        Geometry {
             resolution: print.resolution(),
             voxel_size: print.voxel_size(),
-            g,
+            materials: print.materials().iter().map(MaterialDesc::from).collect(),
             boundary: self.boundary,
             spp: self.spp,
-        })
+        }
     }
 }
 
-/// Channel `c`'s extinction grid and albedo grid (RGB, grey) of a print.
-fn channel_grids(print: &VoxelPrint, c: usize) -> (Vec<f32>, Vec<f32>) {
-    let per_material: Vec<(f32, f32)> = print
-        .materials()
-        .iter()
-        .map(|m| {
-            let t = m.sigma_s[c] + m.sigma_a[c];
-            (t, if t > 0.0 { m.sigma_s[c] / t } else { 0.0 })
-        })
-        .collect();
-    let density = print
-        .indices()
-        .iter()
-        .map(|&k| per_material[usize::from(k)].0)
-        .collect();
-    let albedo = print
-        .indices()
-        .iter()
-        .flat_map(|&k| [per_material[usize::from(k)].1; 3])
-        .collect();
-    (density, albedo)
-}
-
-/// The scene of a print's channel, built in code.
+/// The scene of a print, built in code.
 struct PrintScene<'a> {
     print: &'a VoxelPrint,
     geometry: Geometry,
@@ -176,31 +137,33 @@ impl SceneBuilder for PrintScene<'_> {
             min: [0.0; 3],
             max: size.map(|s| s as f32),
         };
-        let (density, albedo) = channel_grids(self.print, 0);
-        let grid = |channels, data| GridDesc {
-            resolution: self.geometry.resolution,
-            channels,
+        let volume = IndexedDesc::new(
+            Path::new("the print"),
+            self.geometry.materials.clone(),
+            self.geometry.resolution,
             bounds,
-            convention: GridConvention::Cell,
-            data,
-            layout: SampleLayout::Dense,
-        };
-        let distance = DISTANCE_IN_WIDTHS * size[0].max(size[1]);
-        let origin = [0.5 * size[0], 0.5 * size[1], size[2] + distance];
-        // Mitsuba's look-at frame: columns left, up, view direction, origin. Looking down -z
-        // with +y up puts +x to the image's right and +y at its top.
+            self.print.indices(),
+        )?;
+        // Mitsuba's camera frame, columns left, up, view direction and origin: looking down -z
+        // with +y up puts +x to the image's right and +y at its top. The orthographic film spans
+        // camera-space x in [-1, 1] and y in [-h/w, h/w]: scaling x by half the print's width and
+        // y by w/h times half its height maps the film onto the top face, one pixel per texel.
+        let aspect = f64::from(w) / f64::from(h);
+        let half = [0.5 * size[0], 0.5 * size[1] * aspect];
+        let above = size[2] + sz;
         let to_world = [
-            [-1.0, 0.0, 0.0, origin[0] as f32],
-            [0.0, 1.0, 0.0, origin[1] as f32],
-            [0.0, 0.0, -1.0, origin[2] as f32],
+            [-half[0] as f32, 0.0, 0.0, (0.5 * size[0]) as f32],
+            [0.0, half[1] as f32, 0.0, (0.5 * size[1]) as f32],
+            [0.0, 0.0, -1.0, above as f32],
             [0.0, 0.0, 0.0, 1.0],
         ];
-        let fov_x = 2.0 * (0.5 * size[0] / distance).atan();
         Ok(SceneDescription {
             camera: CameraDesc {
                 to_world,
-                fov_degrees: fov_x.to_degrees() as f32,
+                // Unused by an orthographic camera.
+                fov_degrees: 0.0,
                 fov_axis: FovAxis::X,
+                projection: Projection::Orthographic,
             },
             film: FilmDesc {
                 width: w,
@@ -216,14 +179,12 @@ impl SceneBuilder for PrintScene<'_> {
                 bsdf: self.geometry.boundary,
             },
             medium: MediumDesc {
-                density: DensityDesc::Grid(grid(1, density)),
+                phase: volume.phase(),
+                density: DensityDesc::Indexed(volume),
                 scale: 1.0,
-                albedo: AlbedoDesc::Grid(grid(3, albedo)),
-                phase: if self.geometry.g == 0.0 {
-                    PhaseDesc::Isotropic
-                } else {
-                    PhaseDesc::HenyeyGreenstein { g: self.geometry.g }
-                },
+                // Not read: each voxel's material gives its albedo.
+                albedo: AlbedoDesc::Constant([0.0; 3]),
+                // Not read either: a voxel is one material (no interpolation between indices).
                 lookup: GridLookup::Nearest,
                 storage: GridStorage::Dense,
             },
@@ -236,53 +197,63 @@ impl Predictor for RenderPredictor {
     type Error = PredictError;
 
     fn predict(&mut self, print: &VoxelPrint) -> Result<Vec<LinearRgb>, PredictError> {
-        let geometry = self.geometry(print)?;
-        if self.scene.as_ref().is_none_or(|(g, _)| *g != geometry) {
-            let builder = PrintScene { print, geometry };
-            // Nearest lookup chosen, not left to the backend's default (a voxel is one material).
-            let settings = RenderSettings {
-                lookup: Some(GridLookup::Nearest),
-                ..RenderSettings::default()
-            };
-            self.scene = Some((geometry, Scene::build(&builder, &settings)?));
-        }
-        let (_, scene) = self.scene.as_mut().expect("built above");
-        let [w, h, _] = geometry.resolution;
-        let mut texels = vec![LinearRgb([0.0; 3]); w as usize * h as usize];
-        let mut errors = texels.clone();
-        for c in 0..3 {
-            let (density, albedo) = channel_grids(print, c);
-            scene.set_grid("density", density)?;
-            scene.set_grid("albedo", albedo)?;
-            // Two independent halves (spp / 2 and the rest), averaged by their sample counts.
-            let halves = [self.spp / 2, self.spp - self.spp / 2];
-            let mut images = Vec::new();
-            for (k, &n) in halves.iter().enumerate() {
-                if n == 0 {
-                    continue;
-                }
-                let mut film = scene.film();
-                let request = RenderRequest::samples(0..n)
-                    .with_seed(self.seed.wrapping_add(k as u32))
-                    .with_lookup(GridLookup::Nearest);
-                self.backend.render(scene, &mut film, request, &Quiet)?;
-                images.push((f64::from(n), film.image(n)));
+        let geometry = self.geometry(print);
+        match &mut self.scene {
+            Some((built, scene)) if *built == geometry => scene.set_indices(print.indices())?,
+            _ => {
+                let builder = PrintScene {
+                    print,
+                    geometry: geometry.clone(),
+                };
+                self.scene = Some((
+                    geometry.clone(),
+                    Scene::build(&builder, &RenderSettings::default())?,
+                ));
             }
-            // Image row 0 is the print's top edge, texel row h - 1.
-            for y in 0..h {
-                for x in 0..w {
-                    let at = |image: &volpt::Image| f64::from(image.pixel(x, h - 1 - y)[c]);
-                    let i = (x + w * y) as usize;
-                    let total: f64 = images.iter().map(|(n, _)| n).sum();
-                    texels[i].0[c] = images.iter().map(|(n, im)| n * at(im)).sum::<f64>() / total;
-                    errors[i].0[c] = match images.as_slice() {
-                        [(_, a), (_, b)] => 0.5 * (at(a) - at(b)).abs(),
-                        _ => f64::INFINITY,
-                    };
-                }
+        }
+        let (_, scene) = self.scene.as_ref().expect("built above");
+        let [w, h, _] = geometry.resolution;
+        // Two independent halves (spp / 2 and the rest), averaged by their sample counts.
+        let halves = [self.spp / 2, self.spp - self.spp / 2];
+        let mut images = Vec::new();
+        for (k, &n) in halves.iter().enumerate() {
+            if n == 0 {
+                continue;
+            }
+            let mut film = scene.film();
+            let request = RenderRequest::samples(0..n).with_seed(self.seed.wrapping_add(k as u32));
+            self.backend.render(scene, &mut film, request, &Quiet)?;
+            images.push((f64::from(n), film.image(n)));
+        }
+        let total: f64 = images.iter().map(|(n, _)| n).sum();
+        let mut texels = Vec::with_capacity(w as usize * h as usize);
+        let mut errors = Vec::with_capacity(texels.capacity());
+        // Image row 0 is the print's top edge, texel row h - 1.
+        for y in 0..h {
+            for x in 0..w {
+                let at = |image: &volpt::Image| image.pixel(x, h - 1 - y).map(f64::from);
+                texels.push(LinearRgb([0, 1, 2].map(|c| {
+                    images.iter().map(|(n, im)| n * at(im)[c]).sum::<f64>() / total
+                })));
+                errors.push(LinearRgb(match images.as_slice() {
+                    [(_, a), (_, b)] => [0, 1, 2].map(|c| 0.5 * (at(a)[c] - at(b)[c]).abs()),
+                    _ => [f64::INFINITY; 3],
+                }));
             }
         }
         self.standard_error = errors;
         Ok(texels)
+    }
+}
+
+impl From<&Material> for MaterialDesc {
+    fn from(m: &Material) -> Self {
+        MaterialDesc {
+            name: m.name.clone(),
+            sigma_s: m.sigma_s,
+            sigma_a: m.sigma_a,
+            g: m.g,
+            colour: Some(m.colour),
+        }
     }
 }

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use volpt_render::{path_settings, render, with_scene, Image, RenderOptions, SceneVisitor};
 use volpt_scene::{
     AlbedoDesc, BoundaryDesc, Bounds, BsdfDesc, CameraDesc, Config, DensityDesc, EnvironmentDesc,
-    FilmDesc, FovAxis, GridConvention, GridDesc, IntegratorDesc, MediumDesc, PhaseDesc,
+    FilmDesc, FovAxis, GridConvention, GridDesc, IntegratorDesc, MediumDesc, PhaseDesc, Projection,
     SceneAssembler, SceneBuilder, SceneDescription, SceneError,
 };
 
@@ -45,6 +45,7 @@ impl SceneBuilder for Shell {
                 to_world,
                 fov_degrees: 30.0,
                 fov_axis: FovAxis::X,
+                projection: Projection::Perspective,
             },
             film: FilmDesc {
                 width: 256,

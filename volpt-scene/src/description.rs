@@ -57,14 +57,29 @@ pub enum FovAxis {
     Diagonal,
 }
 
-/// A pinhole perspective camera. Camera space is Mitsuba's: it looks along +z with +y up and +x to the
-/// left of the image; `to_world` maps camera space to world space.
+/// A camera: a pinhole (Mitsuba's `perspective`) or Mitsuba's `orthographic` sensor. Camera space
+/// is Mitsuba's: it looks along +z with +y up and +x to the left of the image; `to_world` maps
+/// camera space to world space.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct CameraDesc {
     pub to_world: Matrix4,
-    /// Full field of view in degrees along `fov_axis`.
+    /// Full field of view in degrees along `fov_axis` (a pinhole's; unused by an orthographic
+    /// camera).
     pub fov_degrees: f32,
     pub fov_axis: FovAxis,
+    pub projection: Projection,
+}
+
+/// How a camera maps the film to rays.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub enum Projection {
+    /// A pinhole: rays from `to_world`'s origin through the film (Mitsuba's `perspective`).
+    #[default]
+    Perspective,
+    /// Parallel rays along camera-space +z from the film at camera-space `(x, y, 0)`, `x` in
+    /// [-1, 1] and `y` in [-h/w, h/w], scaled by `to_world` (Mitsuba 3's `orthographic`: its
+    /// `to_world` scale sets the extent).
+    Orthographic,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

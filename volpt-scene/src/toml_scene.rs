@@ -610,6 +610,7 @@ fn finish(
             to_world,
             fov_degrees: c.fov,
             fov_axis,
+            projection: Projection::Perspective,
         },
         film: FilmDesc {
             width: file.film.width,

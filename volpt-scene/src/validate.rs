@@ -73,7 +73,9 @@ fn check(
         return Err(invalid("spp", "at least 1 sample per pixel", "0".into()));
     }
     let camera = &desc.camera;
-    if !(camera.fov_degrees > 0.0 && camera.fov_degrees < 180.0) {
+    // An orthographic camera's rays are parallel: it has no field of view.
+    let perspective = camera.projection == crate::description::Projection::Perspective;
+    if perspective && !(camera.fov_degrees > 0.0 && camera.fov_degrees < 180.0) {
         return Err(invalid(
             "camera fov",
             "an angle in degrees in (0, 180)",

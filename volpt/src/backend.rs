@@ -18,7 +18,7 @@ use volpt_scene::GridStorage;
 
 use crate::auto::{self, AutoCache};
 use crate::scene::Reading;
-use crate::{multi, Error, Observer, RenderRequest, Scene};
+use crate::{multi, Error, Named, Observer, RenderRequest, Scene};
 
 /// The kind of machine a render runs on.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -96,21 +96,28 @@ impl Gpus {
     pub fn ordinals(&self, count: usize) -> Result<Vec<usize>, Error> {
         match *self {
             Gpus::First => Ok(vec![0]),
-            Gpus::All if count == 0 => Err(Error::Settings(
-                "--gpus all: the CUDA driver sees no GPU on this machine".into(),
-            )),
+            Gpus::All if count == 0 => Err(Error::Setting {
+                key: "gpus",
+                expected: "GPUs the CUDA driver sees (it sees none on this machine)".into(),
+                found: self.to_string(),
+            }),
             Gpus::All => Ok((0..count).collect()),
-            Gpus::List(0) => Err(Error::Settings(
-                "--gpus: expected at least one GPU, found none".into(),
-            )),
+            Gpus::List(0) => Err(Error::Setting {
+                key: "gpus",
+                expected: "at least one GPU".into(),
+                found: "none".into(),
+            }),
             Gpus::List(mask) => {
                 let ordinals: Vec<usize> = (0..64).filter(|i| mask & (1 << i) != 0).collect();
                 match ordinals.iter().find(|&&o| o >= count) {
-                    Some(o) => Err(Error::Settings(format!(
-                        "--gpus {self}: expected GPUs numbered 0 to {}, found GPU {o} (the CUDA \
-                         driver sees {count} GPUs)",
-                        count.saturating_sub(1)
-                    ))),
+                    Some(o) => Err(Error::Setting {
+                        key: "gpus",
+                        expected: format!(
+                            "GPUs numbered 0 to {} (the CUDA driver sees {count} GPUs)",
+                            count.saturating_sub(1)
+                        ),
+                        found: format!("GPU {o} in {self}"),
+                    }),
                     None => Ok(ordinals),
                 }
             }
@@ -217,7 +224,7 @@ impl Backend {
     }
 
     /// Opens the backend `options` name; options out of their bounds ([`MAX_REGISTERS`],
-    /// [`REFILL_AT`]) or that do not apply to it are refused.
+    /// [`REFILL_AT`], [`TILES`]) or that do not apply to it are refused.
     pub fn open(options: &BackendOptions) -> Result<Self, Error> {
         let gpu = &options.gpu;
         check_bounds(gpu)?;
@@ -450,10 +457,10 @@ impl Backend {
     ) -> Result<Rendered, Error> {
         let (width, height) = scene.resolution();
         if (film.width, film.height) != (width, height) {
-            return Err(Error::Settings(format!(
-                "the film is {}x{} but the scene renders {width}x{height}",
-                film.width, film.height
-            )));
+            return Err(Error::FilmSize {
+                film: (film.width, film.height),
+                scene: (width, height),
+            });
         }
         let desc = scene.read_as(self.reading(scene, request))?;
         let path = request.path.unwrap_or(scene.path_settings());
@@ -513,6 +520,9 @@ pub const MAX_REGISTERS: RangeInclusive<u32> = 16..=255;
 /// regeneration-sk's refill thresholds ([`GpuOptions::refill_at`]): idle lanes of a 32-lane warp.
 pub const REFILL_AT: RangeInclusive<u32> = 1..=32;
 
+/// The columns and the rows of tiles an image may be cut into ([`GpuOptions::tiles`]).
+pub const TILES: RangeInclusive<u32> = 1..=4096;
+
 /// Refuses a GPU option out of its bounds with [`Error::Setting`], whichever backend it is for.
 fn check_bounds(gpu: &GpuOptions) -> Result<(), Error> {
     let bound = |key, range: &RangeInclusive<u32>, value: Option<u32>| match value {
@@ -524,55 +534,81 @@ fn check_bounds(gpu: &GpuOptions) -> Result<(), Error> {
         _ => Ok(()),
     };
     bound("max_registers", &MAX_REGISTERS, gpu.max_registers)?;
-    bound("refill_at", &REFILL_AT, gpu.refill_at)
+    bound("refill_at", &REFILL_AT, gpu.refill_at)?;
+    match gpu.tiles {
+        Some([c, r]) if !(TILES.contains(&c) && TILES.contains(&r)) => Err(Error::Setting {
+            key: "tiles",
+            expected: format!(
+                "columns and rows of {} to {} each",
+                TILES.start(),
+                TILES.end()
+            ),
+            found: format!("{c},{r}"),
+        }),
+        _ => Ok(()),
+    }
 }
 
-/// Refuses GPU options for the CPU backend, naming the option and what to do.
+/// Refuses GPU options for the CPU backend, naming the option and why.
 fn refuse_on_cpu(gpu: &GpuOptions) -> Result<(), Error> {
-    let refuse = |message: String| Err(Error::Settings(message));
+    let refuse = |key: &'static str, value: String, why: &str| {
+        Err(
+            Error::conflict(key, value, BackendKind::KEY, BackendKind::Cpu.name(), why)
+                .or_use(BackendKind::KEY, BackendKind::Cuda.name()),
+        )
+    };
     if let Some(strategy) = gpu.strategy {
-        return refuse(format!(
-            "--strategy {strategy} schedules GPU work; the CPU backend has no strategies (use \
-             --backend cuda, or drop --strategy)"
-        ));
+        return refuse(
+            StrategyChoice::KEY,
+            strategy.to_string(),
+            "a strategy schedules GPU work, and the CPU backend has no strategies",
+        );
     }
     if let Some(n) = gpu.max_registers {
-        return refuse(format!(
-            "--max-registers {n} caps the GPU kernels' registers; the CPU backend has none (use \
-             --backend cuda, or drop --max-registers)"
-        ));
+        return refuse(
+            "max_registers",
+            n.to_string(),
+            "the cap is on the GPU kernels' registers, and the CPU backend has none",
+        );
     }
     if let Some(n) = gpu.refill_at {
-        return refuse(format!(
-            "--refill-at {n} sets a GPU strategy's refill threshold; the CPU backend has no \
-             strategies (use --backend cuda, or drop --refill-at)"
-        ));
+        return refuse(
+            "refill_at",
+            n.to_string(),
+            "the threshold is a GPU strategy's, and the CPU backend has no strategies",
+        );
     }
     if let Some([c, r]) = gpu.tiles {
-        return refuse(format!(
-            "--tiles {c},{r} splits the GPU's launches; the CPU backend has no launches (use \
-             --backend cuda, or drop --tiles)"
-        ));
+        return refuse(
+            "tiles",
+            format!("{c},{r}"),
+            "tiles split the GPU's launches, and the CPU backend has no launches",
+        );
     }
     if let Some(math) = gpu.math {
-        return refuse(format!(
-            "--math {math} chooses the GPU's kernels; the CPU backend always computes exactly \
-             (use --backend cuda, or drop --math)"
-        ));
+        return refuse(
+            Math::KEY,
+            math.name().to_owned(),
+            "math chooses the GPU's kernels, and the CPU backend always computes exactly",
+        );
     }
     if gpu.gpus != Gpus::First {
-        return refuse(format!(
-            "--gpus {} renders on GPUs; the CPU backend uses every core already (use --backend \
-             cuda, or drop --gpus)",
-            gpu.gpus
-        ));
-    }
-    if gpu.volume_memory.is_some() || gpu.device_memory_budget.is_some() || gpu.bricked {
         return refuse(
-            "--volume-memory, --device-memory-budget and --bricked place grids for the GPU; the \
-             CPU backend reads them where they were loaded (use --backend cuda, or drop them)"
-                .into(),
+            "gpus",
+            gpu.gpus.to_string(),
+            "the CPU backend uses every core already",
         );
+    }
+    let placement = "the volume options place grids for the GPU, and the CPU backend reads them \
+                     where they were loaded";
+    if let Some(memory) = gpu.volume_memory {
+        return refuse(VolumeMemory::KEY, memory.name().to_owned(), placement);
+    }
+    if let Some(bytes) = gpu.device_memory_budget {
+        return refuse("device_memory_budget", bytes.to_string(), placement);
+    }
+    if gpu.bricked {
+        return refuse("bricked", "true".to_owned(), placement);
     }
     Ok(())
 }
@@ -586,35 +622,47 @@ fn schedule(gpu: &GpuOptions) -> Result<Option<Schedule>, Error> {
     } else {
         StrategyChoice::Auto
     };
-    let refuse = |message: String| Err(Error::Settings(message));
-    match gpu.strategy.unwrap_or(default) {
+    let strategy = gpu.strategy.unwrap_or(default);
+    let refuse = |key: &'static str, value: String, why: &str| {
+        Err(
+            Error::conflict(key, value, StrategyChoice::KEY, strategy, why)
+                .or_use(StrategyChoice::KEY, Strategy::RegenerationSk),
+        )
+    };
+    match strategy {
         StrategyChoice::Auto => {
             if let Some([c, r]) = gpu.tiles {
-                return refuse(format!(
-                    "--tiles {c},{r} with --strategy auto: name a strategy to tile its launches"
-                ));
+                return refuse(
+                    "tiles",
+                    format!("{c},{r}"),
+                    "auto chooses the strategy, and tiles split one strategy's launches",
+                );
             }
             if let Some(n) = gpu.refill_at {
-                return refuse(format!(
-                    "--refill-at {n} with --strategy auto: name the strategy (--strategy \
-                     regeneration-sk) to set its refill threshold"
-                ));
+                return refuse(
+                    "refill_at",
+                    n.to_string(),
+                    "auto chooses the strategy, and the refill threshold is one strategy's",
+                );
             }
             if let Some(n) = gpu.max_registers {
-                return refuse(format!(
-                    "--max-registers {n} with --strategy auto: auto chooses the register cap too \
-                     (name a strategy to set it)"
-                ));
+                return refuse(
+                    "max_registers",
+                    n.to_string(),
+                    "auto chooses the register cap too",
+                );
             }
             Ok(None)
         }
-        StrategyChoice::Fixed(strategy)
-            if gpu.refill_at.is_some() && strategy != Strategy::RegenerationSk =>
+        StrategyChoice::Fixed(other)
+            if gpu.refill_at.is_some() && other != Strategy::RegenerationSk =>
         {
-            refuse(format!(
-                "--refill-at sets regeneration-sk's refill threshold; {strategy} schedules paths \
-                 otherwise (use --strategy regeneration-sk)"
-            ))
+            refuse(
+                "refill_at",
+                gpu.refill_at.unwrap_or_default().to_string(),
+                "the refill threshold is regeneration-sk's; this strategy schedules paths \
+                 otherwise",
+            )
         }
         StrategyChoice::Fixed(strategy) => Ok(Some(Schedule {
             strategy,

@@ -7,11 +7,11 @@
 //! sample order, so the resumed render's image is the uninterrupted one's bit for bit.
 
 use std::ops::Range;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use volpt_film::checkpoint::Checkpoint;
-use volpt_film::{Film, FilmFile};
+use volpt_film::checkpoint::{Checkpoint, CheckpointError};
+use volpt_film::{Film, FilmFile, FilmFileError};
 
 use crate::films::{merge_films, MergeError, Merged};
 use crate::{Backend, Error, Observer, RenderRequest, Rendered, Scene};
@@ -34,9 +34,11 @@ pub fn render_checkpointed(
     observer: &dyn Observer,
 ) -> Result<(Film, Rendered), Error> {
     if checkpointing.interval.is_zero() {
-        return Err(Error::Settings(
-            "--checkpoint-interval must be a positive number of seconds".into(),
-        ));
+        return Err(Error::Setting {
+            key: "checkpoint_interval",
+            expected: "a positive number of seconds".into(),
+            found: format!("{:?}", checkpointing.interval),
+        });
     }
     let spp = scene.spp();
     let fingerprint = backend.fingerprint(scene, &RenderRequest::samples(0..spp))?;
@@ -50,11 +52,17 @@ pub fn render_checkpointed(
                 volpt_scene::limits::memory_limit(),
             )?;
             if state.samples > spp {
-                return Err(Error::Settings(format!(
-                    "{}: the checkpoint holds {} samples per pixel, more than the {spp} asked for",
+                return Err(Error::conflict(
+                    "spp",
+                    spp,
+                    "resume",
                     path.display(),
-                    state.samples
-                )));
+                    format!(
+                        "the checkpoint holds {} samples per pixel, more than the {spp} asked \
+                         for",
+                        state.samples
+                    ),
+                ));
             }
             observer.note(&format!(
                 "resuming from {} at sample {}\n",
@@ -170,4 +178,105 @@ pub fn merge(parts: Vec<Part>) -> Result<Part, Error> {
         samples,
         film,
     })
+}
+
+impl Part {
+    /// Saves the part as a checkpoint, which `volpt render --resume` continues: a checkpoint holds
+    /// samples `0..n`, so a part of later samples is refused.
+    pub fn save_checkpoint(&self, path: &Path) -> Result<(), Error> {
+        if self.samples.start != 0 {
+            return Err(CheckpointError::NotFromZero {
+                path: path.to_owned(),
+                samples: self.samples.clone(),
+            }
+            .into());
+        }
+        Ok(Checkpoint::write_film(
+            path,
+            self.fingerprint,
+            self.seed,
+            self.samples.end,
+            &self.film,
+        )?)
+    }
+
+    /// The checkpoint at `path` as the part of its samples `0..n`. With `scene`, a checkpoint of
+    /// another scene (fingerprint) or film size is refused; without, the checkpoint is read as
+    /// its header says, and its checksum checked.
+    pub fn read_checkpoint(path: &Path, scene: Option<&Scene>) -> Result<Part, Error> {
+        let header = Checkpoint::header(path);
+        let (fingerprint, size, seed) = match (scene, header) {
+            // The scene's, where the header is unreadable: the reader then says why.
+            (Some(scene), header) => (
+                scene.fingerprint(),
+                scene.resolution(),
+                header.map_or(scene.seed(), |h| h.seed),
+            ),
+            (None, header) => {
+                let h = header?;
+                (h.fingerprint, (h.width, h.height), h.seed)
+            }
+        };
+        let limit = volpt_scene::limits::memory_limit();
+        let checkpoint = Checkpoint::read(path, fingerprint, size, seed, limit)?;
+        Ok(Part {
+            fingerprint: checkpoint.fingerprint,
+            seed: checkpoint.seed,
+            samples: 0..checkpoint.samples,
+            film: checkpoint.film,
+        })
+    }
+
+    /// The part as a film file ([`FilmFile`]) of its one range.
+    pub fn film_file(&self) -> FilmFile {
+        FilmFile {
+            fingerprint: self.fingerprint,
+            seed: self.seed,
+            ranges: vec![self.samples.clone()],
+            film: self.film.clone(),
+        }
+    }
+
+    /// The part of a film file of one range; `path` names it in the refusal of several.
+    fn of_film_file(file: FilmFile, path: &Path) -> Result<Part, Error> {
+        let samples = match file.ranges.as_slice() {
+            [range] => range.clone(),
+            ranges => {
+                return Err(FilmFileError::NotOneRange {
+                    path: path.to_owned(),
+                    ranges: ranges.to_vec(),
+                }
+                .into())
+            }
+        };
+        Ok(Part {
+            fingerprint: file.fingerprint,
+            seed: file.seed,
+            samples,
+            film: file.film,
+        })
+    }
+
+    /// Writes the part as a film file (`VOLPTFL1`, what `volpt render --film` writes), atomically.
+    pub fn write_film(&self, path: &Path) -> Result<(), Error> {
+        Ok(self.film_file().write(path)?)
+    }
+
+    /// The part of the film file (or checkpoint) at `path`; a film of several ranges (a merge
+    /// with gaps) is refused.
+    pub fn read_film(path: &Path) -> Result<Part, Error> {
+        Self::of_film_file(crate::read_film(path)?, path)
+    }
+
+    /// The part as the film file's bytes: how it travels between processes without a file.
+    pub fn to_bytes(&self) -> Result<Vec<u8>, Error> {
+        Ok(self.film_file().to_bytes()?)
+    }
+
+    /// The part of [`Part::to_bytes`]'s bytes, checked as a film file is.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Part, Error> {
+        let limit = volpt_scene::limits::memory_limit();
+        let file = FilmFile::from_bytes(bytes, limit)?;
+        Self::of_film_file(file, Path::new(volpt_film::film_file::BYTES))
+    }
 }

@@ -13,8 +13,8 @@ use std::ops::Range;
 use std::path::Path;
 
 use thiserror::Error;
+pub use volpt_film::film_file::FilmFile;
 use volpt_film::film_file::{format_ranges, normalize_ranges};
-pub use volpt_film::film_file::{FilmFile, FilmFileError};
 
 use crate::Error;
 

@@ -69,18 +69,22 @@ pub fn describe(
         "film",
         format!("{}x{}, {} spp", desc.film.width, desc.film.height, desc.spp),
     );
+    let origin = [
+        desc.camera.to_world[0][3],
+        desc.camera.to_world[1][3],
+        desc.camera.to_world[2][3],
+    ];
     field(
         "camera",
-        format!(
-            "origin {:?}, fov {} deg along {:?}",
-            [
-                desc.camera.to_world[0][3],
-                desc.camera.to_world[1][3],
-                desc.camera.to_world[2][3]
-            ],
-            desc.camera.fov_degrees,
-            desc.camera.fov_axis
-        ),
+        match desc.camera.projection {
+            volpt_scene::description::Projection::Perspective => format!(
+                "origin {origin:?}, fov {} deg along {:?}",
+                desc.camera.fov_degrees, desc.camera.fov_axis
+            ),
+            volpt_scene::description::Projection::Orthographic => {
+                format!("orthographic, film centre {origin:?}")
+            }
+        },
     );
     let depth = |d: Option<u32>| d.map_or("unlimited".to_owned(), |d| d.to_string());
     field(

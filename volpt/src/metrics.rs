@@ -75,10 +75,14 @@ impl Errors {
     /// The bias left when the variances of the estimate and of `reference` are taken out of the
     /// MSE (0 where the noise of the MSE makes it negative).
     pub fn bias(&self, reference: &Reference) -> f64 {
-        (self.mse - self.variance - reference.variance())
-            .max(0.0)
-            .sqrt()
+        bias(self.mse, self.variance, reference.variance())
     }
+}
+
+/// The bias left of `mse` when the variances of the estimate and of the reference are taken out
+/// (0 where the noise of the MSE makes it negative).
+pub fn bias(mse: f64, variance: f64, reference_variance: f64) -> f64 {
+    (mse - variance - reference_variance).max(0.0).sqrt()
 }
 
 /// The errors of the mean of films `a` and `b` (independent halves of `spp_each` samples each)

@@ -19,7 +19,7 @@ use volpt_scene::{
 };
 
 use crate::settings::RenderSettings;
-use crate::Error;
+use crate::{Error, Named};
 
 /// A scene ready to render: its description, the path settings and variant choice it renders with,
 /// and its seed.
@@ -522,9 +522,24 @@ impl Scene {
                     _ => up = value,
                 }
                 self.up = up;
-                self.desc.camera.to_world = look_at(origin, target, up).ok_or_else(|| {
+                let before = self.desc.camera.to_world;
+                let mut to_world = look_at(origin, target, up).ok_or_else(|| {
                     wrong("a camera whose direction (target - origin) and up are non-zero and not parallel")
                 })?;
+                // An orthographic film's extent is its frame's scale: moving it keeps that.
+                if self.desc.camera.projection == volpt_scene::description::Projection::Orthographic
+                {
+                    for j in 0..3 {
+                        let scale = (0..3).map(|i| before[i][j].powi(2)).sum::<f32>().sqrt();
+                        (0..3).for_each(|i| to_world[i][j] *= scale);
+                    }
+                }
+                self.desc.camera.to_world = to_world;
+            }
+            "camera.fov"
+                if d.camera.projection == volpt_scene::description::Projection::Orthographic =>
+            {
+                return Err(wrong("no field of view: the camera is orthographic (its to_world scale sets the extent)"));
             }
             "camera.fov" => {
                 d.camera.fov_degrees = float(&|v| v > 0.0 && v < 180.0, "degrees in (0, 180)")?
@@ -616,6 +631,41 @@ impl Scene {
             return Ok(());
         }
         let old = std::mem::replace(self.grid_values(name), values);
+        self.renew_data(name, |scene| *scene.grid_values(name) = old)
+    }
+
+    /// Replaces the material index of every voxel of the medium's material-indexed volume
+    /// ([`volpt_scene::material::IndexedDesc::set_indices`]: one byte per voxel, x fastest, each below the
+    /// table's length) — a printing application's next iteration. New indices are new data, as
+    /// [`Scene::set_grid`]'s new values are; the same indices change nothing; a refusal (a medium
+    /// without indices, the wrong count, an index past the table) leaves the scene as it was.
+    pub fn set_indices(&mut self, indices: &[u8]) -> Result<(), Error> {
+        let DensityDesc::Indexed(volume) = &mut self.desc.medium.density else {
+            return Err(Error::Grid {
+                grid: "indices".to_owned(),
+                expected: "a material-indexed medium".to_owned(),
+                found: "a medium without material indices".to_owned(),
+            });
+        };
+        let old = volume.clone();
+        volume
+            .set_indices(indices)
+            .map_err(|problem| volpt_scene::SceneError::Material {
+                path: self.source.clone().into(),
+                problem,
+            })?;
+        if *volume == old {
+            return Ok(());
+        }
+        self.renew_data("indices", |scene| {
+            scene.desc.medium.density = DensityDesc::Indexed(old);
+        })
+    }
+
+    /// Checks the scene after grid `name`'s data changed, as a loaded scene's are: if it passes,
+    /// the data is new (its own identity: nothing kept of the old data is read again), else
+    /// `restore` puts the old data back and the check's error names the grid.
+    fn renew_data(&mut self, name: &str, restore: impl FnOnce(&mut Self)) -> Result<(), Error> {
         let checked = volpt_scene::validate::validate(&self.desc, &self.source)
             .map_err(|error| match error {
                 volpt_scene::SceneError::InvalidScene {
@@ -623,7 +673,11 @@ impl Scene {
                     expected,
                     found,
                     ..
-                } => wrong(format!("{expected} (the scene's {field})"), found),
+                } => Error::Grid {
+                    grid: name.to_owned(),
+                    expected: format!("{expected} (the scene's {field})"),
+                    found,
+                },
                 error => Error::Scene(error),
             })
             .and_then(|checked| {
@@ -631,13 +685,12 @@ impl Scene {
             });
         match checked {
             Ok(checked) => {
-                // New values, new identity: nothing kept of the old values is read again.
                 self.data = Arc::new(DataFacts::new(checked));
                 self.changed();
                 Ok(())
             }
             Err(error) => {
-                *self.grid_values(name) = old;
+                restore(self);
                 Err(error)
             }
         }
@@ -771,22 +824,28 @@ fn check_lookup(
     let texture = matches!(lookup, GridLookup::Texture | GridLookup::TextureHalf);
     let sparse = (desc.medium.grids()).any(|(_, g)| g.layout == SampleLayout::Sparse);
     if texture && sparse {
-        return Err(Error::Settings(
-            "--lookup texture and texture-f16 read dense grids, and this scene's grid is kept \
-             sparse (a VDB): use trilinear, stochastic or nearest lookups, or read the VDB dense \
-             (sparse = \"never\" in a TOML scene)"
+        return Err(Error::Setting {
+            key: GridLookup::KEY,
+            expected: "a lookup of sparse grids for this scene's grid, kept sparse (a VDB): \
+                       trilinear, stochastic or nearest (textures hold dense grids; a TOML scene \
+                       reads a VDB dense with sparse = \"never\")"
                 .to_owned(),
-        ));
+            found: lookup.name().to_owned(),
+        });
     }
     if lookup != GridLookup::TextureHalf {
         return Ok(());
     }
     for (name, largest) in desc.medium.largest_values(checked) {
         if largest > HALF_MAX {
-            return Err(Error::Settings(format!(
-                "--lookup texture-f16: the medium's largest {name} is {largest}, above half \
-                 precision's largest value, {HALF_MAX} (use --lookup texture: f32 texels)"
-            )));
+            return Err(Error::Setting {
+                key: GridLookup::KEY,
+                expected: format!(
+                    "a lookup that holds the medium's largest {name}, {largest}: texture (f32 \
+                     texels), not texture-f16, whose largest value is {HALF_MAX}"
+                ),
+                found: lookup.name().to_owned(),
+            });
         }
     }
     Ok(())

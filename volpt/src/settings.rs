@@ -9,7 +9,7 @@ use volpt_core::{Estimator, PathSettings, Roulette};
 use volpt_render::{path_settings, Effects};
 use volpt_scene::{Config, GridLookup, SceneDescription};
 
-use crate::Error;
+use crate::{Error, Named};
 
 /// How a render traces and samples, over the scene file's values.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -88,21 +88,40 @@ impl RenderSettings {
 
     /// The scene's integrator settings with these tracking, estimator and roulette choices.
     pub fn path_settings(&self, desc: &SceneDescription) -> Result<PathSettings, Error> {
-        let mut settings = path_settings(desc);
-        settings.majorant_resolution = match (self.tracking, self.majorant_resolution) {
-            (Some(Tracking::Global), Some(r)) if r > 1 => {
-                return Err(Error::Settings(format!(
-                    "--tracking global uses one majorant; --majorant-resolution {r} asks for a \
-                     grid"
-                )))
-            }
-            (Some(Tracking::Global), _) => 1,
-            (_, Some(r)) => check_majorant_resolution(r)?,
-            (Some(Tracking::Grid), None) if settings.majorant_resolution <= 1 => {
-                PathSettings::DEFAULT_MAJORANT_RESOLUTION
-            }
-            (_, None) => settings.majorant_resolution,
-        };
+        self.path_over(path_settings(desc))
+    }
+
+    /// `base` (a scene's path settings, [`crate::Scene::path_settings`]) with these settings'
+    /// choices of depths, tracking and majorant resolution, estimator and roulette over it,
+    /// checked as [`crate::Scene::load`] checks them: the path settings of a
+    /// [`crate::RenderRequest`] that asks for other choices than its scene's.
+    pub fn path_over(&self, base: PathSettings) -> Result<PathSettings, Error> {
+        let mut settings = base;
+        let depth = |d: Option<u32>| d.unwrap_or(PathSettings::UNLIMITED);
+        if let Some(max_depth) = self.max_depth {
+            settings.max_depth = depth(max_depth);
+        }
+        if let Some(rr_depth) = self.rr_depth {
+            settings.rr_depth = depth(rr_depth);
+        }
+        settings.majorant_resolution =
+            match (self.tracking, self.majorant_resolution) {
+                (Some(Tracking::Global), Some(r)) if r > 1 => return Err(Error::conflict(
+                    "majorant_resolution",
+                    r,
+                    Tracking::KEY,
+                    Tracking::Global.name(),
+                    "global tracking uses one majorant, and a resolution above 1 asks for a grid \
+                     of them",
+                )
+                .or_use(Tracking::KEY, Tracking::Grid.name())),
+                (Some(Tracking::Global), _) => 1,
+                (_, Some(r)) => check_majorant_resolution(r)?,
+                (Some(Tracking::Grid), None) if settings.majorant_resolution <= 1 => {
+                    PathSettings::DEFAULT_MAJORANT_RESOLUTION
+                }
+                (_, None) => settings.majorant_resolution,
+            };
         if let Some(roulette) = self.roulette {
             settings.roulette = roulette;
         }

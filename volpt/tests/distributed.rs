@@ -337,6 +337,19 @@ fn gpus_are_refused_on_the_cpu_and_named_as_given() {
             ..Default::default()
         },
     };
-    let err = Backend::open(&options).err().unwrap().to_string();
-    assert!(err.contains("--gpus all"), "{err}");
+    let err = Backend::open(&options).err().unwrap();
+    assert!(
+        matches!(
+            &err,
+            volpt::Error::Conflict { key: "gpus", value, with: "backend", with_value, .. }
+                if value == "all" && with_value == "cpu"
+        ),
+        "{err}"
+    );
+    // Each front end spells the keys its own way.
+    let flags = err.spelled(&|key, value| format!("--{key} {}", value.unwrap_or_default()));
+    assert!(
+        flags.starts_with("--gpus all with --backend cpu: "),
+        "{flags}"
+    );
 }

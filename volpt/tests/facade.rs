@@ -173,6 +173,55 @@ fn the_camera_moves_as_a_lookat_in_the_scene_file_does() {
     }
 }
 
+/// The example's sensor made orthographic (its film 1.4 units wide), at `origin` looking at
+/// `target`.
+fn orthographic_example(dir: &Path, origin: &str, target: &str) -> PathBuf {
+    edited_example(
+        dir,
+        &[
+            (
+                r#"<sensor type="perspective">"#,
+                r#"<sensor type="orthographic">"#,
+            ),
+            (r#"<float name="fov" value="30"/>"#, ""),
+            (
+                r#"<lookat origin="3.2, 2.4, 4" target="0, -0.1, 0" up="0, 1, 0"/>"#,
+                &format!(
+                    r#"<scale value="0.7"/><lookat origin="{origin}" target="{target}" up="0, 1, 0"/>"#
+                ),
+            ),
+        ],
+    )
+}
+
+#[test]
+fn an_orthographic_camera_moved_keeps_its_extent_and_takes_no_field_of_view() {
+    let dir = tempfile::tempdir().unwrap();
+    let example = orthographic_example(dir.path(), "3.2, 2.4, 4", "0, -0.1, 0");
+    let mut scene = Scene::load(example, &small()).unwrap();
+    scene
+        .set("camera.origin", ParamValue::Vec3([2.0, 3.0, 3.0]))
+        .unwrap();
+    let e = scene
+        .set("camera.fov", ParamValue::Float(25.0))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("orthographic"), "{e}");
+    // Moving the origin kept the direction (the target moved with it) and the film's scale.
+    let moved = tempfile::tempdir().unwrap();
+    let reloaded = Scene::load(
+        orthographic_example(moved.path(), "2, 3, 3", "-1.2, 0.5, -1"),
+        &small(),
+    )
+    .unwrap();
+    let (a, b) = (scene.description().camera, reloaded.description().camera);
+    for (ra, rb) in a.to_world.iter().zip(&b.to_world) {
+        for (x, y) in ra.iter().zip(rb) {
+            assert!((x - y).abs() < 1e-5, "{:?} vs {:?}", a.to_world, b.to_world);
+        }
+    }
+}
+
 #[test]
 fn bad_parameters_are_refused_by_name_and_change_nothing() {
     let mut scene = Scene::load(example(), &small()).unwrap();
@@ -386,6 +435,32 @@ fn print_scene(dir: &Path, white_sigma_a: &str) -> PathBuf {
     path
 }
 
+/// A TOML scene of a 3 x 2 x 2 print of two materials with `indices` (one byte per voxel).
+fn indexed_scene(dir: &Path, indices: &[u8]) -> PathBuf {
+    std::fs::write(dir.join("print.raw"), indices).unwrap();
+    let text = r##"[volume]
+file = "print.raw"
+format = "raw"
+resolution = [3, 2, 2]
+type = "u8"
+bounds = [[0.0, 0.0, 0.0], [3.0, 2.0, 2.0]]
+[boundary]
+bsdf = "dielectric"
+[[materials]]
+name = "cyan"
+sigma_s = [4.0, 6.0, 7.0]
+sigma_a = [6.0, 0.8, 0.2]
+g = 0.3
+[[materials]]
+name = "white"
+sigma_t = 12.0
+albedo = [0.99, 0.98, 0.97]
+"##;
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
 /// A material's coefficients set as parameters render as the scene file with those
 /// coefficients, bit for bit; the scene lists them; a refused value leaves the scene as it was.
 #[test]
@@ -414,4 +489,35 @@ fn material_parameters_render_as_the_changed_scene_file_does() {
     let (a, b) = (render(&scene, 0..6), render(&changed, 0..6));
     assert_ne!(a.sums, before.sums);
     assert_eq!(a.sums, b.sums);
+}
+
+#[test]
+fn new_indices_render_as_the_scene_loaded_with_them_and_refused_ones_change_nothing() {
+    let (before, after) = (
+        [0, 1, 1, 0, 0, 1, 1, 1, 0, 0, 0, 1],
+        [1, 1, 0, 0, 1, 0, 0, 1, 1, 0, 1, 1],
+    );
+    let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let mut scene = Scene::load(indexed_scene(a.path(), &before), &small()).unwrap();
+    let reloaded = Scene::load(indexed_scene(b.path(), &after), &small()).unwrap();
+    let original = scene.fingerprint();
+    assert_ne!(original, reloaded.fingerprint());
+    // Refusals: the wrong count, an index past the table; the scene stays as it was.
+    let e = scene.set_indices(&after[..11]).unwrap_err().to_string();
+    assert!(e.contains("12") && e.contains("11"), "{e}");
+    let mut past = after;
+    past[4] = 2;
+    let e = scene.set_indices(&past).unwrap_err().to_string();
+    assert!(e.contains('2'), "{e}");
+    assert_eq!(scene.fingerprint(), original);
+    // The same indices change nothing; new ones render as the scene loaded with them.
+    scene.set_indices(&before).unwrap();
+    assert_eq!(scene.fingerprint(), original);
+    scene.set_indices(&after).unwrap();
+    assert_eq!(scene.fingerprint(), reloaded.fingerprint());
+    assert_eq!(render(&scene, 0..6).sums, render(&reloaded, 0..6).sums);
+    // A medium without indices has none to replace.
+    let mut cube = Scene::load(example(), &small()).unwrap();
+    let e = cube.set_indices(&after).unwrap_err().to_string();
+    assert!(e.contains("material-indexed"), "{e}");
 }

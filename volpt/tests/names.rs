@@ -116,7 +116,7 @@ fn the_majorant_grid_bound_is_the_librarys() {
 
 #[test]
 fn the_gpu_knobs_bounds_are_refused_before_any_gpu_is_opened() {
-    use volpt::{Backend, BackendOptions, GpuOptions, MAX_REGISTERS, REFILL_AT};
+    use volpt::{Backend, BackendOptions, GpuOptions, MAX_REGISTERS, REFILL_AT, TILES};
     let refused = |gpu: GpuOptions, key: &str, expected: &str, found: &str| {
         for options in [
             BackendOptions::cuda(gpu),
@@ -160,12 +160,27 @@ fn the_gpu_knobs_bounds_are_refused_before_any_gpu_is_opened() {
     );
     refused(refill(REFILL_AT.start() - 1), "refill_at", "1 to 32", "0");
     refused(refill(REFILL_AT.end() + 1), "refill_at", "1 to 32", "33");
+    let tiles = |t| GpuOptions {
+        tiles: Some(t),
+        ..GpuOptions::default()
+    };
+    let each = "columns and rows of 1 to 4096 each";
+    refused(tiles([TILES.start() - 1, 3]), "tiles", each, "0,3");
+    refused(tiles([4, TILES.end() + 1]), "tiles", each, "4,4097");
     // In bounds, the CPU refuses them for what they are: GPU knobs.
     let in_bounds = Backend::open(&BackendOptions {
         gpu: registers(*MAX_REGISTERS.end()),
         ..Default::default()
-    });
-    assert!(matches!(in_bounds, Err(Error::Settings(m)) if m.contains("--max-registers 255")));
+    })
+    .err();
+    assert!(
+        matches!(
+            &in_bounds,
+            Some(Error::Conflict { key: "max_registers", value, with: "backend", with_value, .. })
+                if value == "255" && with_value == "cpu"
+        ),
+        "{in_bounds:?}"
+    );
 }
 
 #[test]
@@ -188,4 +203,102 @@ fn an_unknown_parameter_is_its_own_error() {
         scene.set("spp", volpt::ParamValue::Int(0)).unwrap_err(),
         Error::Param { .. }
     ));
+}
+
+/// Settings that cannot go together are one typed error naming both keys and values in the
+/// library's spelling, with a reason that names no key: each front end spells the keys its own
+/// way ([`Error::spelled`]).
+#[test]
+fn conflicts_between_settings_are_typed_with_both_keys() {
+    use volpt::{Backend, BackendOptions, GpuOptions};
+    let conflict = |error: Error| match error {
+        Error::Conflict {
+            key,
+            value,
+            with,
+            with_value,
+            why,
+            ..
+        } => {
+            // Keys of several words are unmistakable in a sentence; one-word keys are words.
+            for k in [
+                "refill_at",
+                "max_registers",
+                "majorant_resolution",
+                "volume_memory",
+            ] {
+                assert!(!why.contains(k), "the reason names {k}: {why}");
+            }
+            (key, value, with, with_value)
+        }
+        other => panic!("not a conflict: {other:?}"),
+    };
+    let open = |kind, gpu| {
+        Backend::open(&BackendOptions { kind, gpu })
+            .err()
+            .expect("refused")
+    };
+    let gpu = |f: fn(&mut GpuOptions)| {
+        let mut gpu = GpuOptions::default();
+        f(&mut gpu);
+        gpu
+    };
+    let strategy = gpu(|g| g.strategy = Some(StrategyChoice::Fixed(Strategy::NaiveSk)));
+    assert_eq!(
+        conflict(open(BackendKind::Cpu, strategy)),
+        ("strategy", "naive-sk".into(), "backend", "cpu".into())
+    );
+    // Refused before the driver is asked for a GPU.
+    let tiles = gpu(|g| {
+        g.strategy = Some(StrategyChoice::Auto);
+        g.tiles = Some([2, 2]);
+    });
+    assert_eq!(
+        conflict(open(BackendKind::Cuda, tiles)),
+        ("tiles", "2,2".into(), "strategy", "auto".into())
+    );
+    let refill = gpu(|g| {
+        g.strategy = Some(StrategyChoice::Fixed(Strategy::NaiveSk));
+        g.refill_at = Some(8);
+    });
+    assert_eq!(
+        conflict(open(BackendKind::Cuda, refill)),
+        ("refill_at", "8".into(), "strategy", "naive-sk".into())
+    );
+    let cube = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/example/cube.xml");
+    let settings = RenderSettings {
+        tracking: Some(Tracking::Global),
+        majorant_resolution: Some(8),
+        ..RenderSettings::default()
+    };
+    let error = Scene::load(&cube, &settings).expect_err("refused");
+    let flags = error.spelled(&|key, value| {
+        let flag = format!("--{}", key.replace('_', "-"));
+        value.map_or(flag.clone(), |v| format!("{flag} {v}"))
+    });
+    assert_eq!(
+        conflict(error),
+        (
+            "majorant_resolution",
+            "8".into(),
+            "tracking",
+            "global".into()
+        )
+    );
+    assert!(
+        flags.starts_with("--majorant-resolution 8 with --tracking global: global tracking"),
+        "{flags}"
+    );
+    // The same choices as a request's path settings over a loaded scene's: the same refusal.
+    let scene = Scene::load(&cube, &RenderSettings::default()).unwrap();
+    let error = settings.path_over(scene.path_settings()).unwrap_err();
+    assert_eq!(
+        conflict(error),
+        (
+            "majorant_resolution",
+            "8".into(),
+            "tracking",
+            "global".into()
+        )
+    );
 }

@@ -37,6 +37,7 @@ fn scene(size: u32) -> BallScene {
             tan_half_fov: Vec2::splat(0.2),
             width: size,
             height: size,
+            orthographic: false,
         },
         bounds: Aabb::new(Vec3::splat(-0.5), Vec3::splat(0.5)),
         medium: SmoothBall {

@@ -20,6 +20,7 @@ fn an_absorbing_ball_transmits_its_analytic_transmittance() {
             tan_half_fov: Vec2::splat(0.2),
             width: 16,
             height: 16,
+            orthographic: false,
         },
         bounds: Aabb::new(Vec3::splat(-0.5), Vec3::splat(0.5)),
         medium: SmoothBall {

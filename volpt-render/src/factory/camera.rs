@@ -3,7 +3,8 @@
 use super::*;
 
 /// Mitsuba's perspective camera: the field of view spans `fov_axis`, the other axis follows from the
-/// film's aspect ratio.
+/// film's aspect ratio. Mitsuba 3's orthographic camera: the film spans camera-space x in [-1, 1]
+/// and y in [-h/w, h/w] (its `orthographic_projection`), scaled by `to_world`.
 pub fn camera(desc: &CameraDesc, film: &FilmDesc) -> PerspectiveCamera {
     let m = desc.to_world;
     let column = |j: usize| Vec3::new(m[0][j], m[1][j], m[2][j]);
@@ -11,7 +12,9 @@ pub fn camera(desc: &CameraDesc, film: &FilmDesc) -> PerspectiveCamera {
     let tan_half = tan(0.5 * desc.fov_degrees.to_radians());
     let along_x = Vec2::new(tan_half, tan_half * h / w);
     let along_y = Vec2::new(tan_half * w / h, tan_half);
+    let orthographic = desc.projection == Projection::Orthographic;
     let tan_half_fov = match desc.fov_axis {
+        _ if orthographic => Vec2::new(1.0, h / w),
         FovAxis::X => along_x,
         FovAxis::Y => along_y,
         FovAxis::Smaller if w <= h => along_x,
@@ -31,5 +34,6 @@ pub fn camera(desc: &CameraDesc, film: &FilmDesc) -> PerspectiveCamera {
         tan_half_fov,
         width: film.width,
         height: film.height,
+        orthographic,
     }
 }

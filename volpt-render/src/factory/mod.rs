@@ -50,7 +50,8 @@ use volpt_core::math::tan;
 use volpt_core::path::Estimator;
 use volpt_core::{Aabb, PathSettings, PerspectiveCamera, Scene, Vec2, Vec3, VolumeScene};
 use volpt_scene::description::{
-    Bounds, BsdfDesc, CameraDesc, EnvironmentDesc, FilmDesc, FovAxis, PhaseDesc, SceneDescription,
+    Bounds, BsdfDesc, CameraDesc, EnvironmentDesc, FilmDesc, FovAxis, PhaseDesc, Projection,
+    SceneDescription,
 };
 
 /// What a backend can render: the CPU needs a [`Scene`] it can share between threads, a GPU backend

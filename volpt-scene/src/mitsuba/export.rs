@@ -22,7 +22,9 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use crate::description::{Bounds, FovAxis, GridConvention, GridDesc, Matrix4, SceneDescription};
+use crate::description::{
+    Bounds, FovAxis, GridConvention, GridDesc, Matrix4, Projection, SceneDescription,
+};
 use crate::error::SceneError;
 use crate::output::create_dir;
 use crate::vol::{write_vol, VolGrid};
@@ -120,10 +122,8 @@ pub fn write_mitsuba3(
         <integer name="rr_depth" value="{rr_depth}"/>
     </integrator>
 
-    <sensor type="perspective">
-        <float name="fov" value="{fov}"/>
-        <string name="fov_axis" value="{fov_axis}"/>
-        {camera}
+    <sensor type="{sensor}">
+        {fov}{camera}
         <sampler type="independent">
             <integer name="sample_count" value="{spp}"/>
         </sampler>
@@ -150,7 +150,19 @@ pub fn write_mitsuba3(
 "#,
         max_depth = depth(desc.integrator.max_depth, -1),
         rr_depth = depth(desc.integrator.rr_depth, i64::from(NO_ROULETTE_DEPTH)),
-        fov = desc.camera.fov_degrees,
+        sensor = match desc.camera.projection {
+            Projection::Perspective => "perspective",
+            Projection::Orthographic => "orthographic",
+        },
+        // An orthographic sensor has no field of view.
+        fov = match desc.camera.projection {
+            Projection::Perspective => format!(
+                "<float name=\"fov\" value=\"{}\"/>\n        <string name=\"fov_axis\" \
+                 value=\"{fov_axis}\"/>\n        ",
+                desc.camera.fov_degrees
+            ),
+            Projection::Orthographic => String::new(),
+        },
         camera = matrix_transform(&desc.camera.to_world, "        "),
         spp = desc.spp,
         width = desc.film.width,

@@ -1,9 +1,11 @@
-//! `<sensor type="perspective">` with its `<film>` and `<sampler>`.
+//! `<sensor type="perspective">` and `<sensor type="orthographic">` (its `to_world` scale sets the
+//! extent: camera-space x in [-1, 1], y in [-h/w, h/w], as Mitsuba 3 maps its film), with their
+//! `<film>` and `<sampler>`.
 
 use super::plugin::{parse_f64, quoted, Arg, Ctx, Plugin};
 use super::transform::{to_f32, transform, IDENTITY_F64};
 use super::xml::Element;
-use crate::description::{CameraDesc, FilmDesc, FovAxis};
+use crate::description::{CameraDesc, FilmDesc, FovAxis, Projection};
 use crate::error::SceneError;
 
 /// Mitsuba's film size when none is given.
@@ -29,18 +31,35 @@ pub(crate) struct Sensor {
 
 pub(crate) fn sensor(el: &Element, ctx: &Ctx<'_>) -> Result<Sensor, SceneError> {
     let p = Plugin::new(el, ctx);
-    if p.kind()? != "perspective" {
-        return Err(p.unsupported(
-            "volpt has a perspective (pinhole) camera only: use type=\"perspective\"",
-        ));
-    }
+    let projection = match p.kind()? {
+        "perspective" => Projection::Perspective,
+        "orthographic" => Projection::Orthographic,
+        _ => {
+            return Err(p.unsupported(
+                "volpt has the perspective (pinhole) and orthographic cameras: use \
+                 type=\"perspective\" or type=\"orthographic\"",
+            ))
+        }
+    };
     let to_world = match p.find(&["toWorld", "to_world"])? {
         Some(arg) => transform(&arg)?,
         None => IDENTITY_F64,
     };
     let fov_axis_arg = p.find(&["fovAxis", "fov_axis"])?;
-    let (fov_degrees, fov_axis) =
-        match (p.find(&["fov"])?, p.find(&["focalLength", "focal_length"])?) {
+    let fov = p.find(&["fov"])?;
+    let focal = p.find(&["focalLength", "focal_length"])?;
+    if projection == Projection::Orthographic {
+        if let Some(arg) = fov.as_ref().or(focal.as_ref()).or(fov_axis_arg.as_ref()) {
+            return Err(arg.invalid(
+                "no field of view on an orthographic sensor (its to_world scale sets the extent)",
+                quoted(arg.value()?),
+            ));
+        }
+    }
+    let (fov_degrees, fov_axis) = match projection {
+        // Unused: an orthographic camera's rays are parallel.
+        Projection::Orthographic => (0.0, FovAxis::X),
+        Projection::Perspective => match (fov, focal) {
             (Some(_), Some(focal)) => {
                 return Err(focal.invalid("either fov or a focal length, not both", "both"));
             }
@@ -74,7 +93,8 @@ pub(crate) fn sensor(el: &Element, ctx: &Ctx<'_>) -> Result<Sensor, SceneError> 
                 let degrees = (2.0 * (FRAME_DIAGONAL_MM / (2.0 * mm)).atan()).to_degrees();
                 (degrees as f32, FovAxis::Diagonal)
             }
-        };
+        },
+    };
     p.ignore(&[
         "nearClip",
         "near_clip",
@@ -99,6 +119,7 @@ pub(crate) fn sensor(el: &Element, ctx: &Ctx<'_>) -> Result<Sensor, SceneError> 
             to_world: to_f32(&to_world),
             fov_degrees,
             fov_axis,
+            projection,
         },
         film,
         spp,
