@@ -1,6 +1,6 @@
 //! The compensation loop on the real predictor, timed: a synthetic target (fine bars over a
 //! smooth gradient) of `SIZE` x `SIZE` texels, the naive print `LAYERS` colour layers deep in a
-//! `DEPTH`-layer slab of the five inks, `SPP` samples per texel and channel per prediction, at
+//! `DEPTH`-layer slab of the five inks, `SPP` samples per texel per prediction (one chromatic render), at
 //! most `ITERATIONS` predictions, on the CPU or (`cuda`) a GPU; writes the record to `OUT`.
 //!
 //! ```sh
@@ -109,7 +109,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     )?;
     let total = start.elapsed().as_secs_f64();
     println!(
-        "{size} x {size} texels, {} layers ({} colour), {} spp x 3 channels: {} iterations in {total:.2} s \
+        "{size} x {size} texels, {} layers ({} colour), {} spp (one chromatic render): {} iterations in {total:.2} s \
          ({:.2} s each); mean dE00 naive {:.3}, best {:.3} (iteration {})",
         setup.halftone.depth,
         setup.halftone.layers,
