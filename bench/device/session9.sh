@@ -37,8 +37,17 @@ checks)
     for check in ${CHECKS:-quick-all materials chromatic}; do
         case $check in
         quick-all) part quick-all 240 env STRATEGIES_LIMIT=120 bash quick-all.sh ;;
+        # quick-all's strategy checks alone (every strategy and fast math against the CPU).
+        strategies) part strategies 130 env TRIALS=3 T=30 PROBE_T=15 \
+            SCENES_ONLY="^(homogeneous-cube-null|cgg-logo|smoke|bucky)$" EXACT_STRATEGIES="regeneration-sk" \
+            FAST_STRATEGIES="regeneration-sk regeneration-warp-sk regeneration-block-sk streaming-sk" \
+            CAPS="64" bash strategies.sh ;;
         materials) part materials 90 bash materials.sh ;;
         chromatic) part chromatic 100 env FILMS=${FILMS:-8} bash chromatic.sh ;;
+        orthographic) part orthographic 90 bash orthographic.sh ;;
+        materials-cost) part materials-cost 120 bash materials-cost.sh ;;
+        # From the repository's root (the script reads scenes/example there).
+        facade-typed) part facade-typed 60 env VOLPT="$PWD/bin/volpt" bash ../bench/device/facade-typed.sh ;;
         esac
     done
     for extra in ${EXTRA:-}; do
@@ -47,11 +56,18 @@ checks)
     ;;
 ab)
     cp "$KEEP/volpt" bin/volpt
-    part ab-bin 120 env STRATEGIES="regeneration-sk" TRIALS=3 bash ab-bin.sh
-    part sparse-table 150 bash sparse-table.sh
+    # AB picks the parts; BEFORE is bin/volpt-before (the carried binary).
+    for ab in ${AB:-ab-bin sparse-table}; do
+        case $ab in
+        ab-bin) part ab-bin 120 env STRATEGIES="regeneration-sk" TRIALS=3 bash ab-bin.sh ;;
+        sparse-table) part sparse-table 150 bash sparse-table.sh ;;
+        materials-cost) cp bin/volpt-before bin/volpt-base
+            part materials-cost 120 env SPP=64 bash materials-cost.sh ;;
+        esac
+    done
     ;;
 esac
-for f in "$OUT"/*/summary.txt "$OUT"/ab-bin/ab-bin.txt "$OUT"/*/sparse-table.txt; do
+for f in "$OUT"/*/summary.txt "$OUT"/ab-bin/ab-bin.txt "$OUT"/*/sparse-table.txt "$OUT"/*/cost.txt; do
     [ -f "$f" ] && { echo "---- $f"; cat "$f"; } >>"$summary"
 done
 for d in "$OUT"/*/; do tail -n 3 "$d/stdout.txt" 2>/dev/null | sed "s|^|$(basename "$d"): |" >>"$summary"; done
