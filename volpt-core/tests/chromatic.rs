@@ -23,9 +23,9 @@ use volpt_core::rng::Rng;
 use volpt_core::tracking::{spectral_delta_tracking, FreeFlight};
 use volpt_core::{
     Aabb, Bsdf, ChromaticMedium, ConstantEnvironment, Estimator, GridAlbedo, GridMapping,
-    GridMedium, HenyeyGreenstein, HomogeneousMedium, Medium, NullBoundary, PathSettings, PathState,
-    PerspectiveCamera, Ray, RoughDielectric, Scene, SmoothDielectric, Spectrum, Vec2, Vec3,
-    VolumeScene,
+    GridMedium, HenyeyGreenstein, HeroChannel, HomogeneousMedium, Medium, NullBoundary,
+    PathSettings, PathState, PerspectiveCamera, Ray, RoughDielectric, Scene, SmoothDielectric,
+    Spectrum, Vec2, Vec3, VolumeScene,
 };
 use volpt_core::{Environment, Grid, LatLongEnvironment, LatLongRows};
 
@@ -327,16 +327,46 @@ fn grid_channels_are_grey_renders_rough_dielectric_next_event_under_a_map() {
     assert_identity("homogeneous, rough, nee, map", chromatic, grey);
 }
 
-/// Channels 10^10 apart, an absorbing one and a subnormal one: every path's light is finite, and
-/// its path densities stay in [0, 3] with mean 1 (the balance heuristic bounds the weight of each
-/// channel by 3 times its own estimator's).
+/// Channels 10^10 apart, an absorbing one and a subnormal one: (sigma_t, albedo).
+const EXTREME_MEDIA: [([f32; 3], [f32; 3]); 3] = [
+    ([1e-5, 1.0, 1e5], [1.0, 0.5, 0.0]),
+    ([1e-40, 3.0, 30.0], [0.99, 1.0, 0.9]),
+    ([0.0, 0.0, 8.0], [1.0, 1.0, 1.0]),
+];
+
+/// Traces `samples` paths of `scene` and asserts after every step that the path densities are
+/// finite and in [0, 3] (the balance heuristic bounds the weight of each channel by 3 times its
+/// own estimator's), with mean 1 where `mean_one`, and that every path's light is finite and
+/// non-negative.
+fn assert_spectral_weights_bounded<S>(scene: &S, samples: u32, mean_one: bool)
+where
+    S: Scene,
+    S::Medium: Medium<Spectral = HeroChannel>,
+{
+    for sample in 0..samples {
+        let mut path = PathState::from_camera(scene, 1, 2, sample, 9);
+        while path.alive {
+            volpt_core::path::step(scene, &mut path);
+            let r = path.spectral.r_u;
+            assert!(
+                r.is_finite() && r.min_element() >= 0.0 && r.max_element() <= 3.0001,
+                "r_u {r:?}"
+            );
+            let mean = (r.x + r.y + r.z) / 3.0;
+            assert!(
+                !mean_one || r == Spectrum::ZERO || (mean - 1.0).abs() < 1e-4,
+                "r_u {r:?}"
+            );
+        }
+        assert!(path.radiance.is_finite() && path.radiance.min_element() >= 0.0);
+    }
+}
+
+/// The [`EXTREME_MEDIA`] homogeneous: every path's light is finite, and its path densities stay
+/// in [0, 3] with mean 1.
 #[test]
 fn spectral_weights_are_finite_and_bounded_on_extreme_media() {
-    for (sigma_t, albedo) in [
-        ([1e-5, 1.0, 1e5], [1.0, 0.5, 0.0]),
-        ([1e-40, 3.0, 30.0], [0.99, 1.0, 0.9]),
-        ([0.0, 0.0, 8.0], [1.0, 1.0, 1.0]),
-    ] {
+    for (sigma_t, albedo) in EXTREME_MEDIA {
         for estimator in [Estimator::PathTracing, Estimator::NextEvent] {
             let medium = ChromaticMedium::new(
                 Spectrum::from_array(sigma_t),
@@ -344,32 +374,14 @@ fn spectral_weights_are_finite_and_bounded_on_extreme_media() {
                 Spectrum::from_array(albedo),
                 None,
             );
-            let scene = scene(medium, NullBoundary, estimator);
-            for sample in 0..4096 {
-                let mut path = PathState::from_camera(&scene, 1, 2, sample, 9);
-                while path.alive {
-                    volpt_core::path::step(&scene, &mut path);
-                    let r = path.spectral.r_u;
-                    assert!(
-                        r.is_finite() && r.min_element() >= 0.0 && r.max_element() <= 3.0001,
-                        "r_u {r:?}"
-                    );
-                    let mean = (r.x + r.y + r.z) / 3.0;
-                    assert!(
-                        r == Spectrum::ZERO || (mean - 1.0).abs() < 1e-4,
-                        "r_u {r:?}"
-                    );
-                }
-                assert!(path.radiance.is_finite() && path.radiance.min_element() >= 0.0);
-            }
+            assert_spectral_weights_bounded(&scene(medium, NullBoundary, estimator), 4096, true);
         }
     }
 }
 
-/// The extreme media of [`spectral_weights_are_finite_and_bounded_on_extreme_media`] as density
-/// grids with empty voxels, tracked through a majorant grid whose cells scale each channel's
-/// bound (empty cells included): every step's path densities finite in [0, 3], every path's
-/// light finite and non-negative.
+/// The [`EXTREME_MEDIA`] as density grids with empty voxels, tracked through a majorant grid
+/// whose cells scale each channel's bound (empty cells included): every step's path densities
+/// finite in [0, 3], every path's light finite and non-negative.
 #[test]
 fn spectral_weights_are_finite_and_bounded_in_grids_with_empty_cells() {
     let mut grids = Grids::new();
@@ -378,11 +390,7 @@ fn spectral_weights_are_finite_and_bounded_in_grids_with_empty_cells() {
             *d = 0.0;
         }
     }
-    for (sigma_t, albedo) in [
-        ([1e-5, 1.0, 1e5], [1.0, 0.5, 0.0]),
-        ([1e-40, 3.0, 30.0], [0.99, 1.0, 0.9]),
-        ([0.0, 0.0, 8.0], [1.0, 1.0, 1.0]),
-    ] {
+    for (sigma_t, albedo) in EXTREME_MEDIA {
         let extinction = Spectrum::from_array(sigma_t);
         grids.build_majorants(extinction.max_element());
         for estimator in [Estimator::PathTracing, Estimator::NextEvent] {
@@ -393,19 +401,7 @@ fn spectral_weights_are_finite_and_bounded_in_grids_with_empty_cells() {
                 None,
             );
             medium.majorants = Some(grids.majorant_grid());
-            let scene = scene(medium, NullBoundary, estimator);
-            for sample in 0..512 {
-                let mut path = PathState::from_camera(&scene, 1, 2, sample, 9);
-                while path.alive {
-                    volpt_core::path::step(&scene, &mut path);
-                    let r = path.spectral.r_u;
-                    assert!(
-                        r.is_finite() && r.min_element() >= 0.0 && r.max_element() <= 3.0001,
-                        "r_u {r:?}"
-                    );
-                }
-                assert!(path.radiance.is_finite() && path.radiance.min_element() >= 0.0);
-            }
+            assert_spectral_weights_bounded(&scene(medium, NullBoundary, estimator), 512, false);
         }
     }
 }
