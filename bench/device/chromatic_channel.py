@@ -5,18 +5,14 @@ mean of the chromatic films with the grey films' (the grey medium of channel C's
 Welch's z over the films (each film one independent estimate). Exits 1 when |z| >= 5, and prints
 the relative standard error of the difference (1% bias at 10 sigma needs it <= 0.1%)."""
 import math
-import struct
 import sys
+
+from film_diff import read
 
 
 def channel_mean(path, c):
-    data = open(path, "rb").read()
-    if data[:8] != b"VOLPTFL1":
-        sys.exit(f"{path}: not a VOLPTFL1 film")
-    _, width, height, _, count = struct.unpack_from("<QIIII", data, 8)
-    ranges = [struct.unpack_from("<II", data, 32 + 8 * i) for i in range(count)]
+    (_, width, height, _, ranges), sums = read(path)
     spp = sum(b - a for a, b in ranges)
-    sums = struct.unpack_from(f"<{3 * width * height}d", data, 32 + 8 * count)
     return sum(sums[c::3]) / (width * height * spp)
 
 

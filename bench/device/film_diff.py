@@ -37,4 +37,5 @@ def main():
     sys.exit(0 if worst <= bound else 1)
 
 
-main()
+if __name__ == "__main__":
+    main()

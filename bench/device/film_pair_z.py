@@ -6,18 +6,14 @@ the grey render of channel C's coefficients), and pixels are independent of each
 own random streams), so the pixels' differences have mean 0 and z = mean / (sd / sqrt(pixels)).
 Exits 1 when |z| >= 5; prints the relative standard error (1% bias at 10 sigma needs <= 1e-3)."""
 import math
-import struct
 import sys
+
+from film_diff import read
 
 
 def channel(path, c):
-    data = open(path, "rb").read()
-    if data[:8] != b"VOLPTFL1":
-        sys.exit(f"{path}: not a VOLPTFL1 film")
-    _, width, height, _, count = struct.unpack_from("<QIIII", data, 8)
-    ranges = [struct.unpack_from("<II", data, 32 + 8 * i) for i in range(count)]
+    (_, _, _, _, ranges), sums = read(path)
     spp = sum(b - a for a, b in ranges)
-    sums = struct.unpack_from(f"<{3 * width * height}d", data, 32 + 8 * count)
     return [s / spp for s in sums[c::3]]
 
 
