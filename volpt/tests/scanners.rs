@@ -3,9 +3,13 @@
 //! `.mha`, from a TOML scene with a transfer function, a Mitsuba `gridvolume`, and on their own
 //! (`volpt render FILE_OR_FOLDER`).
 
+mod common;
+
+use common::render;
+
 use std::path::{Path, PathBuf};
 
-use volpt::{Backend, Film, Quiet, RenderSettings, Scene};
+use volpt::{RenderSettings, Scene};
 
 fn scenes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/scanners")
@@ -31,14 +35,6 @@ fn settings(params: &[(&str, &Path)]) -> RenderSettings {
             .collect(),
         ..RenderSettings::default()
     }
-}
-
-fn render(scene: &Scene) -> Film {
-    let mut film = scene.film();
-    Backend::cpu()
-        .render(scene, &mut film, 0..scene.spp(), &Quiet)
-        .unwrap();
-    film
 }
 
 const NRRD: [&str; 5] = [

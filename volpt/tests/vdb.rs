@@ -1,9 +1,13 @@
 //! VDB volumes (written by the real OpenVDB library: `scenes/vdb/make_fixtures.py`) render on the
 //! CPU bit for bit as the same grids read from other files, sparse or dense.
 
+mod common;
+
+use common::render;
+
 use std::path::{Path, PathBuf};
 
-use volpt::{Backend, Film, GridLookup, Quiet, RenderSettings, Scene};
+use volpt::{Backend, GridLookup, Quiet, RenderSettings, Scene};
 
 fn scenes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes")
@@ -25,14 +29,6 @@ fn small() -> RenderSettings {
         seed: 11,
         ..RenderSettings::default()
     }
-}
-
-fn render(scene: &Scene) -> Film {
-    let mut film = scene.film();
-    Backend::cpu()
-        .render(scene, &mut film, 0..scene.spp(), &Quiet)
-        .unwrap();
-    film
 }
 
 fn with(settings: RenderSettings, params: &[(&str, &str)]) -> RenderSettings {

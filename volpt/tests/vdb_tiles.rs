@@ -3,22 +3,18 @@
 //! for bit as a dense grid of the tiles' one value over the same box, and a 16384^3 box of root
 //! tiles loads and renders.
 
+mod common;
+
+use common::render;
+
 use std::path::{Path, PathBuf};
 
-use volpt::{Backend, Effects, Film, Quiet, RenderSettings, Scene};
+use volpt::{Effects, RenderSettings, Scene};
 
 fn fixture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../scenes/vdb/fixtures")
         .join(name)
-}
-
-fn render(scene: &Scene) -> Film {
-    let mut film = scene.film();
-    Backend::cpu()
-        .render(scene, &mut film, 0..scene.spp(), &Quiet)
-        .unwrap();
-    film
 }
 
 /// A scene of `volume` (TOML `[volume]` lines) seen through a null boundary, semi-transparent.

@@ -1,9 +1,21 @@
 //! What the facade's integration tests share.
 
+// Each test crate that includes this module uses a part of it.
+#![allow(dead_code)]
+
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::Duration;
 
-use volpt::Observer;
+use volpt::{Backend, Film, Observer, Quiet, Scene};
+
+/// The scene's whole film, rendered on the CPU.
+pub fn render(scene: &Scene) -> Film {
+    let mut film = scene.film();
+    Backend::cpu()
+        .render(scene, &mut film, 0..scene.spp(), &Quiet)
+        .unwrap();
+    film
+}
 
 /// Cancels at the `after`-th look, asking for a look after every sample.
 pub struct CancelAfter {
