@@ -1,6 +1,7 @@
 //! A compensation's record, written to a folder: what a user looks at and what a printer takes.
 //!
-//! - `target.png`: the target (sRGB); `prediction.png`: the kept (best) iteration's prediction,
+//! - `target.png`: the target (sRGB); `prediction.png`: the kept (best) iteration's prediction
+//!   (and `prediction.exr`: its linear RGB, 32-bit float),
 //!   and `comparison.png`: side by side, the target, the naive prediction and its ΔE map, the
 //!   kept prediction and its ΔE map (enlarged to at least [`COMPARISON_HEIGHT`] pixels);
 //! - `iteration_NN/prediction.png`: the iteration's predicted top view (sRGB, 8-bit);
@@ -90,6 +91,22 @@ pub fn write_record(
         png::ColorType::Rgb,
         &srgb(&kept.prediction),
     )?;
+    // Its linear RGB values, unrounded (L*a*b* is `colour::LinearRgb::to_lab` of these).
+    let exr_path = dir.join("prediction.exr");
+    volpt::Image {
+        width,
+        height,
+        pixels: kept
+            .prediction
+            .iter()
+            .map(|c| c.0.map(|v| v as f32))
+            .collect(),
+    }
+    .write_exr(&exr_path)
+    .map_err(|e| PrintError::Io {
+        path: exr_path.clone(),
+        source: std::io::Error::other(e),
+    })?;
     // Side by side, a column of white between, each panel enlarged to at least
     // COMPARISON_HEIGHT pixels (nearest): target, naive prediction and its ΔE map, kept
     // prediction and its ΔE map.

@@ -254,10 +254,7 @@ fn an_orthographic_camera_is_mitsubas_sensor_scaled_to_its_extent() {
 fn an_orthographic_camera_needs_an_extent_and_takes_no_field_of_view() {
     let ortho = "[camera]\nprojection = \"orthographic\"\n";
     for (extra, expected) in [
-        (
-            ortho.to_string(),
-            "camera.extent: expected the film's size",
-        ),
+        (ortho.to_string(), "camera.extent: expected the film's size"),
         (
             format!("{ortho}extent = 2.0\nfov = 30.0\n"),
             "camera.fov: expected no field of view on an orthographic camera",
