@@ -479,7 +479,7 @@ fn shadow_transmittance<S: Scene>(
     shadow: Ray,
 ) -> Option<Transmittance<S>> {
     let mut transmittance = chord_transmittance(scene, path, &shadow)?;
-    if S::Shape::CONVEX {
+    if scene.shape().convex() {
         return Some(transmittance);
     }
     let mut shadow = shadow;
@@ -537,7 +537,7 @@ fn boundary_next_event_estimate<S: Scene>(scene: &S, path: &mut PathOf<S>, hit: 
         return;
     }
     // A non-convex shape may stand in the way, which bends the shadow ray.
-    if !S::Shape::CONVEX
+    if !scene.shape().convex()
         && scene
             .shape()
             .entry(&Ray::new(hit.point, light.dir))

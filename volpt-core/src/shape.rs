@@ -7,6 +7,7 @@
 //! BVH. Every answer's normal is the surface's outward geometric normal.
 
 use crate::geometry::{Aabb, BoxHit, Ray};
+use crate::mesh::TriangleMesh;
 
 /// A closed surface bounding the medium.
 ///
@@ -18,6 +19,13 @@ pub trait Shape {
     /// Whether every ray leaves the shape once and never meets it again: a path's light that
     /// leaves it reaches the environment, and a shadow ray needs one exit.
     const CONVEX: bool;
+
+    /// [`Shape::CONVEX`] for this shape: a shape chosen at run time ([`BoundaryShape`]) knows only
+    /// then. A compile-time constant for every other shape.
+    #[inline(always)]
+    fn convex(&self) -> bool {
+        Self::CONVEX
+    }
 
     fn bounds(&self) -> Aabb;
 
@@ -61,4 +69,83 @@ impl Shape for Aabb {
     fn exit_distance(&self, ray: &Ray) -> f32 {
         Aabb::exit_distance(self, ray)
     }
+}
+
+/// The boundary a scene file describes, chosen at run time: its box, or a closed triangle mesh.
+/// One scene type serves both, so a mesh boundary costs no second copy of every variant's code;
+/// a box pays one well-predicted branch per question. The mesh's questions are functions of their
+/// own (`inline(never)`): one copy of the BVH traversal, whatever the variant.
+#[derive(Clone, Copy, Debug)]
+pub enum BoundaryShape<'a> {
+    Box(Aabb),
+    Mesh(TriangleMesh<'a>),
+}
+
+impl Shape for BoundaryShape<'_> {
+    const CONVEX: bool = false;
+
+    #[inline(always)]
+    fn convex(&self) -> bool {
+        matches!(self, BoundaryShape::Box(_))
+    }
+
+    #[inline(always)]
+    fn bounds(&self) -> Aabb {
+        match self {
+            BoundaryShape::Box(b) => *b,
+            BoundaryShape::Mesh(m) => m.bounds,
+        }
+    }
+
+    #[inline(always)]
+    fn contains(&self, p: crate::Vec3) -> bool {
+        match self {
+            BoundaryShape::Box(b) => Aabb::contains(b, p),
+            BoundaryShape::Mesh(m) => mesh_contains(m, p),
+        }
+    }
+
+    #[inline(always)]
+    fn entry(&self, ray: &Ray) -> Option<BoxHit> {
+        match self {
+            BoundaryShape::Box(b) => Aabb::entry(b, ray),
+            BoundaryShape::Mesh(m) => mesh_entry(m, ray),
+        }
+    }
+
+    #[inline(always)]
+    fn exit(&self, ray: &Ray) -> BoxHit {
+        match self {
+            BoundaryShape::Box(b) => Aabb::exit(b, ray),
+            BoundaryShape::Mesh(m) => mesh_exit(m, ray),
+        }
+    }
+
+    #[inline(always)]
+    fn exit_distance(&self, ray: &Ray) -> f32 {
+        match self {
+            BoundaryShape::Box(b) => Aabb::exit_distance(b, ray),
+            BoundaryShape::Mesh(m) => mesh_exit_distance(m, ray),
+        }
+    }
+}
+
+#[inline(never)]
+fn mesh_contains(mesh: &TriangleMesh<'_>, p: crate::Vec3) -> bool {
+    mesh.contains(p)
+}
+
+#[inline(never)]
+fn mesh_entry(mesh: &TriangleMesh<'_>, ray: &Ray) -> Option<BoxHit> {
+    mesh.entry(ray)
+}
+
+#[inline(never)]
+fn mesh_exit(mesh: &TriangleMesh<'_>, ray: &Ray) -> BoxHit {
+    mesh.exit(ray)
+}
+
+#[inline(never)]
+fn mesh_exit_distance(mesh: &TriangleMesh<'_>, ray: &Ray) -> f32 {
+    mesh.exit_distance(ray)
 }

@@ -1,4 +1,5 @@
-//! A scene's box boundary against the same box as a 12-triangle mesh, on the CPU, same run:
+//! A scene's box boundary against the same box as a 12-triangle mesh (each as the factory holds
+//! it, a [`BoundaryShape`]), on the CPU, same run:
 //! segments per second of each (alternating, three rounds) and whether the images agree bit for
 //! bit (the mesh of a box traces the box's paths).
 //!
@@ -8,7 +9,7 @@ use std::path::PathBuf;
 
 use volpt_core::mesh::build::build;
 use volpt_core::mesh::primitives::cuboid;
-use volpt_core::WithShape;
+use volpt_core::{BoundaryShape, WithShape};
 use volpt_render::{path_settings, render, with_scene, RenderOptions, RenderScene, SceneVisitor};
 use volpt_scene::{builder_for, Config, SceneAssembler};
 
@@ -21,7 +22,7 @@ impl SceneVisitor for Compare {
         let buffers = build(&vertices, &triangles).expect("a box is a closed mesh");
         let meshed = WithShape {
             scene,
-            shape: buffers.mesh(),
+            shape: BoundaryShape::Mesh(buffers.mesh()),
         };
         let (mut boxed_rate, mut mesh_rate) = (0.0, 0.0);
         for round in 0..3 {

@@ -11,6 +11,9 @@
 use std::collections::HashMap;
 use std::fmt;
 use std::path::Path;
+use std::sync::Arc;
+
+use serde::{Serialize, Serializer};
 
 use volpt_core::mesh::build::{build, BuildError, MeshBuffers};
 
@@ -93,6 +96,80 @@ fn parse_error(line: Option<usize>, field: &str, expected: &str, found: &str) ->
         field: field.into(),
         expected: expected.into(),
         found: format!("\"{found}\""),
+    }
+}
+
+/// A closed triangle mesh that bounds the medium, placed in world space, with its BVH. The
+/// boundary's box ([`crate::BoundaryDesc::bounds`]) is then the mesh's bounding box.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshDesc {
+    /// What it was made from (a file, or Mitsuba's `sphere`), for `volpt info`.
+    pub source: String,
+    pub buffers: MeshBuffers,
+    /// FNV-1a of the triangles' bytes: what a scene's fingerprint takes in for them.
+    pub content: u64,
+}
+
+impl MeshDesc {
+    /// Checks `soup`, places it by `to_world` (a row-major affine transform, applied in f64, each
+    /// coordinate then rounded once to f32) and builds its BVH; `source` names it in errors and
+    /// in `volpt info`. A mirroring transform reverses every triangle, so that they still face
+    /// outwards.
+    pub fn placed(
+        source: &Path,
+        soup: &TriangleSoup,
+        to_world: &[[f64; 4]; 4],
+    ) -> Result<Arc<Self>, SceneError> {
+        let m = to_world;
+        let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+        let vertices: Vec<[f32; 3]> = soup
+            .vertices
+            .iter()
+            .map(|v| {
+                let p = v.map(f64::from);
+                core::array::from_fn(|r| {
+                    (m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3]) as f32
+                })
+            })
+            .collect();
+        let triangles: Vec<[u32; 3]> = if det < 0.0 {
+            soup.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect()
+        } else {
+            soup.triangles.clone()
+        };
+        let placed = TriangleSoup {
+            vertices,
+            triangles,
+        };
+        let buffers = build_mesh(source, &placed)?;
+        let mut hash = FNV_OFFSET;
+        for t in &buffers.triangles {
+            for byte in bytemuck::bytes_of(t) {
+                hash = (hash ^ u64::from(*byte)).wrapping_mul(FNV_PRIME);
+            }
+        }
+        Ok(Arc::new(Self {
+            source: source.display().to_string(),
+            buffers,
+            content: hash,
+        }))
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.buffers.triangles.len()
+    }
+}
+
+const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+const FNV_PRIME: u64 = 0x0000_0100_0000_01b3;
+
+/// The source, the triangle count and the triangles' hash: not the triangles themselves, which
+/// may be millions (a fingerprint serialises the description at every render).
+impl Serialize for MeshDesc {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        (&self.source, self.triangle_count() as u64, self.content).serialize(serializer)
     }
 }
 

@@ -76,6 +76,11 @@ pub enum BuildError {
         to: u32,
         triangles: usize,
     },
+    /// Every triangle faces inwards: the signed volume the mesh encloses, `volume`, is not
+    /// positive (a closed mesh that faces outwards encloses a positive one, cavities included).
+    InsideOut {
+        volume: f64,
+    },
 }
 
 impl fmt::Display for BuildError {
@@ -104,6 +109,12 @@ impl fmt::Display for BuildError {
             Self::NonManifoldEdge { from, to, triangles } => write!(
                 f,
                 "the mesh is not manifold: edge {from}-{to} borders {triangles} triangles, expected 2"
+            ),
+            Self::InsideOut { volume } => write!(
+                f,
+                "the mesh faces inwards: it encloses a signed volume of {volume:e}, expected a \
+                 positive one (each triangle's vertices counter-clockwise seen from outside); \
+                 reverse every triangle"
             ),
         }
     }
@@ -148,6 +159,7 @@ pub fn build(vertices: &[[f32; 3]], indices: &[[u32; 3]]) -> Result<MeshBuffers,
         let (normal, offset) = plane(&v).ok_or(BuildError::Degenerate { triangle })?;
         triangles.push(MeshTriangle { v, normal, offset });
     }
+    check_outward(vertices, indices)?;
     let mut prims: Vec<Prim> = triangles
         .iter()
         .enumerate()
@@ -172,6 +184,32 @@ pub fn build(vertices: &[[f32; 3]], indices: &[[u32; 3]]) -> Result<MeshBuffers,
         order,
         bounds,
     })
+}
+
+/// The divergence theorem: a closed mesh whose triangles face outwards encloses the positive
+/// volume `sum(a . (b x c)) / 6`, in f64 (relative to the first vertex, so that a mesh far from
+/// the origin keeps its digits). Inside-out meshes (an STL exported with inverted normals) are
+/// closed and consistent, so only this catches them.
+fn check_outward(vertices: &[[f32; 3]], indices: &[[u32; 3]]) -> Result<(), BuildError> {
+    let origin = vertices[indices[0][0] as usize].map(f64::from);
+    let at = |i: u32| {
+        let v = vertices[i as usize];
+        [0, 1, 2].map(|k| f64::from(v[k]) - origin[k])
+    };
+    let volume: f64 = indices
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(at);
+            a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                + a[2] * (b[0] * c[1] - b[1] * c[0])
+        })
+        .sum::<f64>()
+        / 6.0;
+    if volume > 0.0 {
+        Ok(())
+    } else {
+        Err(BuildError::InsideOut { volume })
+    }
 }
 
 fn check_indices(vertices: usize, indices: &[[u32; 3]]) -> Result<(), BuildError> {
