@@ -17,6 +17,7 @@ pub mod bsdf;
 pub mod camera;
 pub mod chromatic;
 pub mod environment;
+pub mod flight;
 pub mod frame;
 pub mod fresnel;
 pub mod geometry;

@@ -308,7 +308,8 @@ fn advance<S: Scene, const DEFER_SCATTER: bool>(scene: &S, path: &mut PathOf<S>)
         return None;
     }
     if path.inside {
-        let t_exit = scene.shape().exit_distance(&path.ray);
+        // Cast through a mesh only if the flight may reach it.
+        let t_exit = scene.shape().flight_exit(&path.ray);
         let collision = path.spectral.free_flight(
             scene.medium(),
             &path.ray,

@@ -6,6 +6,7 @@
 //! closed triangle mesh ([`crate::mesh::TriangleMesh`]) answers them with a ray cast through its
 //! BVH. Every answer's normal is the surface's outward geometric normal.
 
+use crate::flight::{FlightEnd, LazyExit};
 use crate::geometry::{Aabb, BoxHit, Ray};
 use crate::mesh::TriangleMesh;
 
@@ -40,10 +41,25 @@ pub trait Shape {
 
     /// `exit(ray).t`, the same bits, for a free flight that needs only the distance.
     fn exit_distance(&self, ray: &Ray) -> f32;
+
+    /// `exit_distance(ray)` as a free flight compares with it: the distance itself for a box, a
+    /// mesh's found only if a flight gets far enough to need it ([`crate::flight`]).
+    type Exit<'a>: FlightEnd
+    where
+        Self: 'a;
+
+    fn flight_exit<'a>(&'a self, ray: &'a Ray) -> Self::Exit<'a>;
 }
 
 impl Shape for Aabb {
     const CONVEX: bool = true;
+
+    type Exit<'a> = f32;
+
+    #[inline(always)]
+    fn flight_exit<'a>(&'a self, ray: &'a Ray) -> f32 {
+        Aabb::exit_distance(self, ray)
+    }
 
     #[inline(always)]
     fn bounds(&self) -> Aabb {
@@ -83,6 +99,19 @@ pub enum BoundaryShape<'a> {
 
 impl Shape for BoundaryShape<'_> {
     const CONVEX: bool = false;
+
+    type Exit<'e>
+        = LazyExit<'e>
+    where
+        Self: 'e;
+
+    #[inline(always)]
+    fn flight_exit<'e>(&'e self, ray: &'e Ray) -> LazyExit<'e> {
+        match self {
+            BoundaryShape::Box(b) => LazyExit::known(Aabb::exit_distance(b, ray), ray),
+            BoundaryShape::Mesh(m) => m.flight_exit(ray),
+        }
+    }
 
     #[inline(always)]
     fn convex(&self) -> bool {

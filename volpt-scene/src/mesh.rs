@@ -143,7 +143,7 @@ impl MeshDesc {
             vertices,
             triangles,
         };
-        let buffers = build_mesh(source, &placed)?;
+        let buffers = with_distances(build_mesh(source, &placed)?);
         let mut hash = FNV_OFFSET;
         for t in &buffers.triangles {
             for byte in bytemuck::bytes_of(t) {
@@ -160,6 +160,32 @@ impl MeshDesc {
     pub fn triangle_count(&self) -> usize {
         self.buffers.triangles.len()
     }
+}
+
+/// `buffers` with their distance grid ([`volpt_core::mesh::distance`]), its slabs computed on
+/// every core.
+fn with_distances(mut buffers: MeshBuffers) -> MeshBuffers {
+    use volpt_core::mesh::distance::{distance_slab, resolution_for, DISTANCE_RESOLUTION};
+    let res = resolution_for(buffers.bounds, DISTANCE_RESOLUTION);
+    let slab = (res[0] * res[1]) as usize;
+    let mut values = vec![0.0; slab * res[2] as usize];
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let slabs_per_thread = (res[2] as usize).div_ceil(threads);
+    let mesh = buffers.mesh();
+    std::thread::scope(|scope| {
+        for (chunk, out) in values.chunks_mut(slab * slabs_per_thread).enumerate() {
+            let mesh = &mesh;
+            scope.spawn(move || {
+                for (i, out) in out.chunks_mut(slab).enumerate() {
+                    let z = chunk * slabs_per_thread + i;
+                    distance_slab(mesh, res, z as u32, out);
+                }
+            });
+        }
+    });
+    buffers.distances = values;
+    buffers.distance_res = res;
+    buffers
 }
 
 const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;

@@ -23,15 +23,42 @@ pub struct MeshBuffers {
     /// `order[i]`: the input index of triangle `i`.
     pub order: Vec<u32>,
     pub bounds: Aabb,
+    /// The distance grid's values ([`super::SurfaceDistance`]), empty until
+    /// [`MeshBuffers::with_distances`], and its resolution.
+    pub distances: Vec<f32>,
+    pub distance_res: [u32; 3],
 }
 
 impl MeshBuffers {
     pub fn mesh(&self) -> super::TriangleMesh<'_> {
+        let distance = if self.distances.is_empty() {
+            super::SurfaceDistance::NONE
+        } else {
+            super::SurfaceDistance {
+                values: &self.distances,
+                ..super::distance::layout(self.bounds, self.distance_res)
+            }
+        };
         super::TriangleMesh {
             nodes: &self.nodes,
             triangles: &self.triangles,
             bounds: self.bounds,
+            distance,
         }
+    }
+
+    /// These buffers with a distance grid of `res` cells over the mesh's box, computed here one
+    /// slab after another (a host with threads may compute the slabs,
+    /// [`super::distance::distance_slab`], in parallel and set `distances` itself).
+    pub fn with_distances(mut self, res: [u32; 3]) -> Self {
+        let slab = (res[0] * res[1]) as usize;
+        let mut values = alloc::vec![0.0; slab * res[2] as usize];
+        for (z, out) in values.chunks_mut(slab).enumerate() {
+            super::distance::distance_slab(&self.mesh(), res, z as u32, out);
+        }
+        self.distances = values;
+        self.distance_res = res;
+        self
     }
 }
 
@@ -183,6 +210,8 @@ pub fn build(vertices: &[[f32; 3]], indices: &[[u32; 3]]) -> Result<MeshBuffers,
         triangles: order.iter().map(|&i| triangles[i as usize]).collect(),
         order,
         bounds,
+        distances: Vec::new(),
+        distance_res: [0; 3],
     })
 }
 
