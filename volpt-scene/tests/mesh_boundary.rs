@@ -58,9 +58,9 @@ fn octahedron_ply() -> String {
             [x, z, y]
         });
     }
-    let mut text = format!(
+    let mut text = String::from(
         "ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\nproperty float y\n\
-         property float z\nelement face 8\nproperty list uchar int vertex_indices\nend_header\n"
+         property float z\nelement face 8\nproperty list uchar int vertex_indices\nend_header\n",
     );
     for v in vertices {
         text += &format!("{} {} {}\n", v[0], v[1], v[2]);

@@ -84,7 +84,8 @@ pub(crate) fn boundary(
             let radius = match p.find(&["radius"])? {
                 Some(arg) => {
                     let r = arg.float()?;
-                    if !(r > 0.0) {
+                    // `float` is finite.
+                    if r <= 0.0 {
                         return Err(arg.invalid("a positive radius", r.to_string()));
                     }
                     f64::from(r)
