@@ -137,20 +137,6 @@ fn negative_density_names_the_voxel() {
 }
 
 #[test]
-fn rgb_density_grid_is_an_error() {
-    let text = medium_scene(GRID_MEDIUM);
-    let (dir, path) = scene_file(&text);
-    let grid = VolGrid {
-        channels: 3,
-        data: vec![0.5; 24],
-        ..density_grid([2, 2, 2], unit_bounds())
-    };
-    write_grid(dir.path(), "density.vol", &grid);
-    let err = load_mitsuba(&path).unwrap_err();
-    message_of(&err, &["density.vol", "1 channel", "found 3"]);
-}
-
-#[test]
 fn albedo_grid_above_one_is_an_error() {
     let text = medium_scene(
         r#"<medium type="heterogeneous" name="interior">

@@ -22,7 +22,7 @@ use crate::vol::{read_vol, VolGrid};
 /// What a volume is used for, which decides the values and channel counts it may hold.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Role {
-    /// Extinction: one channel, values >= 0.
+    /// Extinction: one channel, or three (a density per channel), values >= 0.
     Density,
     /// Single-scattering albedo: one (grey) or three channels, values in [0, 1]. A one-channel
     /// grid is expanded to three.
