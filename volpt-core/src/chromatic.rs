@@ -3,7 +3,8 @@
 //!
 //! `sigma_t(p) = extinction * density(p)`: an RGB extinction times an optional density grid (none:
 //! density 1, a homogeneous chromatic medium) of one channel, or of three (a density per channel:
-//! Mitsuba's RGB `sigma_t` `gridvolume`); the albedo is a constant or an RGB grid. Or a
+//! Mitsuba's RGB `sigma_t` `gridvolume`); the albedo is a constant or an RGB grid; RGB grids are
+//! read trilinearly or, where their lookup says so, nearest. Or a
 //! material-indexed volume ([`crate::material`]): extinction, albedo and phase asymmetry from the
 //! table row of the voxel's material. Which of these a medium has is a run-time branch inside the
 //! one type, so chromatic media add one value to the registry's medium axis, not a cartesian
@@ -32,7 +33,7 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::abi::{Component, GridParams, Upload};
-use crate::grid::{DenseTrilinear, Grid, GridPlacement, GridReads};
+use crate::grid::{DenseTrilinear, Grid, GridLookup, GridPlacement, GridReads};
 use crate::majorant::{build_majorants, MajorantGrid, MajorantGridParams};
 use crate::material::{MaterialGrid, MaterialGridParams};
 use crate::medium::{Medium, TrackedMedium};
@@ -189,9 +190,7 @@ impl Medium for ChromaticMedium<'_> {
         }
         match (&self.density, &self.density_rgb) {
             (Some(grid), _) => self.extinction * DenseTrilinear::lookup(grid, p)[0],
-            (None, Some(grid)) => {
-                self.extinction * Spectrum::from_array(DenseTrilinear::lookup(grid, p))
-            }
+            (None, Some(grid)) => self.extinction * Spectrum::from_array(read(grid, p)),
             (None, None) => self.extinction,
         }
     }
@@ -213,7 +212,7 @@ impl Medium for ChromaticMedium<'_> {
             return materials.albedo(p);
         }
         match &self.albedo_grid {
-            Some(grid) => Spectrum::from_array(DenseTrilinear::lookup(grid, p)),
+            Some(grid) => Spectrum::from_array(read(grid, p)),
             None => self.albedo,
         }
     }
@@ -244,6 +243,18 @@ impl<'a> TrackedMedium<'a> for ChromaticMedium<'a> {
 
     fn materials(&self) -> Option<MaterialGrid<'a>> {
         self.materials
+    }
+}
+
+/// A dense grid's value at `p`, trilinear, or the nearest sample's where the grid says so (an
+/// RGB grid exported from a material-indexed volume, Mitsuba's `filter_type` `nearest`): a
+/// run-time branch, the trilinear read's arithmetic unchanged.
+#[inline(always)]
+fn read(grid: &Grid<'_, 3>, p: Vec3) -> [f32; 3] {
+    if grid.lookup == GridLookup::Nearest {
+        grid.lookup(p)
+    } else {
+        DenseTrilinear::lookup(grid, p)
     }
 }
 

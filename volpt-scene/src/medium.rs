@@ -28,7 +28,7 @@ use crate::material::{IndexedDesc, InfoTable, MaterialDesc};
 use crate::mitsuba::export::rgb_element;
 use crate::mitsuba::plugin::{quoted, Arg, Ctx, Plugin};
 use crate::mitsuba::preprocess::Dialect;
-use crate::mitsuba::volume::{constant_error, volume, Role, VolumeValue};
+use crate::mitsuba::volume::{constant_error, volume, Filter, Role, VolumeValue};
 use crate::mitsuba::xml::Element;
 use crate::phase::PhaseDesc;
 use crate::simplification::Simplification;
@@ -159,8 +159,9 @@ impl MediumDesc {
             Some(arg) => PhaseDesc::from_mitsuba(arg.target, ctx)?,
             None => PhaseDesc::Isotropic,
         };
-        let (density, albedo) = if kind == "homogeneous" {
-            homogeneous(&p)?
+        let (density, albedo, lookup) = if kind == "homogeneous" {
+            let (density, albedo) = homogeneous(&p)?;
+            (density, albedo, GridLookup::Trilinear)
         } else {
             heterogeneous(&p)?
         };
@@ -172,7 +173,7 @@ impl MediumDesc {
             scale,
             albedo,
             phase,
-            lookup: Default::default(),
+            lookup,
             storage: Default::default(),
         })
     }
@@ -270,7 +271,11 @@ fn homogeneous(p: &Plugin<'_>) -> Result<(DensityDesc, AlbedoDesc), SceneError> 
     }
 }
 
-fn heterogeneous(p: &Plugin<'_>) -> Result<(DensityDesc, AlbedoDesc), SceneError> {
+/// A heterogeneous medium's extinction and albedo, and how its grids are read: nearest where
+/// every grid's `filter_type` says so (volpt reads a medium's grids one way), else trilinearly
+/// (grids whose filters differ are warned about).
+fn heterogeneous(p: &Plugin<'_>) -> Result<(DensityDesc, AlbedoDesc, GridLookup), SceneError> {
+    let mut filters = Vec::new();
     let density = match p.find(&["density", "sigma_t"])? {
         None => DensityDesc::Constant(default_for(
             p,
@@ -278,7 +283,10 @@ fn heterogeneous(p: &Plugin<'_>) -> Result<(DensityDesc, AlbedoDesc), SceneError
             "<volume name=\"density\">",
         )?),
         Some(arg) => match volume(&arg, p.ctx, Role::Density)? {
-            VolumeValue::Grid(grid) => DensityDesc::Grid(grey_if_equal(grid)),
+            VolumeValue::Grid(grid, filter) => {
+                filters.push(filter);
+                DensityDesc::Grid(grey_if_equal(grid))
+            }
             VolumeValue::Constant(v) => extinction(non_negative(&arg, v)?),
         },
     };
@@ -287,23 +295,39 @@ fn heterogeneous(p: &Plugin<'_>) -> Result<(DensityDesc, AlbedoDesc), SceneError
             AlbedoDesc::Constant([default_for(p, DEFAULT_ALBEDO, "<volume name=\"albedo\">")?; 3])
         }
         Some(arg) => match volume(&arg, p.ctx, Role::Albedo)? {
-            VolumeValue::Grid(grid) => AlbedoDesc::Grid(grid),
+            VolumeValue::Grid(grid, filter) => {
+                filters.push(filter);
+                AlbedoDesc::Grid(grid)
+            }
             VolumeValue::Constant(v) => AlbedoDesc::Constant(in_unit_range(&arg, v)?),
         },
+    };
+    let lookup = match filters[..] {
+        [Filter::Nearest] | [Filter::Nearest, Filter::Nearest] => GridLookup::Nearest,
+        [Filter::Trilinear, Filter::Nearest] | [Filter::Nearest, Filter::Trilinear] => {
+            tracing::warn!(
+                "{}:{}: the medium's grids have different filter_type values: volpt reads both \
+                 trilinearly",
+                p.el.file.display(),
+                p.el.line
+            );
+            GridLookup::Trilinear
+        }
+        _ => GridLookup::Trilinear,
     };
     p.warn_unless(
         &["method"],
         "woodcock",
         "delta (Woodcock) tracking, which is unbiased",
     )?;
-    Ok((density, albedo))
+    Ok((density, albedo, lookup))
 }
 
 /// A constant parameter of a homogeneous medium (a grid would need a heterogeneous one).
 fn constant(p: &Plugin<'_>, arg: &Arg<'_>) -> Result<[f32; 3], SceneError> {
     match volume(arg, p.ctx, Role::Density)? {
         VolumeValue::Constant(v) => Ok(v),
-        VolumeValue::Grid(_) => Err(SceneError::Unsupported {
+        VolumeValue::Grid(..) => Err(SceneError::Unsupported {
             path: arg.target.file.to_path_buf(),
             line: arg.target.line,
             what: arg.target.describe(),
@@ -486,10 +510,12 @@ impl MediumDesc {
             DensityDesc::Grid(g) => g.channels == 3,
             DensityDesc::Constant(_) | DensityDesc::Indexed(_) => false,
         };
-        if chromatic_grids && (sparse || !plain_reads) {
+        let chromatic_reads = plain_reads
+            || (self.lookup == GridLookup::Nearest && self.storage == GridStorage::Dense);
+        if chromatic_grids && (sparse || !chromatic_reads) {
             return Err(invalid(
                 "grid lookup",
-                "trilinear lookups of dense grids beside a chromatic extinction",
+                "trilinear or nearest lookups of dense grids beside a chromatic extinction",
                 format!("{:?} lookups, {:?} storage", self.lookup, self.storage),
             ));
         }
@@ -603,6 +629,11 @@ impl MediumDesc {
         &self,
         grid: &mut GridWriter<'_>,
     ) -> Result<(&'static str, String, String), SceneError> {
+        // Nearest lookups are Mitsuba 3's `nearest` filter; the others are written trilinear.
+        let filter = match self.lookup {
+            GridLookup::Nearest => "nearest",
+            _ => "trilinear",
+        };
         let (medium_type, sigma_t) = match &self.density {
             DensityDesc::Constant(d) => (
                 "homogeneous",
@@ -619,7 +650,7 @@ impl MediumDesc {
                 };
                 ("homogeneous", rgb_element("sigma_t", &unit))
             }
-            DensityDesc::Grid(g) => ("heterogeneous", grid(g, "density", "sigma_t", "trilinear")?),
+            DensityDesc::Grid(g) => ("heterogeneous", grid(g, "density", "sigma_t", filter)?),
             // Mitsuba 3 reads no material table: the table expanded per voxel, read nearest.
             DensityDesc::Indexed(indexed) => {
                 let g = indexed.materials().first().map_or(0.0, |m| m.g);
@@ -641,7 +672,7 @@ impl MediumDesc {
         };
         let albedo = match &self.albedo {
             AlbedoDesc::Constant(rgb) => rgb_element("albedo", rgb),
-            AlbedoDesc::Grid(g) => grid(g, "albedo", "albedo", "trilinear")?,
+            AlbedoDesc::Grid(g) => grid(g, "albedo", "albedo", filter)?,
         };
         Ok((medium_type, sigma_t, albedo))
     }
@@ -968,6 +999,9 @@ impl fmt::Display for DensityDesc {
             DensityDesc::Constant(d) => write!(f, "constant {d}"),
             DensityDesc::Rgb(rgb) => write!(f, "constant RGB {rgb:?} (chromatic)"),
             DensityDesc::Indexed(indexed) => write!(f, "{}", InfoTable(indexed)),
+            DensityDesc::Grid(g) if g.channels == 3 => {
+                write!(f, "{} (a density per channel: chromatic)", InfoGrid(g))
+            }
             DensityDesc::Grid(g) => write!(f, "{}", InfoGrid(g)),
         }
     }

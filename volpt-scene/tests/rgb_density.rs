@@ -108,12 +108,51 @@ fn a_negative_channel_or_a_transfer_function_beside_it_is_refused() {
     message_of(&err, &["albedo.transfer_function", "three channels"]);
 }
 
-/// A chromatic grid is read by trilinear lookups of dense samples; another lookup is refused
-/// when the scene is checked.
+/// A chromatic grid is read trilinearly or nearest, from dense samples; a texture lookup is
+/// refused when the scene is checked.
 #[test]
-fn a_density_per_channel_with_nearest_lookups_is_refused() {
+fn a_density_per_channel_with_texture_lookups_is_refused() {
     let mut desc = toml(&rgb_grid(|_| {}), "").unwrap();
     desc.medium.lookup = GridLookup::Nearest;
+    volpt_scene::validate::validate(&desc, "scene.toml").unwrap();
+    desc.medium.lookup = GridLookup::Texture;
     let err = volpt_scene::validate::validate(&desc, "scene.toml").unwrap_err();
-    message_of(&err, &["grid lookup", "trilinear lookups of dense grids", "Nearest"]);
+    message_of(
+        &err,
+        &["grid lookup", "trilinear or nearest lookups of dense grids", "Texture"],
+    );
+}
+
+/// Mitsuba 3's `filter_type`: `nearest` on every grid of the medium reads them nearest (an
+/// exported material-indexed volume's grids), `trilinear` or none trilinearly, and grids whose
+/// filters differ trilinearly (with a warning).
+#[test]
+fn a_gridvolume_filter_type_of_nearest_reads_the_medium_nearest() {
+    let grid = rgb_grid(|_| {});
+    let nearest = r#"<string name="filter_type" value="nearest"/>"#;
+    let albedo = |filter: &str| {
+        format!(
+            r#"<volume name="albedo" type="gridvolume"><string name="filename" value="albedo.vol"/>{filter}</volume>"#
+        )
+    };
+    let load = |sigma_filter: &str, albedo: &str| {
+        let text = medium_scene(&format!(
+            r#"<medium type="heterogeneous" name="interior">
+                <volume name="sigma_t" type="gridvolume"><string name="filename" value="rgb.vol"/>{sigma_filter}</volume>
+                {albedo}
+            </medium>"#
+        ));
+        let (dir, path) = scene_file(&text);
+        write_grid(dir.path(), "rgb.vol", &grid);
+        let albedo_grid = VolGrid {
+            data: vec![0.5; 24],
+            ..grid.clone()
+        };
+        write_grid(dir.path(), "albedo.vol", &albedo_grid);
+        load_mitsuba(&path).unwrap().medium.lookup
+    };
+    assert_eq!(load(nearest, ""), GridLookup::Nearest);
+    assert_eq!(load(nearest, &albedo(nearest)), GridLookup::Nearest);
+    assert_eq!(load("", ""), GridLookup::Trilinear);
+    assert_eq!(load(nearest, &albedo("")), GridLookup::Trilinear);
 }
