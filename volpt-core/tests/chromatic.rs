@@ -3,8 +3,10 @@
 //! a test no weight can be tuned to pass), for a homogeneous and a grid medium (with its majorant
 //! grid and an albedo grid), path tracing and next-event estimation, behind each boundary kind;
 //! that the spectral MIS weights stay finite and bounded on media whose channels are 10^10 apart;
-//! that each channel's own majorant leaves a homogeneous medium without null collisions; and that
-//! it lowers the variance at equal samples against one majorant for all channels.
+//! that each channel's own majorant leaves a homogeneous medium without null collisions; that it
+//! lowers the variance at equal samples against one majorant for all channels, and lets every
+//! hero's path live as long as the longest-lived channel's light; and that a density per channel
+//! renders as per-channel scales of a grey grid (bit for bit under the global majorant).
 //!
 //! With `VOLPT_FULL_POWER=1` each comparison has the power to see a 1% bias at 10 standard errors:
 //! it asserts that the standard error of the difference is at most 0.1% of the mean (2^23 paths a
