@@ -25,7 +25,11 @@ fn medium(channel: Option<usize>) -> MediumDesc {
         None => (
             GridDesc {
                 channels: 3,
-                data: grey.data.iter().flat_map(|d| SCALES.map(|e| d * e)).collect(),
+                data: grey
+                    .data
+                    .iter()
+                    .flat_map(|d| SCALES.map(|e| d * e))
+                    .collect(),
                 ..grey
             },
             ALBEDO,
@@ -49,7 +53,11 @@ fn medium(channel: Option<usize>) -> MediumDesc {
 }
 
 fn scene(channel: Option<usize>) -> SceneDescription {
-    framed_scene(12, medium(channel), EnvironmentDesc::Constant([1.0, 0.9, 0.8]))
+    framed_scene(
+        12,
+        medium(channel),
+        EnvironmentDesc::Constant([1.0, 0.9, 0.8]),
+    )
 }
 
 #[test]
@@ -74,12 +82,17 @@ fn each_channel_of_a_density_per_channel_renders_as_its_grey_grid() {
             ..plain_path_tracing()
         };
         let chromatic = ImageMean::render(&scene(None), SPP, 1, settings);
-        let twins = [0, 1, 2].map(|c| ImageMean::render(&scene(Some(c)), SPP, 2 + c as u32, settings));
+        let twins =
+            [0, 1, 2].map(|c| ImageMean::render(&scene(Some(c)), SPP, 2 + c as u32, settings));
         let grey = ImageMean {
             mean: [0, 1, 2].map(|c| twins[c].mean[c]),
             var: [0, 1, 2].map(|c| twins[c].var[c]),
         };
-        assert_agree(&format!("density per channel, {estimator:?}"), &grey, &chromatic);
+        assert_agree(
+            &format!("density per channel, {estimator:?}"),
+            &grey,
+            &chromatic,
+        );
     }
 }
 

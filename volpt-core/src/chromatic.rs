@@ -252,7 +252,7 @@ impl<'a> TrackedMedium<'a> for ChromaticMedium<'a> {
 #[inline(always)]
 fn read(grid: &Grid<'_, 3>, p: Vec3) -> [f32; 3] {
     if grid.lookup == GridLookup::Nearest {
-        grid.lookup(p)
+        grid.lookup_dense_nearest(p)
     } else {
         DenseTrilinear::lookup(grid, p)
     }
@@ -271,8 +271,16 @@ pub fn build_channel_majorants(
     channels: &mut [f32],
     bound: &mut [f32],
 ) {
-    assert_eq!(channels.len(), 3 * bound.len(), "three channel bounds a cell");
-    assert_eq!(3 * plane.len(), density.data.len(), "one plane value a sample");
+    assert_eq!(
+        channels.len(),
+        3 * bound.len(),
+        "three channel bounds a cell"
+    );
+    assert_eq!(
+        3 * plane.len(),
+        density.data.len(),
+        "one plane value a sample"
+    );
     for c in 0..3 {
         for (v, s) in plane.iter_mut().zip(density.data.chunks_exact(3)) {
             *v = s[c];

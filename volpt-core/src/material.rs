@@ -113,7 +113,11 @@ impl<'a> MaterialGrid<'a> {
         assert!(table.len().is_multiple_of(MATERIAL_FLOATS) && !table.is_empty());
         let materials = table.len() / MATERIAL_FLOATS;
         assert!(materials <= MAX_MATERIALS, "table size");
-        assert_eq!(indices.len(), index_words(voxels, materials), "index grid size");
+        assert_eq!(
+            indices.len(),
+            index_words(voxels, materials),
+            "index grid size"
+        );
         let mut grid = Self {
             indices,
             res,

@@ -517,7 +517,11 @@ fn own_channel_majorants_lower_the_variance_at_equal_samples() {
 fn a_density_per_channel_renders_as_per_channel_scales_of_its_grey_grid() {
     const SCALE: f32 = 1.25;
     const CHANNELS: [f32; 3] = [1.0, 2.0, 4.0];
-    const SCALES: [f32; 3] = [SCALE * CHANNELS[0], SCALE * CHANNELS[1], SCALE * CHANNELS[2]];
+    const SCALES: [f32; 3] = [
+        SCALE * CHANNELS[0],
+        SCALE * CHANNELS[1],
+        SCALE * CHANNELS[2],
+    ];
     let grids = Grids::new();
     let rgb: Vec<f32> = grids
         .density
@@ -568,15 +572,40 @@ fn a_density_per_channel_renders_as_per_channel_scales_of_its_grey_grid() {
         let k = cell[0] + 2 * cell[1] + 4 * cell[2];
         let sigma = per_channel.sigma_t_rgb(p);
         for c in 0..3 {
-            assert!(sigma[c] <= channels[3 * k + c], "{p:?}: channel {c} {sigma:?}");
+            assert!(
+                sigma[c] <= channels[3 * k + c],
+                "{p:?}: channel {c} {sigma:?}"
+            );
         }
-        assert_eq!(cells[k], channels[3 * k..3 * k + 3].iter().copied().fold(0.0, f32::max));
+        assert_eq!(
+            cells[k],
+            channels[3 * k..3 * k + 3]
+                .iter()
+                .copied()
+                .fold(0.0, f32::max)
+        );
     }
-    let grey = render(&scene(scaled, rough(), Estimator::PathTracing), power().0, 1);
-    let rgb = render(&scene(per_channel, rough(), Estimator::PathTracing), power().0, 2);
+    let grey = render(
+        &scene(scaled, rough(), Estimator::PathTracing),
+        power().0,
+        1,
+    );
+    let rgb = render(
+        &scene(per_channel, rough(), Estimator::PathTracing),
+        power().0,
+        2,
+    );
     assert_identity("density per channel, rough, PT", rgb, [grey; 3]);
-    let grey = render(&scene(scaled, NullBoundary, Estimator::NextEvent), power().0, 1);
-    let rgb = render(&scene(per_channel, NullBoundary, Estimator::NextEvent), power().0, 2);
+    let grey = render(
+        &scene(scaled, NullBoundary, Estimator::NextEvent),
+        power().0,
+        1,
+    );
+    let rgb = render(
+        &scene(per_channel, NullBoundary, Estimator::NextEvent),
+        power().0,
+        2,
+    );
     assert_identity("density per channel, null, NEE", rgb, [grey; 3]);
 }
 
@@ -587,10 +616,7 @@ fn same_paths<B: Bsdf + Copy>(
     boundary: B,
     estimator: Estimator,
 ) {
-    let (a, b) = (
-        scene(a, boundary, estimator),
-        scene(b, boundary, estimator),
-    );
+    let (a, b) = (scene(a, boundary, estimator), scene(b, boundary, estimator));
     for sample in 0..4096 {
         let mut p = PathState::from_camera(&a, sample % 4, (sample / 4) % 4, sample / 16, 5);
         let mut q = PathState::from_camera(&b, sample % 4, (sample / 4) % 4, sample / 16, 5);

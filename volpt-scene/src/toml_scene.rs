@@ -549,8 +549,12 @@ fn assemble_indexed(
             }
         };
         match indices {
-            SliceIndices::Bytes(i) => IndexedDesc::new(volume_path, materials, resolution, bounds, &i)?,
-            SliceIndices::Wide(i) => IndexedDesc::new(volume_path, materials, resolution, bounds, &i)?,
+            SliceIndices::Bytes(i) => {
+                IndexedDesc::new(volume_path, materials, resolution, bounds, &i)?
+            }
+            SliceIndices::Wide(i) => {
+                IndexedDesc::new(volume_path, materials, resolution, bounds, &i)?
+            }
         }
     } else {
         let (grid, _) = read_volume(cx, volume_path, v)?;

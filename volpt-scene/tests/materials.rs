@@ -182,7 +182,9 @@ fn a_table_of_more_than_256_materials_has_16_bit_indices() {
             [(k / 256) as u8, (k % 256) as u8, 7]
         });
     }
-    let text = format!("[volume]\nfile = \"layers\"\nbounds = [[0.0, 0.0, 0.0], [3.0, 2.0, 2.0]]\n{materials}");
+    let text = format!(
+        "[volume]\nfile = \"layers\"\nbounds = [[0.0, 0.0, 0.0], [3.0, 2.0, 2.0]]\n{materials}"
+    );
     let slices = write(dir.path(), "slices.toml", text.as_bytes());
     for path in [raw, slices] {
         let desc = load(&path).unwrap();
@@ -207,7 +209,10 @@ fn a_table_of_more_than_256_materials_has_16_bit_indices() {
         for (i, &k) in WIDE_PRINT.iter().enumerate() {
             let (x, y, z) = (i % 3, i / 3 % 2, i / 6);
             let centre = volpt_core::Vec3::new(x as f32 + 0.5, y as f32 + 0.5, z as f32 + 0.5);
-            assert_eq!(grid.sigma_t(centre), volpt_core::Spectrum::splat(k as f32 + 1.0));
+            assert_eq!(
+                grid.sigma_t(centre),
+                volpt_core::Spectrum::splat(k as f32 + 1.0)
+            );
         }
         assert_eq!(grid.max_extinction(), 300.0);
     }

@@ -7,13 +7,14 @@ mod common;
 
 use common::*;
 use volpt_scene::{
-    builder_for, load_mitsuba, Config, DensityDesc, GridLookup, SceneAssembler, SceneError,
-    VolGrid,
+    builder_for, load_mitsuba, Config, DensityDesc, GridLookup, SceneAssembler, SceneError, VolGrid,
 };
 
 /// A 2x2x2 grid of three channels, `edit`ed.
 fn rgb_grid(edit: impl FnOnce(&mut Vec<f32>)) -> VolGrid {
-    let mut data: Vec<f32> = (0..8).flat_map(|i| [i as f32, 2.0 * i as f32, 4.0 * i as f32]).collect();
+    let mut data: Vec<f32> = (0..8)
+        .flat_map(|i| [i as f32, 2.0 * i as f32, 4.0 * i as f32])
+        .collect();
     edit(&mut data);
     VolGrid {
         channels: 3,
@@ -46,7 +47,11 @@ fn toml(grid: &VolGrid, extra: &str) -> Result<volpt_scene::SceneDescription, Sc
     let dir = tempfile::tempdir().unwrap();
     write_grid(dir.path(), "rgb.vol", grid);
     let path = dir.path().join("scene.toml");
-    std::fs::write(&path, format!("[volume]\nfile = \"rgb.vol\"\nscale = 2.0\n{extra}")).unwrap();
+    std::fs::write(
+        &path,
+        format!("[volume]\nfile = \"rgb.vol\"\nscale = 2.0\n{extra}"),
+    )
+    .unwrap();
     SceneAssembler::new(Config::default()).assemble(builder_for(&path)?.as_ref())
 }
 
@@ -83,7 +88,10 @@ fn a_three_channel_sigma_t_of_equal_channels_loads_as_a_grey_grid() {
         (toml(&grey, "").unwrap(), toml(&beside, "").unwrap()),
     ] {
         assert_eq!(density(&desc).channels, 1);
-        assert_eq!(density(&desc).data, (0..8).map(|i| i as f32).collect::<Vec<_>>());
+        assert_eq!(
+            density(&desc).data,
+            (0..8).map(|i| i as f32).collect::<Vec<_>>()
+        );
         assert!(!desc.medium.is_chromatic());
         assert_eq!(density(&beside).channels, 3);
         assert!(beside.medium.is_chromatic());
@@ -93,7 +101,10 @@ fn a_three_channel_sigma_t_of_equal_channels_loads_as_a_grey_grid() {
 #[test]
 fn a_negative_channel_or_a_transfer_function_beside_it_is_refused() {
     let negative = rgb_grid(|d| d[3 * 6 + 1] = -1.0);
-    for err in [mitsuba(&negative, "").unwrap_err(), toml(&negative, "").unwrap_err()] {
+    for err in [
+        mitsuba(&negative, "").unwrap_err(),
+        toml(&negative, "").unwrap_err(),
+    ] {
         message_of(&err, &["rgb.vol", "voxel (x=0, y=1, z=1)", ">= 0", "-1"]);
     }
     let grid = rgb_grid(|_| {});
@@ -102,7 +113,10 @@ fn a_negative_channel_or_a_transfer_function_beside_it_is_refused() {
     std::fs::write(&tf, "0 0.5 0.5 0.5\n30 0.9 0.9 0.9\n").unwrap();
     let err = toml(
         &grid,
-        &format!("[albedo]\ntransfer_function = {:?}\n", tf.display().to_string()),
+        &format!(
+            "[albedo]\ntransfer_function = {:?}\n",
+            tf.display().to_string()
+        ),
     )
     .unwrap_err();
     message_of(&err, &["albedo.transfer_function", "three channels"]);
@@ -119,7 +133,11 @@ fn a_density_per_channel_with_texture_lookups_is_refused() {
     let err = volpt_scene::validate::validate(&desc, "scene.toml").unwrap_err();
     message_of(
         &err,
-        &["grid lookup", "trilinear or nearest lookups of dense grids", "Texture"],
+        &[
+            "grid lookup",
+            "trilinear or nearest lookups of dense grids",
+            "Texture",
+        ],
     );
 }
 

@@ -44,8 +44,8 @@ use std::sync::Arc;
 use volpt_core::abi::SceneAbi;
 use volpt_core::grid::Grid;
 
-use volpt_core::majorant::MajorantGrid;
 use volpt_core::chromatic::build_channel_majorants;
+use volpt_core::majorant::MajorantGrid;
 use volpt_core::material::build_material_channel_majorants;
 use volpt_core::math::tan;
 use volpt_core::path::Estimator;
@@ -430,21 +430,24 @@ impl Derived {
         // A density per channel: each channel's bounds from its own samples (built anew each
         // time, as an indexed volume's).
         let per_channel = |res: [u32; 3]| {
-            parts.medium.channel_densities().map(|(density, extinction)| {
-                let cells = res.iter().map(|&r| r as usize).product::<usize>();
-                let (mut channels, mut data) = (vec![0.0; 3 * cells], vec![0.0; cells]);
-                let mut plane = vec![0.0; density.data.len() / 3];
-                build_channel_majorants(
-                    &density,
-                    extinction,
-                    bounds,
-                    res,
-                    &mut plane,
-                    &mut channels,
-                    &mut data,
-                );
-                (Arc::new(Majorants { data, res }), Some(channels))
-            })
+            parts
+                .medium
+                .channel_densities()
+                .map(|(density, extinction)| {
+                    let cells = res.iter().map(|&r| r as usize).product::<usize>();
+                    let (mut channels, mut data) = (vec![0.0; 3 * cells], vec![0.0; cells]);
+                    let mut plane = vec![0.0; density.data.len() / 3];
+                    build_channel_majorants(
+                        &density,
+                        extinction,
+                        bounds,
+                        res,
+                        &mut plane,
+                        &mut channels,
+                        &mut data,
+                    );
+                    (Arc::new(Majorants { data, res }), Some(channels))
+                })
         };
         let majorants = (settings.majorant_resolution > 1)
             .then(|| MajorantGrid::resolution_for(bounds, settings.majorant_resolution))
