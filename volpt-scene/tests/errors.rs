@@ -6,7 +6,7 @@ mod common;
 use std::path::Path;
 
 use common::*;
-use volpt_scene::{load_mitsuba, AlbedoDesc, DensityDesc, SceneError, VolGrid};
+use volpt_scene::{load_mitsuba, AlbedoDesc, DensityDesc, SceneError};
 
 /// The 1-based line of the first occurrence of `needle` in `text`.
 fn line_of(text: &str, needle: &str) -> usize {

@@ -11,7 +11,7 @@ use volpt_scene::{
 };
 
 /// A 2x2x2 grid of three channels, `edit`ed.
-fn rgb_grid(edit: impl FnOnce(&mut Vec<f32>)) -> VolGrid {
+fn rgb_grid(edit: impl FnOnce(&mut [f32])) -> VolGrid {
     let mut data: Vec<f32> = (0..8)
         .flat_map(|i| [i as f32, 2.0 * i as f32, 4.0 * i as f32])
         .collect();
@@ -24,7 +24,7 @@ fn rgb_grid(edit: impl FnOnce(&mut Vec<f32>)) -> VolGrid {
 }
 
 /// Equal channels in every sample: a grey grid spelt in three.
-fn equal_channels(data: &mut Vec<f32>) {
+fn equal_channels(data: &mut [f32]) {
     for s in data.chunks_exact_mut(3) {
         s[1] = s[0];
         s[2] = s[0];

@@ -75,6 +75,9 @@ macro_rules! axis {
     ($(#[$doc:meta])* $part:ident $(<$lt:lifetime>)?, $kind:ident, $input:ty, $rule:ident,
      [$(($camel:ident, $snake:ident, $ty:ty))*]) => {
         $(#[$doc])*
+        // One built part per render, moved into the scene it renders: the chromatic medium's
+        // grids and tables make its variant the largest, which costs nothing here.
+        #[allow(clippy::large_enum_variant)]
         pub enum $part $(<$lt>)? {
             $($camel($ty),)*
         }
