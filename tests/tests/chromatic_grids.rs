@@ -15,7 +15,7 @@ use volpt_tests::plain_path_tracing;
 /// Each channel's extinction per unit density: channels 5x apart, the cyan resin's regime.
 const SCALES: [f32; 3] = [1.2, 3.0, 6.0];
 const ALBEDO: [f32; 3] = [0.9, 0.7, 0.5];
-const SPP: u32 = 256;
+const SPP: u32 = 12288;
 
 /// The generated density with holes times [`SCALES`] per channel, as one three-channel grid
 /// (`rgb`), or channel `c`'s alone as a grey grid.
