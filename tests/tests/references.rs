@@ -67,6 +67,7 @@ fn scene(
         boundary: BoundaryDesc {
             bounds: unit_cube(),
             bsdf: BsdfDesc::Null,
+            mesh: None,
         },
         medium,
         environment,

@@ -8,6 +8,7 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use serde::Deserialize;
 
@@ -144,12 +145,34 @@ pub struct CameraSpec {
     pub target: [f32; 3],
     #[serde(default = "y_up")]
     pub up: [f32; 3],
-    /// Full field of view in degrees along `fov_axis`.
-    #[serde(default = "thesis_fov")]
-    pub fov: f32,
+    /// Full field of view in degrees along `fov_axis` (perspective; default 0.7).
+    pub fov: Option<f32>,
     /// `x` (default), `y`, `smaller`, `larger` or `diagonal`, as in Mitsuba.
     #[serde(default)]
     pub fov_axis: FovAxisName,
+    /// `perspective` (default) or `orthographic` (Mitsuba 3's sensors).
+    #[serde(default)]
+    pub projection: ProjectionName,
+    /// Orthographic: the film's size in world units, `width` or `[width, height]` (the height
+    /// defaults to the width times the film's aspect, height / width).
+    pub extent: Option<OneOrTwo>,
+}
+
+/// `camera.projection`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ProjectionName {
+    #[default]
+    Perspective,
+    Orthographic,
+}
+
+/// One number or two.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(untagged)]
+pub enum OneOrTwo {
+    One(f64),
+    Two([f64; 2]),
 }
 
 impl Default for CameraSpec {
@@ -158,8 +181,10 @@ impl Default for CameraSpec {
             origin: thesis_origin(),
             target: [0.0; 3],
             up: y_up(),
-            fov: thesis_fov(),
+            fov: None,
             fov_axis: FovAxisName::default(),
+            projection: ProjectionName::default(),
+            extent: None,
         }
     }
 }
@@ -380,7 +405,7 @@ fn assemble(
 
     let volume_path = resolve(&v.file, "volume.file")?;
     if !file.materials.is_empty() {
-        return assemble_indexed(cx, &file, &volume_path);
+        return assemble_indexed(cx, &file, &volume_path, dir, params);
     }
     if v.format == Some(VolumeFormat::Png) {
         return Err(cx.invalid(
@@ -389,7 +414,20 @@ fn assemble(
             "no [[materials]]",
         ));
     }
+    let mesh_path = match &file.boundary.mesh {
+        Some(m) => Some(resolve(m, "boundary.mesh")?),
+        None => None,
+    };
+    let mesh = file.boundary.mesh(cx, mesh_path.as_deref())?;
+    // The grids lie over the mesh's bounding box unless `volume.bounds` places them.
+    let mesh_box = match (&mesh, v.bounds) {
+        (Some(m), None) => Some(crate::BoundaryDesc::mesh(m.clone(), BsdfDesc::Null).bounds),
+        _ => None,
+    };
     let (mut grid, file_box) = read_volume(cx, &volume_path, v)?;
+    if let Some(b) = mesh_box {
+        grid.bounds = b;
+    }
     if let Some(target) = v.normalise {
         if !(target.is_finite() && target > 0.0) {
             return Err(cx.invalid("volume.normalise", "a positive density", target));
@@ -423,13 +461,13 @@ fn assemble(
                 sparsity: sparsity(cx, v)?,
             };
             let mut albedo = crate::vdb::read_vdb(&volume_path, &options)?;
-            if let Some(b) = v.bounds {
+            let placed = match (v.bounds, mesh_box) {
+                (Some(b), _) => Some(checked_box(cx, "volume.bounds", b)?),
+                (None, mesh_box) => mesh_box,
+            };
+            if let Some(b) = placed {
                 // The albedo moves with the density's box.
-                albedo.bounds = remap(
-                    albedo.bounds,
-                    file_box,
-                    checked_box(cx, "volume.bounds", b)?,
-                );
+                albedo.bounds = remap(albedo.bounds, file_box, b);
             }
             Some(albedo)
         }
@@ -453,7 +491,7 @@ fn assemble(
         lookup: Default::default(),
         storage: Default::default(),
     };
-    finish(cx, &file, grid_bounds, medium)
+    finish(cx, &file, grid_bounds, medium, mesh)
 }
 
 /// A material-indexed volume's scene: `[[materials]]` and `[volume]`'s index grid or slices;
@@ -462,6 +500,8 @@ fn assemble_indexed(
     cx: &Cx<'_>,
     file: &SceneFile,
     volume_path: &Path,
+    dir: &Path,
+    params: &[(String, String)],
 ) -> Result<SceneDescription, SceneError> {
     let v = &file.volume;
     if file.albedo.value.is_some()
@@ -570,7 +610,15 @@ fn assemble_indexed(
         lookup: Default::default(),
         storage: Default::default(),
     };
-    finish(cx, file, bounds, medium)
+    // An indexed volume keeps its own placement (its slices' or its file's voxel size).
+    let mesh = match &file.boundary.mesh {
+        Some(m) => {
+            let path = resolve_path(cx, dir, m, "boundary.mesh", file, params)?;
+            file.boundary.mesh(cx, Some(&path))?
+        }
+        None => file.boundary.mesh(cx, None)?,
+    };
+    finish(cx, file, bounds, medium, mesh)
 }
 
 /// The scene around `medium`, whose grid's box is `grid_bounds`: boundary, camera, film,
@@ -580,11 +628,13 @@ fn finish(
     file: &SceneFile,
     grid_bounds: Bounds,
     medium: MediumDesc,
+    mesh: Option<Arc<MeshDesc>>,
 ) -> Result<SceneDescription, SceneError> {
     let bsdf = file.boundary.bsdf(cx)?;
-    let bounds = match file.boundary.bounds {
-        Some(box_) => checked_box(cx, "boundary.bounds", box_)?,
-        None => grid_bounds,
+    let boundary = match (mesh, file.boundary.bounds) {
+        (Some(mesh), _) => BoundaryDesc::mesh(mesh, bsdf),
+        (None, Some(box_)) => BoundaryDesc::box_(checked_box(cx, "boundary.bounds", box_)?, bsdf),
+        (None, None) => BoundaryDesc::box_(grid_bounds, bsdf),
     };
 
     let c = &file.camera;
@@ -595,10 +645,8 @@ fn finish(
         FovAxisName::Larger => FovAxis::Larger,
         FovAxisName::Diagonal => FovAxis::Diagonal,
     };
-    if !(c.fov > 0.0 && c.fov < 180.0) {
-        return Err(cx.invalid("camera.fov", "degrees in (0, 180)", c.fov));
-    }
-    let to_world = look_at(c.origin, c.target, c.up).ok_or_else(|| {
+    let fov = c.fov.unwrap_or_else(thesis_fov);
+    let mut to_world = look_at(c.origin, c.target, c.up).ok_or_else(|| {
         cx.invalid(
             "camera",
             "an origin apart from the target and an up vector not along the view",
@@ -615,6 +663,58 @@ fn finish(
             format!("{}x{}", file.film.width, file.film.height),
         ));
     }
+    let projection = match c.projection {
+        ProjectionName::Perspective => {
+            if c.extent.is_some() {
+                return Err(cx.invalid(
+                    "camera.extent",
+                    "no extent on a perspective camera (its field of view is `fov`)",
+                    "an extent",
+                ));
+            }
+            if !(fov > 0.0 && fov < 180.0) {
+                return Err(cx.invalid("camera.fov", "degrees in (0, 180)", fov));
+            }
+            Projection::Perspective
+        }
+        ProjectionName::Orthographic => {
+            if let Some(fov) = c.fov {
+                return Err(cx.invalid(
+                    "camera.fov",
+                    "no field of view on an orthographic camera (its film's size is `extent`)",
+                    fov,
+                ));
+            }
+            // Mitsuba 3's orthographic film spans camera-space x in [-1, 1] and y in
+            // [-h/w, h/w], scaled by the frame: half the width on x, and on y half the height
+            // times w/h.
+            let aspect = f64::from(file.film.width) / f64::from(file.film.height);
+            let [w, h] = match c.extent {
+                Some(OneOrTwo::One(w)) => [w, w / aspect],
+                Some(OneOrTwo::Two(size)) => size,
+                None => {
+                    return Err(cx.invalid(
+                        "camera.extent",
+                        "the film's size in world units on an orthographic camera",
+                        "none",
+                    ))
+                }
+            };
+            if !(w.is_finite() && h.is_finite() && w > 0.0 && h > 0.0) {
+                return Err(cx.invalid(
+                    "camera.extent",
+                    "a width and height above 0",
+                    format!("{w}, {h}"),
+                ));
+            }
+            let scale = [0.5 * w, 0.5 * h * aspect];
+            for row in to_world.iter_mut().take(3) {
+                row[0] = (f64::from(row[0]) * scale[0]) as f32;
+                row[1] = (f64::from(row[1]) * scale[1]) as f32;
+            }
+            Projection::Orthographic
+        }
+    };
     let depth = |d: i64, field: &str| match d {
         -1 => Ok(None),
         d if d >= 0 && d <= u32::MAX as i64 => Ok(Some(d as u32)),
@@ -624,9 +724,9 @@ fn finish(
     Ok(SceneDescription {
         camera: CameraDesc {
             to_world,
-            fov_degrees: c.fov,
+            fov_degrees: fov,
             fov_axis,
-            projection: Projection::Perspective,
+            projection,
         },
         film: FilmDesc {
             width: file.film.width,
@@ -637,7 +737,7 @@ fn finish(
             max_depth: depth(file.integrator.max_depth, "integrator.max_depth")?,
             rr_depth: depth(file.integrator.rr_depth, "integrator.rr_depth")?,
         },
-        boundary: BoundaryDesc { bounds, bsdf },
+        boundary,
         medium,
         environment,
     })

@@ -49,7 +49,9 @@ use volpt_core::majorant::MajorantGrid;
 use volpt_core::material::build_material_channel_majorants;
 use volpt_core::math::tan;
 use volpt_core::path::Estimator;
-use volpt_core::{Aabb, PathSettings, PerspectiveCamera, Scene, Vec2, Vec3, VolumeScene};
+use volpt_core::{
+    Aabb, BoundaryShape, PathSettings, PerspectiveCamera, Scene, Shape, Vec2, Vec3, VolumeScene,
+};
 use volpt_scene::description::{
     Bounds, BsdfDesc, CameraDesc, EnvironmentDesc, FilmDesc, FovAxis, PhaseDesc, Projection,
     SceneDescription,
@@ -238,7 +240,7 @@ macro_rules! factory {
         }
 
         /// Hands the scene made of `shared` and `parts` to `visitor`, monomorphised for its variant.
-        fn dispatch<V: SceneVisitor>(shared: Shared, parts: Parts<'_>, visitor: V) -> V::Output {
+        fn dispatch<V: SceneVisitor>(shared: Shared<'_>, parts: Parts<'_>, visitor: V) -> V::Output {
             match (parts.medium, parts.boundary, parts.phase, parts.environment) {
                 $((
                     MediumPart::$M(medium),
@@ -247,7 +249,7 @@ macro_rules! factory {
                     EnvironmentPart::$E(environment),
                 ) => visitor.visit(&VolumeScene {
                     camera: shared.camera,
-                    bounds: shared.bounds,
+                    bounds: shared.shape,
                     settings: shared.settings,
                     medium,
                     boundary,
@@ -343,11 +345,20 @@ impl<'a> Parts<'a> {
     }
 }
 
-/// The parts every variant shares.
-struct Shared {
+/// The parts every variant shares. The boundary's geometry is chosen at run time, box or mesh
+/// ([`BoundaryShape`]): a second scene type per variant would double every backend's code.
+struct Shared<'a> {
     camera: PerspectiveCamera,
-    bounds: Aabb,
+    shape: BoundaryShape<'a>,
     settings: PathSettings,
+}
+
+/// The boundary's geometry `desc` describes, borrowing its mesh.
+pub fn boundary_shape(desc: &SceneDescription) -> BoundaryShape<'_> {
+    match &desc.boundary.mesh {
+        Some(mesh) => BoundaryShape::Mesh(mesh.buffers.mesh()),
+        None => BoundaryShape::Box(aabb(&desc.boundary.bounds)),
+    }
 }
 
 /// Builds the scene that `desc` describes, with `settings` for the integrator, specialised to its
@@ -381,11 +392,11 @@ pub fn with_scene_cached<V: SceneVisitor>(
 ) -> V::Output {
     let shared = Shared {
         camera: camera(&desc.camera, &desc.film),
-        bounds: aabb(&desc.boundary.bounds),
+        shape: boundary_shape(desc),
         settings,
     };
     let parts = Parts::of_cached(desc, effects, cache);
-    let derived = Derived::of_cached(&parts, shared.bounds, &settings, cache);
+    let derived = Derived::of_cached(&parts, shared.shape.bounds(), &settings, cache);
     dispatch(shared, parts.with(&derived), visitor)
 }
 
