@@ -434,6 +434,14 @@ fn assemble(
         }
         grid = normalise(grid, target);
     }
+    let grid = crate::medium::grey_if_equal(grid);
+    if grid.channels == 3 && file.albedo.transfer_function.is_some() {
+        return Err(cx.invalid(
+            "albedo.transfer_function",
+            "a one-channel density to apply it to (or an albedo value)",
+            "a density grid of three channels",
+        ));
+    }
     if !(v.scale.is_finite() && v.scale >= 0.0) {
         return Err(cx.invalid("volume.scale", "a finite scale >= 0", v.scale));
     }
@@ -544,6 +552,7 @@ fn assemble_indexed(
             !files.is_empty()
         });
     let indexed = if slices {
+        use crate::slices::SliceIndices;
         let (indices, resolution) =
             crate::slices::read_slices(volume_path, &materials, v.resolution.map(|r| r[2]))?;
         if let Some(r) = v.resolution {
@@ -579,7 +588,14 @@ fn assemble_indexed(
                 ))
             }
         };
-        IndexedDesc::new(volume_path, materials, resolution, bounds, &indices)?
+        match indices {
+            SliceIndices::Bytes(i) => {
+                IndexedDesc::new(volume_path, materials, resolution, bounds, &i)?
+            }
+            SliceIndices::Wide(i) => {
+                IndexedDesc::new(volume_path, materials, resolution, bounds, &i)?
+            }
+        }
     } else {
         let (grid, _) = read_volume(cx, volume_path, v)?;
         IndexedDesc::from_grid(volume_path, materials, &grid)?
@@ -881,10 +897,10 @@ fn read_volume(cx: &Cx<'_>, file: &Path, v: &VolumeSpec) -> Result<(GridDesc, Bo
             }
         }
     };
-    if grid.channels != 1 {
+    if grid.channels != 1 && grid.channels != 3 {
         return Err(cx.invalid(
             "volume.file",
-            "a one-channel density grid",
+            "a density grid of one channel (grey) or three (a density per channel)",
             format!("{} channels in {}", grid.channels, file.display()),
         ));
     }

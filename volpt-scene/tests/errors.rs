@@ -6,7 +6,7 @@ mod common;
 use std::path::Path;
 
 use common::*;
-use volpt_scene::{load_mitsuba, AlbedoDesc, DensityDesc, SceneError, VolGrid};
+use volpt_scene::{load_mitsuba, AlbedoDesc, DensityDesc, SceneError};
 
 /// The 1-based line of the first occurrence of `needle` in `text`.
 fn line_of(text: &str, needle: &str) -> usize {
@@ -134,20 +134,6 @@ fn negative_density_names_the_voxel() {
             "-1",
         ],
     );
-}
-
-#[test]
-fn rgb_density_grid_is_an_error() {
-    let text = medium_scene(GRID_MEDIUM);
-    let (dir, path) = scene_file(&text);
-    let grid = VolGrid {
-        channels: 3,
-        data: vec![0.5; 24],
-        ..density_grid([2, 2, 2], unit_bounds())
-    };
-    write_grid(dir.path(), "density.vol", &grid);
-    let err = load_mitsuba(&path).unwrap_err();
-    message_of(&err, &["density.vol", "1 channel", "found 3"]);
 }
 
 #[test]

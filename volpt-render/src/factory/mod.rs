@@ -44,6 +44,7 @@ use std::sync::Arc;
 use volpt_core::abi::SceneAbi;
 use volpt_core::grid::Grid;
 
+use volpt_core::chromatic::build_channel_majorants;
 use volpt_core::majorant::MajorantGrid;
 use volpt_core::material::build_material_channel_majorants;
 use volpt_core::math::tan;
@@ -76,6 +77,9 @@ macro_rules! axis {
     ($(#[$doc:meta])* $part:ident $(<$lt:lifetime>)?, $kind:ident, $input:ty, $rule:ident,
      [$(($camel:ident, $snake:ident, $ty:ty))*]) => {
         $(#[$doc])*
+        // One built part per render, moved into the scene it renders: the chromatic medium's
+        // grids and tables make its variant the largest, which costs nothing here.
+        #[allow(clippy::large_enum_variant)]
         pub enum $part $(<$lt>)? {
             $($camel($ty),)*
         }
@@ -160,6 +164,12 @@ macro_rules! factory {
             fn density(&self) -> Option<(Grid<'a, 1>, f32)> {
                 match self {
                     $(MediumPart::$Mv(m) => m.density(),)*
+                }
+            }
+
+            fn channel_densities(&self) -> Option<(Grid<'a, 3>, volpt_core::Spectrum)> {
+                match self {
+                    $(MediumPart::$Mv(m) => m.channel_densities(),)*
                 }
             }
 
@@ -397,7 +407,7 @@ pub struct Derived {
     /// Per-cell majorants and the grid's resolution, if the medium tracks with a grid.
     majorants: Option<Arc<Majorants>>,
     /// Each channel's bound per cell of `majorants` (three a cell), for a medium whose channels'
-    /// bounds are not in proportion (a material-indexed volume's).
+    /// bounds are not in proportion (a material-indexed volume's, a density per channel's).
     channel_majorants: Option<Vec<f32>>,
     bounds: Aabb,
     /// The environment's sampling distribution, for next-event estimation.
@@ -431,13 +441,35 @@ impl Derived {
                 (Arc::new(Majorants { data, res }), Some(channels))
             })
         };
+        // A density per channel: each channel's bounds from its own samples (built anew each
+        // time, as an indexed volume's).
+        let per_channel = |res: [u32; 3]| {
+            parts
+                .medium
+                .channel_densities()
+                .map(|(density, extinction)| {
+                    let cells = res.iter().map(|&r| r as usize).product::<usize>();
+                    let (mut channels, mut data) = (vec![0.0; 3 * cells], vec![0.0; cells]);
+                    let mut plane = vec![0.0; density.data.len() / 3];
+                    build_channel_majorants(
+                        &density,
+                        extinction,
+                        bounds,
+                        res,
+                        &mut plane,
+                        &mut channels,
+                        &mut data,
+                    );
+                    (Arc::new(Majorants { data, res }), Some(channels))
+                })
+        };
         let majorants = (settings.majorant_resolution > 1)
             .then(|| MajorantGrid::resolution_for(bounds, settings.majorant_resolution))
             .and_then(|res| match parts.medium.density() {
                 Some((density, scale)) => {
                     Some((cache.majorants(&density, scale, bounds, res), None))
                 }
-                None => indexed(res),
+                None => per_channel(res).or_else(|| indexed(res)),
             })
             // A grid whose every cell has the global bound (a uniform density, as ad's) saves no
             // step and costs the walk: track with the global majorant.
