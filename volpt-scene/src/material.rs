@@ -358,14 +358,16 @@ impl fmt::Display for InfoTable<'_> {
         writeln!(
             f,
             "material-indexed {}x{}x{} voxels, bounds {:?} .. {:?}, {} materials; GPU memory {} bytes \
-             (1 byte a voxel and the table)",
+             ({} a voxel and the table)",
             d.resolution[0],
             d.resolution[1],
             d.resolution[2],
             d.bounds.min,
             d.bounds.max,
             d.materials.len(),
-            d.device_bytes()
+            d.device_bytes(),
+            // More than 256 materials take u16 indices (`pack`).
+            if d.materials.len() > 256 { "2 bytes" } else { "1 byte" }
         )?;
         for (k, (m, n)) in d.materials.iter().zip(counts).enumerate() {
             let t = m.material();
