@@ -2,7 +2,7 @@
 //! command line's crate: for measuring inks, layer counts and loop options on the CPU.
 //!
 //! ```sh
-//! cargo run --release -p volpt-print --example job -- TARGET.png M.toml OUT LAYERS COLOUR_LAYERS SPP MAX_SPP ITERATIONS
+//! cargo run --release -p volpt-print --example job -- TARGET.png M.toml OUT LAYERS COLOUR_LAYERS SPP MAX_SPP ITERATIONS [IOR]
 //! ```
 
 use std::sync::Arc;
@@ -12,9 +12,11 @@ use volpt_print::job::{run, Job};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let [target, materials, out, layers, colour, spp, max_spp, iterations] = &args[..] else {
+    let (Some([target, materials, out, layers, colour, spp, max_spp, iterations]), ior) =
+        (args.first_chunk::<8>(), args.get(8))
+    else {
         return Err(
-            "expected TARGET.png M.toml OUT LAYERS COLOUR_LAYERS SPP MAX_SPP ITERATIONS".into(),
+            "expected TARGET.png M.toml OUT LAYERS COLOUR_LAYERS SPP MAX_SPP ITERATIONS [IOR]".into(),
         );
     };
     let mut job = Job::new(target.into(), materials.into(), out.into());
@@ -23,6 +25,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     job.spp = spp.parse()?;
     job.max_spp = max_spp.parse()?;
     job.options.max_iterations = iterations.parse()?;
+    // 1: index-matched, no surface.
+    if let Some(ior) = ior {
+        let ior: f32 = ior.parse()?;
+        job.ior = (ior != 1.0).then_some(ior);
+    }
     let backend = Backend::cpu();
     let outcome = run(&job, &backend, Arc::new(Quiet), |k, it| {
         eprintln!(
