@@ -16,7 +16,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         (args.first_chunk::<8>(), args.get(8))
     else {
         return Err(
-            "expected TARGET.png M.toml OUT LAYERS COLOUR_LAYERS SPP MAX_SPP ITERATIONS [IOR]".into(),
+            "expected TARGET.png M.toml OUT LAYERS COLOUR_LAYERS SPP MAX_SPP ITERATIONS [IOR]"
+                .into(),
         );
     };
     let mut job = Job::new(target.into(), materials.into(), out.into());
