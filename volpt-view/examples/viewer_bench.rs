@@ -15,6 +15,12 @@
 //! elsewhere and came back, its grids kept on the GPU in between, must.
 //!
 //! Prints one JSON object.
+//!
+//! Usage: viewer_bench WS_URL --snapshot FILE
+//!
+//! The accumulation instead: a drag away from the initial view and a still move back, then the
+//! linear image (`/snapshot.exr`) once the still view has all its samples, written to FILE
+//! (bench/device/viewer.sh compares the GPU's with the CPU's).
 
 use std::time::{Duration, Instant};
 
@@ -83,11 +89,75 @@ fn mean(v: &[f64]) -> Option<f64> {
     (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
 }
 
+/// The accumulation mode: a drag away, a still move back to the initial view, then its linear
+/// image once it has all its samples, written to `file`. Prints the last frame's header.
+async fn snapshot(ws: &mut Ws, url: &str, hello: &Value, file: &str) {
+    let initial = &hello["initial"];
+    let (origin, target, up) = (
+        vec3(&initial["origin"]),
+        vec3(&initial["target"]),
+        vec3(&initial["up"]),
+    );
+    let far = Instant::now() + Duration::from_secs(60);
+    next_frame(ws, far).await.expect("a first frame");
+    let away = orbit(origin, target, up, 0.3);
+    let drag = json!({"type": "camera", "origin": away, "target": target, "interactive": true});
+    send(ws, drag).await;
+    while let Some((h, _, _)) = next_frame(ws, far).await {
+        if h["interactive"] == true {
+            break;
+        }
+    }
+    send(
+        ws,
+        json!({"type": "camera", "origin": initial["origin"], "target": initial["target"]}),
+    )
+    .await;
+    let last = loop {
+        let (h, _, _) = next_frame(ws, far).await.expect("the still view's frames");
+        let still = h["interactive"] == false && h["view"]["origin"] == initial["origin"];
+        if still && h["spp"] == h["spp_target"] {
+            break h;
+        }
+    };
+    // The page's server, by HTTP: ws://HOST:PORT/ws -> HOST:PORT.
+    let host = url
+        .trim_start_matches("ws://")
+        .split('/')
+        .next()
+        .expect("ws://HOST:PORT/ws");
+    let mut stream = std::net::TcpStream::connect(host).expect("connecting for the snapshot");
+    use std::io::{Read, Write};
+    write!(
+        stream,
+        "GET /snapshot.exr HTTP/1.1\r\nHost: {host}\r\nConnection: close\r\n\r\n"
+    )
+    .expect("asking for the snapshot");
+    let mut response = Vec::new();
+    stream
+        .read_to_end(&mut response)
+        .expect("reading the snapshot");
+    assert!(
+        response.starts_with(b"HTTP/1.1 200"),
+        "snapshot refused: {}",
+        String::from_utf8_lossy(&response[..response.len().min(200)])
+    );
+    let body = response
+        .windows(4)
+        .position(|w| w == b"\r\n\r\n")
+        .expect("an HTTP response")
+        + 4;
+    std::fs::write(file, &response[body..]).expect("writing the snapshot");
+    println!("{last}");
+}
+
 #[tokio::main(flavor = "current_thread")]
 async fn main() {
     let mut args = std::env::args().skip(1);
-    let url = args.next().expect("usage: viewer_bench WS_URL [SECONDS]");
-    let seconds: f64 = args.next().map_or(3.0, |s| s.parse().expect("SECONDS"));
+    let url = args
+        .next()
+        .expect("usage: viewer_bench WS_URL [SECONDS | --snapshot FILE]");
+    let mode = args.next();
     let (mut ws, _) = tokio_tungstenite::connect_async(&url)
         .await
         .expect("connecting");
@@ -95,6 +165,11 @@ async fn main() {
         Some(Ok(Message::Text(t))) => serde_json::from_str(&t).expect("hello"),
         other => panic!("expected hello, got {other:?}"),
     };
+    if mode.as_deref() == Some("--snapshot") {
+        let file = args.next().expect("--snapshot FILE");
+        return snapshot(&mut ws, &url, &hello, &file).await;
+    }
+    let seconds: f64 = mode.map_or(3.0, |s| s.parse().expect("SECONDS"));
     let initial = &hello["initial"];
     let (origin, target, up) = (
         vec3(&initial["origin"]),
