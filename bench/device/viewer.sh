@@ -12,15 +12,18 @@
 # while orbiting at 60 moves/s; a view shown again must give its first image byte for byte), and
 # stops the server with Ctrl-C (SIGINT), which must end it.
 #
-# First, with BACKENDS including cuda, the frames' GPU checks (CHECKS=0 skips them, ~15 s):
+# First, with BACKENDS including cuda, the frames' GPU checks (CHECKS=0 skips them, ~40 s):
 #   1. `volpt selftest` (exact and fast kernels): its "tone mapping" line must PASS: the GPU's
 #      tone-mapped frame equals the CPU's within one 8-bit level.
-#   2. the accumulation: the example cube served at 64x48, 64 spp, dragged away and moved back
-#      (bin/viewer-bench --snapshot), its linear image once the still view has all its samples,
-#      from the GPU and from the CPU: the GPU's exact kernels (regeneration-sk) must be the CPU's
-#      seed-0 image up to rounding (`volpt compare --max-relative 1e-4`), and the GPU's fast
-#      and exact images independent estimates of the CPU's seed-1 image (`--independent`). The
-#      CPU's own viewer image equals `volpt render` bit for bit (volpt-view/tests/accumulation.rs).
+#   2. the accumulation: a scene served, dragged away and moved back (bin/viewer-bench
+#      --snapshot), its linear image once the still view has all its samples, from the GPU and
+#      from the CPU: the example cube (64x48, 64 spp, regeneration-sk) and ad (128x128, 8 spp,
+#      streaming-mk: frames stopped at their deadline with paths in flight, continued by the next;
+#      the line says how many still frames had paths in flight). The GPU's exact kernels must
+#      give the CPU's seed-0 image up to rounding (`volpt compare --max-relative 1e-4`), and the
+#      GPU's exact and fast images must be independent estimates of the CPU's seed-1 image
+#      (`--independent`). The CPU's viewer image is `volpt render`'s bit for bit
+#      (volpt-view/tests/accumulation.rs).
 #
 # Quick look at the frames (checks, then ad and the cube on the GPU at both sizes; ~75 s):
 #   SCENES="example-cube ad" BACKENDS=cuda SECONDS_PER_PHASE=2 bash bundle/viewer.sh
@@ -114,25 +117,46 @@ if [ "${CHECKS:-1}" = 1 ] && [[ " $BACKENDS " == *" cuda "* ]]; then
         check "tone mapping ($math kernels)" grep -E "^PASS tone mapping" "$OUT/viewer-selftest-$math.log"
         say "  $(grep -A1 'tone mapping' "$OUT/viewer-selftest-$math.log" | tail -n 1 | xargs)"
     done
-    cube=(scenes/example/cube.xml --resolution 64x48 --spp 64)
-    for run in "cuda-exact --backend cuda --strategy regeneration-sk --math exact" \
-               "cuda-fast --backend cuda --strategy regeneration-sk --math fast" \
-               "cpu-0 --backend cpu" "cpu-1 --backend cpu --seed 1"; do
-        # shellcheck disable=SC2086 # the run's name and flags
-        set -- $run
-        name=$1; shift
-        serve "accumulation-$name" "${cube[@]}" "$@"
-        rm -f "$OUT/accumulation-$name.exr"
-        if [ -n "$url" ]; then
-            timeout 60 "$CLIENT" "${url}ws" --snapshot "$OUT/accumulation-$name.exr" >>"$log" 2>&1
-        fi
-        stop
-    done
-    check "accumulation: the GPU's exact image is the CPU's (seed 0)" \
-        "$VOLPT" compare "$OUT/accumulation-cuda-exact.exr" "$OUT/accumulation-cpu-0.exr" --max-relative 1e-4
-    for math in exact fast; do
-        check "accumulation: the GPU's $math image estimates the CPU's seed-1 image" \
-            "$VOLPT" compare "$OUT/accumulation-cuda-$math.exr" "$OUT/accumulation-cpu-1.exr" --independent
+    # accumulate NAME SCENE-ARGS -- RUNS...: serves each run ("name flags...") of the scene,
+    # drags away and back, and keeps the still view's linear image as $OUT/accumulation-NAME-RUN.exr.
+    accumulate() {
+        local scene=$1; shift
+        local args=(); while [ "$1" != -- ]; do args+=("$1"); shift; done; shift
+        for run in "$@"; do
+            # shellcheck disable=SC2086 # the run's name and flags
+            set -- $run
+            local name=$1; shift
+            serve "accumulation-$scene-$name" "${args[@]}" "$@"
+            rm -f "$OUT/accumulation-$scene-$name.exr"
+            if [ -n "$url" ]; then
+                timeout 60 "$CLIENT" "${url}ws" --snapshot "$OUT/accumulation-$scene-$name.exr" \
+                    >"$OUT/accumulation-$scene-$name.json" 2>>"$log"
+                say "  $scene $name: $(python3 -c "import json,sys
+try:
+    r = json.load(sys.stdin); print(f\"{r['last']['spp']} spp, {r['last']['width']}x{r['last']['height']}, {r['still_frames_with_paths_in_flight']} still frames with paths in flight\")
+except Exception as e: print('no snapshot:', e)" <"$OUT/accumulation-$scene-$name.json")"
+            fi
+            stop
+        done
+    }
+    # The cube with the default strategy's kernels; ad (paths of ~140 segments, a few of
+    # thousands) with streaming-mk, whose frames stop at their deadline with paths in flight.
+    accumulate cube scenes/example/cube.xml --resolution 64x48 --spp 64 -- \
+        "gpu-exact --backend cuda --strategy regeneration-sk --math exact" \
+        "gpu-fast --backend cuda --strategy regeneration-sk --math fast" \
+        "cpu-0 --backend cpu" "cpu-1 --backend cpu --seed 1"
+    accumulate ad scenes/ad/scene.xml --resolution 128x128 --spp 8 -- \
+        "gpu-exact --backend cuda --strategy streaming-mk --math exact" \
+        "gpu-fast --backend cuda --strategy streaming-mk --math fast" \
+        "cpu-0 --backend cpu" "cpu-1 --backend cpu --seed 1"
+    for scene in cube ad; do
+        a=$OUT/accumulation-$scene
+        check "accumulation, $scene: the GPU's exact image is the CPU's (seed 0)" \
+            "$VOLPT" compare "$a-gpu-exact.exr" "$a-cpu-0.exr" --max-relative 1e-4
+        for math in exact fast; do
+            check "accumulation, $scene: the GPU's $math image estimates the CPU's seed-1 image" \
+                "$VOLPT" compare "$a-gpu-$math.exr" "$a-cpu-1.exr" --independent
+        done
     done
     say ""
 fi

@@ -10,8 +10,9 @@
 //! 3. orbit: camera moves at 60 Hz (interactive, as a drag sends them) for SECONDS: frames/s of
 //!    frames showing a move, the time from a move to the frame showing it, and the resolution.
 //!
-//! Between 1 and 2, the view of the first move is shown again: its first frame must equal the
-//! first one byte for byte (`repeat_identical`), as a render of a scene whose camera went
+//! Between 1 and 2, the view of the first move is shown again: its first frame of one whole sample
+//! (the first frame, unless paths were in flight at its deadline) must equal the first time's
+//! byte for byte (`repeat_identical`), as a render of a scene whose camera went
 //! elsewhere and came back, its grids kept on the GPU in between, must.
 //!
 //! Prints one JSON object.
@@ -20,7 +21,8 @@
 //!
 //! The accumulation instead: a drag away from the initial view and a still move back, then the
 //! linear image (`/snapshot.exr`) once the still view has all its samples, written to FILE
-//! (bench/device/viewer.sh compares the GPU's with the CPU's).
+//! (bench/device/viewer.sh compares the GPU's with the CPU's); prints the last frame's header and
+//! how many of the still view's frames had paths in flight.
 
 use std::time::{Duration, Instant};
 
@@ -80,6 +82,22 @@ async fn next_frame(ws: &mut Ws, deadline: Instant) -> Option<(Value, usize, u64
     }
 }
 
+/// The image hash of epoch `epoch`'s first frame of one whole sample: `first` (that epoch's first
+/// frame) if it is one, else the next that is. A frame with paths in flight (a multi-kernel
+/// strategy's, stopped at its deadline) shows those that had ended by then, which depends on time.
+async fn first_sample(ws: &mut Ws, epoch: u64, first: &(Value, u64)) -> Option<u64> {
+    if first.0["spp"].as_u64() >= Some(1) {
+        return Some(first.1);
+    }
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while let Some((h, _, image)) = next_frame(ws, deadline).await {
+        if h["epoch"].as_u64() == Some(epoch) && h["spp"].as_u64() >= Some(1) {
+            return Some(image);
+        }
+    }
+    None
+}
+
 fn median(mut v: Vec<f64>) -> Option<f64> {
     v.sort_by(|a, b| a.total_cmp(b));
     (!v.is_empty()).then(|| v[v.len() / 2])
@@ -90,7 +108,8 @@ fn mean(v: &[f64]) -> Option<f64> {
 }
 
 /// The accumulation mode: a drag away, a still move back to the initial view, then its linear
-/// image once it has all its samples, written to `file`. Prints the last frame's header.
+/// image once it has all its samples, written to `file`. Prints the last frame's header and how
+/// many frames of the still view showed paths in flight.
 async fn snapshot(ws: &mut Ws, url: &str, hello: &Value, file: &str) {
     let initial = &hello["initial"];
     let (origin, target, up) = (
@@ -113,8 +132,10 @@ async fn snapshot(ws: &mut Ws, url: &str, hello: &Value, file: &str) {
         json!({"type": "camera", "origin": initial["origin"], "target": initial["target"]}),
     )
     .await;
+    let mut in_flight = 0u32;
     let last = loop {
         let (h, _, _) = next_frame(ws, far).await.expect("the still view's frames");
+        in_flight += u32::from(h["spp_in_flight"].as_u64() > Some(0));
         let still = h["interactive"] == false && h["view"]["origin"] == initial["origin"];
         if still && h["spp"] == h["spp_target"] {
             break h;
@@ -148,7 +169,10 @@ async fn snapshot(ws: &mut Ws, url: &str, hello: &Value, file: &str) {
         .expect("an HTTP response")
         + 4;
     std::fs::write(file, &response[body..]).expect("writing the snapshot");
-    println!("{last}");
+    println!(
+        "{}",
+        json!({"last": last, "still_frames_with_paths_in_flight": in_flight})
+    );
 }
 
 #[tokio::main(flavor = "current_thread")]
@@ -189,6 +213,7 @@ async fn main() {
     // 1. Latency of a still move: send, wait for the new epoch's first frame.
     let mut latency = Vec::new();
     let mut first_frames = Vec::new();
+    let mut reference = None;
     for i in 0..10 {
         let o = orbit(origin, target, up, 0.05 * f64::from(i + 1));
         let sent = Instant::now();
@@ -205,6 +230,9 @@ async fn main() {
                 break;
             }
         }
+        if i == 0 {
+            reference = first_sample(&mut ws, epoch, &first_frames[0]).await;
+        }
     }
     // The first move's view again: the same image.
     let sent = Instant::now();
@@ -218,7 +246,8 @@ async fn main() {
     while let Some((h, _, image)) = next_frame(&mut ws, sent + Duration::from_secs(60)).await {
         if h["epoch"].as_u64() > Some(epoch) {
             epoch = h["epoch"].as_u64().unwrap_or(epoch);
-            repeat_identical = first_frames.first().map(|(_, first)| *first == image);
+            let shown = first_sample(&mut ws, epoch, &(h, image)).await;
+            repeat_identical = reference.zip(shown).map(|(a, b)| a == b);
             break;
         }
     }

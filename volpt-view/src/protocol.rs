@@ -244,6 +244,9 @@ pub struct FrameHeader {
     /// Samples per pixel in this frame, and the number the accumulation stops at.
     pub spp: u32,
     pub spp_target: u32,
+    /// Samples whose paths are still in flight on the GPU (the frame shows those that have
+    /// ended: a multi-kernel strategy's frame stopped at its deadline); 0 otherwise.
+    pub spp_in_flight: u32,
     pub interactive: bool,
     /// Milliseconds of this frame's render (its new samples), tone mapping and JPEG encoding.
     pub render_ms: f64,

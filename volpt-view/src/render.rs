@@ -496,6 +496,7 @@ impl Renderer {
             height: linear.height,
             spp: self.done,
             spp_target: self.cap(),
+            spp_in_flight: self.shown() - self.done,
             interactive: self.interactive,
             render_ms: ms(render),
             tonemap_ms: ms(tonemap),
