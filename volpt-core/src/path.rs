@@ -35,6 +35,7 @@ use core::ops::Range;
 use crate::bsdf::Bsdf;
 use crate::environment::Environment;
 use crate::geometry::BoxHit;
+use crate::light;
 use crate::medium::Medium;
 use crate::phase::PhaseFunction;
 use crate::rng::Rng;
@@ -239,7 +240,7 @@ impl<X: SpectralState> PathState<X> {
 
     /// Ends the path at a safety bound; it contributes zero.
     #[inline]
-    fn truncate(&mut self, bound: Truncation) {
+    pub(crate) fn truncate(&mut self, bound: Truncation) {
         self.truncated = bound;
         self.radiance = Spectrum::ZERO;
         self.alive = false;
@@ -347,7 +348,7 @@ fn advance<S: Scene, const DEFER_SCATTER: bool>(scene: &S, path: &mut PathOf<S>)
                     let light_pdf = scene.environment().pdf(path.ray.dir);
                     light *= power_heuristic(path.mis_pdf, light_pdf);
                 }
-                path.radiance += light;
+                path.radiance += light + light::escaped_sun(scene, path);
                 path.alive = false;
             }
         }
@@ -413,9 +414,15 @@ pub fn scatter<S: Scene>(scene: &S, path: &mut PathOf<S>, p: Vec3, albedo: Optio
     if next_event && !next_event_estimate(scene, path, p, &phase) {
         return;
     }
+    // The scene's other lights, behind an index-matched boundary whatever the estimator: a delta
+    // light is reached by no other strategy.
+    let lights = S::Bsdf::IS_NULL && scene.lights().any();
+    if lights && !light::next_event_estimate(scene, path, p, &phase) {
+        return;
+    }
     let sample = phase.sample(path.ray.dir, path.rng.next_2d());
     path.ray = Ray::new(p, sample.wo);
-    if next_event {
+    if next_event || lights {
         path.mis_pdf = sample.pdf;
     }
     path.russian_roulette(settings);
@@ -453,7 +460,7 @@ fn next_event_estimate<S: Scene>(
     };
     let phase = phase.eval(path.ray.dir, light.dir);
     let shadow = Ray::new(p, light.dir);
-    let Some(transmittance) = shadow_transmittance(scene, path, shadow) else {
+    let Some(transmittance) = shadow_transmittance(scene, path, shadow, f32::INFINITY) else {
         path.truncate(Truncation::TrackingSteps);
         return false;
     };
@@ -468,28 +475,33 @@ fn next_event_estimate<S: Scene>(
     true
 }
 
-/// The transmittance along `shadow` to the environment, estimated by ratio tracking over each
-/// chord through the medium: one for a convex shape (the box's code is the single call); a ray
-/// that leaves a non-convex one (a torus) may enter it again. `None` when tracking runs out of
-/// steps. Per channel for a chromatic medium ([`SpectralState::Transmittance`]).
+/// The transmittance along `shadow` up to `distance` (a point light's; infinite for the
+/// environment), estimated by ratio tracking over each chord through the medium: one for a convex
+/// shape (the box's code is the single call); a ray that leaves a non-convex one (a torus) may
+/// enter it again. `None` when tracking runs out of steps. Per channel for a chromatic medium
+/// ([`SpectralState::Transmittance`]).
 #[inline(always)]
-fn shadow_transmittance<S: Scene>(
+pub(crate) fn shadow_transmittance<S: Scene>(
     scene: &S,
     path: &mut PathOf<S>,
     shadow: Ray,
+    distance: f32,
 ) -> Option<Transmittance<S>> {
-    let mut transmittance = chord_transmittance(scene, path, &shadow)?;
+    let mut transmittance = chord_transmittance(scene, path, &shadow, distance)?;
     if S::Shape::CONVEX {
         return Some(transmittance);
     }
-    let mut shadow = shadow;
+    let (mut shadow, mut distance) = (shadow, distance);
     while SpectralOf::<S>::transmits(transmittance) {
         let exit = scene.shape().exit(&shadow);
         match scene.shape().entry(&Ray::new(exit.point, shadow.dir)) {
-            Some(entry) => shadow.origin = entry.point,
-            None => break,
+            Some(entry) if entry.point.distance(shadow.origin) < distance => {
+                distance -= entry.point.distance(shadow.origin);
+                shadow.origin = entry.point;
+            }
+            _ => break,
         }
-        transmittance *= chord_transmittance(scene, path, &shadow)?;
+        transmittance *= chord_transmittance(scene, path, &shadow, distance)?;
     }
     Some(transmittance)
 }
@@ -497,7 +509,8 @@ fn shadow_transmittance<S: Scene>(
 /// A transmittance estimate of scene `S`'s medium.
 type Transmittance<S> = <SpectralOf<S> as SpectralState>::Transmittance;
 
-/// Ratio tracking's estimate along `ray`, from inside the medium to where it leaves the shape.
+/// Ratio tracking's estimate along `ray`, from inside the medium to where it leaves the shape or
+/// to `distance`, whichever is nearer.
 /// A function, not a closure: a closure called from two places may stay a function of its own,
 /// which on a GPU takes the scene into local memory.
 #[inline(always)]
@@ -505,11 +518,15 @@ fn chord_transmittance<S: Scene>(
     scene: &S,
     path: &mut PathOf<S>,
     ray: &Ray,
+    distance: f32,
 ) -> Option<Transmittance<S>> {
+    let exit = scene.shape().exit_distance(ray);
+    // Compared, not `min`: an infinite `distance` (the environment's) folds away.
+    let t_max = if distance < exit { distance } else { exit };
     SpectralOf::<S>::transmittance(
         scene.medium(),
         ray,
-        scene.shape().exit_distance(ray),
+        t_max,
         &mut path.rng,
         &mut path.tracking_steps,
         scene.settings().max_tracking_steps,
@@ -556,7 +573,7 @@ fn boundary_next_event_estimate<S: Scene>(scene: &S, path: &mut PathOf<S>, hit: 
 /// Veach's power heuristic with exponent 2: the weight of a strategy of density `a` against one of
 /// density `b`.
 #[inline]
-fn power_heuristic(a: f32, b: f32) -> f32 {
+pub(crate) fn power_heuristic(a: f32, b: f32) -> f32 {
     let (a2, b2) = (a * a, b * b);
     if a2 + b2 > 0.0 {
         a2 / (a2 + b2)

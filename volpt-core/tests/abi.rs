@@ -152,6 +152,7 @@ fn scene() -> Furnace {
         boundary: NullBoundary,
         phase: HenyeyGreenstein { g: 0.6 },
         environment: ConstantEnvironment(Vec3::new(0.25, 1.5, 3.0)),
+        lights: volpt_core::Lights::NONE,
         settings: settings()[0],
     }
 }

@@ -340,6 +340,7 @@ fn an_absorber_in_a_sphere_and_a_torus_transmits_exp_minus_sigma_chord() {
             boundary: NullBoundary,
             phase: HenyeyGreenstein { g: 0.0 },
             environment: ConstantEnvironment(Spectrum::ONE),
+            lights: volpt_core::Lights::NONE,
             settings: PathSettings::default(),
         };
         let mut worst: f64 = 0.0;
@@ -421,6 +422,7 @@ fn box_and_mesh<B: volpt_core::Bsdf + Copy>(boundary: B, estimator: Estimator) {
         boundary,
         phase: HenyeyGreenstein { g: 0.3 },
         environment: ConstantEnvironment(Spectrum::ONE),
+        lights: volpt_core::Lights::NONE,
         settings,
     };
     let meshed = VolumeScene {
@@ -430,6 +432,7 @@ fn box_and_mesh<B: volpt_core::Bsdf + Copy>(boundary: B, estimator: Estimator) {
         boundary,
         phase: boxed.phase,
         environment: boxed.environment,
+        lights: volpt_core::Lights::NONE,
         settings,
     };
     let (want, want_counters) = image(&boxed, 8);
@@ -476,6 +479,7 @@ fn the_furnace_in_a_torus_returns_the_light_with_and_without_next_event_estimati
             boundary: NullBoundary,
             phase: HenyeyGreenstein { g: 0.3 },
             environment: ConstantEnvironment(Spectrum::ONE),
+            lights: volpt_core::Lights::NONE,
             settings: PathSettings {
                 estimator,
                 ..PathSettings::default()

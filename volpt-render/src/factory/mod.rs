@@ -243,6 +243,7 @@ macro_rules! factory {
                     boundary,
                     phase,
                     environment,
+                    lights: shared.lights,
                 }),)*
             }
         }
@@ -338,6 +339,8 @@ struct Shared {
     camera: PerspectiveCamera,
     bounds: Aabb,
     settings: PathSettings,
+    /// The lights besides the environment: a run-time part of every variant.
+    lights: volpt_core::Lights,
 }
 
 /// Builds the scene that `desc` describes, with `settings` for the integrator, specialised to its
@@ -373,6 +376,7 @@ pub fn with_scene_cached<V: SceneVisitor>(
         camera: camera(&desc.camera, &desc.film),
         bounds: aabb(&desc.boundary.bounds),
         settings,
+        lights: desc.lights.lights(),
     };
     let parts = Parts::of_cached(desc, effects, cache);
     let derived = Derived::of_cached(&parts, shared.bounds, &settings, cache);
