@@ -396,7 +396,12 @@ pub(crate) fn next_event_estimate<S: Scene>(
     } else {
         None
     };
-    for light in [sun, spot].into_iter().flatten() {
+    // One loop over both, not an array of them: a GPU would keep an indexed array in local memory,
+    // and one body keeps one copy of ratio tracking in the kernels.
+    for slot in 0..2 {
+        let Some(light) = (if slot == 0 { sun } else { spot }) else {
+            continue;
+        };
         let phase = phase.eval(path.ray.dir, light.dir);
         let mis = if light.delta {
             1.0

@@ -22,8 +22,8 @@ use common::{from_spherical, integrate, integrate_2d, test_frame, Moments, Z_MAX
 use volpt_core::path::trace;
 use volpt_core::{
     Aabb, ChromaticMedium, ConstantEnvironment, DirectionalLight, Estimator, HenyeyGreenstein,
-    HomogeneousMedium, Lights, NullBoundary, PathSettings, PathState, PerspectiveCamera,
-    Ray, Scene, Spectrum, SpotLight, Vec2, Vec3, VolumeScene,
+    HomogeneousMedium, Lights, NullBoundary, PathSettings, PathState, PerspectiveCamera, Ray,
+    Scene, Spectrum, SpotLight, Vec2, Vec3, VolumeScene,
 };
 
 type LitScene<M> = VolumeScene<M, NullBoundary, HenyeyGreenstein, ConstantEnvironment>;
@@ -142,8 +142,16 @@ fn a_sun_disc_seen_through_an_absorbing_slab_is_its_radiance_times_the_transmitt
         sun: DirectionalLight::new(-to_sun, 0.0, Spectrum::splat(3.0)),
         ..Lights::NONE
     };
-    let scene = LitScene { lights: delta, ..scene };
-    let m = moments(&scene, Ray::new(Vec3::new(0.0, 0.0, -1.0), to_sun), false, 1000);
+    let scene = LitScene {
+        lights: delta,
+        ..scene
+    };
+    let m = moments(
+        &scene,
+        Ray::new(Vec3::new(0.0, 0.0, -1.0), to_sun),
+        false,
+        1000,
+    );
     assert_eq!(m[0].mean(), 0.0);
 }
 
@@ -181,16 +189,16 @@ fn a_delta_sun_over_a_scattering_slab_gives_the_single_scattering_integral() {
         albedo: Spectrum::splat(albedo as f32),
     };
     let view = from_zenith(-10.0);
-    let expected = single_scattering_from(
-        (sigma_t, sigma_t * albedo, g, depth),
-        view,
-        to_sun,
-        2.0,
-    );
+    let expected = single_scattering_from((sigma_t, sigma_t * albedo, g, depth), view, to_sun, 2.0);
     // The lights are sampled whatever the environment's estimator.
     for estimator in [Estimator::PathTracing, Estimator::NextEvent] {
         let scene = scene(medium, slab(depth as f32), g as f32, lights, estimator);
-        let m = moments(&scene, Ray::new(Vec3::new(0.0, 0.0, -1.0), view), false, 50_000);
+        let m = moments(
+            &scene,
+            Ray::new(Vec3::new(0.0, 0.0, -1.0), view),
+            false,
+            50_000,
+        );
         assert_mean(&m[0], expected, &format!("{estimator:?}"));
     }
 }
@@ -218,12 +226,7 @@ fn a_sun_with_extent_over_a_scattering_slab_gives_the_single_scattering_integral
     let scattered = integrate_2d(
         &|cos_theta, phi| {
             let dir = from_spherical(frame, cos_theta, phi);
-            single_scattering_from(
-                (sigma_t, sigma_t * albedo, g, depth),
-                view,
-                dir,
-                radiance,
-            )
+            single_scattering_from((sigma_t, sigma_t * albedo, g, depth), view, dir, radiance)
         },
         (cos_radius, 1.0),
         (0.0, 2.0 * PI),
@@ -231,8 +234,19 @@ fn a_sun_with_extent_over_a_scattering_slab_gives_the_single_scattering_integral
     );
     // The camera ray looks at the disc's centre through the slab.
     let direct = radiance * (-sigma_t * depth / view.z as f64).exp();
-    let scene = scene(medium, slab(depth as f32), g as f32, lights, Estimator::NextEvent);
-    let m = moments(&scene, Ray::new(Vec3::new(0.0, 0.0, -1.0), view), false, 200_000);
+    let scene = scene(
+        medium,
+        slab(depth as f32),
+        g as f32,
+        lights,
+        Estimator::NextEvent,
+    );
+    let m = moments(
+        &scene,
+        Ray::new(Vec3::new(0.0, 0.0, -1.0), view),
+        false,
+        200_000,
+    );
     assert_mean(&m[0], direct + scattered, "sun disc");
 }
 

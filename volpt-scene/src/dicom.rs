@@ -71,7 +71,7 @@ const NATIVE_SYNTAXES: [&str; 4] = [
     "1.2.840.10008.1.2",
     "1.2.840.10008.1.2.1",
     "1.2.840.10008.1.2.2",
-    "1.2.840.10008.1.2.1.99",
+    DEFLATED,
 ];
 
 /// Whether `path` names a DICOM file by its extension (`.dcm`, `.dicom`).
@@ -275,13 +275,20 @@ fn open_dicom(path: &Path) -> Result<Option<Vec<u8>>, SceneError> {
 /// Refuses a data set whose element (or item) declares more bytes than follow it: dicom-object
 /// allocates a value's declared length before reading it, so a corrupt or hostile length (up to
 /// 4 GiB) must not reach it. Walks the file meta group (explicit VR little endian) and the data set
-/// in its transfer syntax's encoding, into sequences and items; stops at encapsulated pixel data
-/// (not decoded) and at a deflated data set (whose syntax is refused below before its pixels).
+/// in its transfer syntax's encoding, into sequences and items; a deflated data set (explicit VR
+/// little endian, raw deflate) is inflated first, within the memory limit, and walked the same
+/// way. Stops at encapsulated pixel data (not decoded).
 fn check_lengths(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
+    check_element_lengths(path, bytes, true)
+}
+
+/// [`check_lengths`] of `bytes`, which start with the file meta group if `in_meta`, else with
+/// an explicit VR little endian data set.
+fn check_element_lengths(path: &Path, bytes: &[u8], in_meta: bool) -> Result<(), SceneError> {
     const EXPLICIT_LE: (bool, bool) = (true, false);
     let mut at = 0usize;
     let mut encoding = EXPLICIT_LE; // (explicit VR, big endian)
-    let mut in_meta = true;
+    let mut in_meta = in_meta;
     while at + 8 <= bytes.len() {
         let u16_at = |i: usize, big: bool| {
             let b = [bytes[i], bytes[i + 1]];
@@ -302,8 +309,8 @@ fn check_lengths(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
         if in_meta && u16_at(at, false) != 0x0002 {
             in_meta = false;
             let syntax = transfer_syntax_of(bytes, at);
-            if syntax.as_deref() == Some("1.2.840.10008.1.2.1.99") {
-                return Ok(());
+            if syntax.as_deref() == Some(DEFLATED) {
+                return check_element_lengths(path, &inflate(path, &bytes[at..])?, false);
             }
             encoding = match syntax.as_deref() {
                 Some("1.2.840.10008.1.2") => (false, false),
@@ -366,6 +373,23 @@ fn check_lengths(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
         at += length;
     }
     Ok(())
+}
+
+/// The deflated explicit VR little endian transfer syntax.
+const DEFLATED: &str = "1.2.840.10008.1.2.1.99";
+
+/// A deflated data set (raw deflate, PS3.5 A.5), inflated: real bytes, refused past the memory
+/// limit (a deflate stream expands at most ~1032 times, `DEFLATE_MAX_RATIO`).
+fn inflate(path: &Path, deflated: &[u8]) -> Result<Vec<u8>, SceneError> {
+    use std::io::Read;
+    let limit = crate::limits::memory_limit();
+    let mut inflated = Vec::new();
+    flate2::read::DeflateDecoder::new(deflated)
+        .take(limit.saturating_add(1))
+        .read_to_end(&mut inflated)
+        .map_err(|e| decode_error(path, "the deflated data set", e))?;
+    crate::limits::check_memory(path, "the inflated data set", Some(inflated.len() as u64))?;
+    Ok(inflated)
 }
 
 /// Whether the explicit-VR element whose value starts at `at` is a sequence (`SQ`).

@@ -75,6 +75,35 @@ impl SpotCone {
 }
 
 impl LightsDesc {
+    /// The lights' parameters a scene takes between renders (the facade's `Scene::get` and
+    /// `Scene::set`): a scene has those of the lights it has.
+    pub const PARAMS: &'static [(&'static str, &'static str)] = &[
+        (
+            "sun.direction",
+            "where the sun's light travels (from the sun), a 3-vector",
+        ),
+        (
+            "sun.irradiance",
+            "the sun's irradiance on a surface facing it, RGB >= 0",
+        ),
+        (
+            "sun.angular_radius",
+            "the sun disc's angular radius in degrees, in [0, 90]; 0 is a delta direction",
+        ),
+        (
+            "light.position",
+            "the point or spot light's position, a 3-vector",
+        ),
+        (
+            "light.intensity",
+            "the point or spot light's radiant intensity (W/sr), RGB >= 0",
+        ),
+        (
+            "light.direction",
+            "where the spot's beam points, a 3-vector",
+        ),
+    ];
+
     pub fn is_empty(&self) -> bool {
         self.sun.is_none() && self.spot.is_none()
     }
@@ -182,7 +211,7 @@ impl LightsDesc {
 
     /// The `<emitter>`s of a Mitsuba 3 scene (empty for none). A sun with an angular radius has
     /// no Mitsuba 3 spelling (`directional` is a delta direction): an error naming it.
-    pub(crate) fn to_mitsuba3(&self, xml: &std::path::Path) -> Result<String, SceneError> {
+    pub(crate) fn to_mitsuba3(self, xml: &std::path::Path) -> Result<String, SceneError> {
         let mut out = String::new();
         let xyz = |name: &str, tag: &str, v: &[f32; 3]| {
             format!(
@@ -528,8 +557,7 @@ impl LightSpec {
                         cone: Some(SpotCone {
                             direction,
                             cutoff_angle: *cutoff_angle,
-                            beam_width: beam_width
-                                .unwrap_or(SpotCone::default_beam(*cutoff_angle)),
+                            beam_width: beam_width.unwrap_or(SpotCone::default_beam(*cutoff_angle)),
                         }),
                     });
                 }

@@ -262,7 +262,13 @@ impl Header {
 
         let dimension = require("dimension", "3")?;
         if dimension.value != "3" {
-            return Err(at(bad_at(dimension, "3")));
+            // A 4D file is a vector (RGB, a tensor) or a time series of volumes: which channel
+            // or time is the density is the user's choice.
+            return Err(at(bad_at(
+                dimension,
+                "3 (a scalar volume: a 4D file, RGB, vector or time series, is not read; extract \
+                 one channel or time first, e.g. `unu slice -a 0 -p 0 -i in.nrrd -o out.nrrd`)",
+            )));
         }
         if let Some(f) = get(&["space dimension"]) {
             if f.value != "3" {

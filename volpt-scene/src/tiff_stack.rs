@@ -129,7 +129,9 @@ impl Stack {
                     path,
                     page,
                     "colour type",
-                    "greyscale",
+                    "greyscale (one sample per pixel: volpt reads a density; RGB, palette and \
+                     multi-sample pages are not read, convert the stack to one channel first, \
+                     e.g. ImageJ's Image > Type > 8-bit or 32-bit)",
                     format!("{colour:?}"),
                 ));
             };

@@ -142,7 +142,12 @@ fn an_nrrd_header_declaring_more_than_the_memory_limit_is_refused_before_allocat
 #[test]
 fn nrrd_errors_name_the_field_expected_and_found() {
     let dir = tempfile::TempDir::new().unwrap();
-    let cases: [(&str, &[u8], &str); 6] = [
+    let cases: [(&str, &[u8], &str); 7] = [
+        (
+            "type: uchar\ndimension: 4\nsizes: 3 2 2 2\nencoding: raw\n",
+            &[1; 24],
+            "a 4D file, RGB, vector or time series, is not read",
+        ),
         (
             "type: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n",
             &[1; 7],
@@ -206,6 +211,24 @@ fn a_tiff_stack_whose_pages_differ_in_size_is_refused() {
     assert!(path.ends_with("c.tif"), "{path:?}: {problem}");
 }
 
+/// An RGB page is refused by name, saying what to do: volpt reads one channel, a density.
+#[test]
+fn an_rgb_tiff_stack_is_refused_naming_its_colour_type() {
+    let dir = tempfile::TempDir::new().unwrap();
+    let path = dir.path().join("rgb.tif");
+    let file = std::fs::File::create(&path).unwrap();
+    let mut encoder = tiff::encoder::TiffEncoder::new(file).unwrap();
+    encoder
+        .write_image::<tiff::encoder::colortype::RGB8>(2, 2, &[7u8; 12])
+        .unwrap();
+    drop(encoder);
+    let error = volpt_scene::read_tiff_stack(&path).unwrap_err().to_string();
+    assert!(
+        error.contains("RGB") && error.contains("one channel"),
+        "{error}"
+    );
+}
+
 /// dicom-object allocates a value's declared length before reading it: a length beyond the file
 /// (here PixelData claiming almost 4 GiB) is refused before the file reaches it.
 #[test]
@@ -216,6 +239,83 @@ fn a_dicom_element_longer_than_its_file_is_refused_before_parsing() {
     bytes[at..at + 4].copy_from_slice(&0xFFFF_FFF0u32.to_le_bytes());
     let dir = tempfile::TempDir::new().unwrap();
     std::fs::write(dir.path().join("IM0001"), bytes).unwrap();
+    let (_, problem) = problem(volpt_scene::read_dicom_series(dir.path()));
+    assert!(problem.to_string().contains("(7FE0,0010)"), "{problem}");
+}
+
+/// `bytes`, an explicit VR little endian DICOM file, as a deflated one (PS3.5 A.5): the file meta
+/// group's transfer syntax becomes 1.2.840.10008.1.2.1.99 (its group length follows) and the data
+/// set after it is raw-deflated; `edit` changes the data set before.
+fn deflated(bytes: &[u8], edit: impl FnOnce(&mut Vec<u8>)) -> Vec<u8> {
+    use std::io::Write;
+    assert_eq!(&bytes[128..132], b"DICM");
+    let (mut at, mut meta) = (132, Vec::new());
+    while u16::from_le_bytes([bytes[at], bytes[at + 1]]) == 0x0002 {
+        let (tag, vr) = (&bytes[at..at + 4], &bytes[at + 4..at + 6]);
+        let (header, length) = if matches!(vr, b"OB" | b"OW" | b"UN" | b"SQ" | b"UT") {
+            let b = &bytes[at + 8..at + 12];
+            (12, u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
+        } else {
+            (
+                8,
+                usize::from(u16::from_le_bytes([bytes[at + 6], bytes[at + 7]])),
+            )
+        };
+        if tag == [0x02, 0x00, 0x10, 0x00] {
+            let uid = b"1.2.840.10008.1.2.1.99";
+            meta.extend_from_slice(&bytes[at..at + 6]);
+            meta.extend_from_slice(&(uid.len() as u16).to_le_bytes());
+            meta.extend_from_slice(uid);
+        } else {
+            meta.extend_from_slice(&bytes[at..at + header + length]);
+        }
+        at += header + length;
+    }
+    // (0002,0000) UL, the group's length after it, is the first element.
+    let group_length = (meta.len() - 12) as u32;
+    meta[8..12].copy_from_slice(&group_length.to_le_bytes());
+    let mut data_set = bytes[at..].to_vec();
+    edit(&mut data_set);
+    let mut encoder = flate2::write::DeflateEncoder::new(Vec::new(), flate2::Compression::best());
+    encoder.write_all(&data_set).unwrap();
+    let mut out = bytes[..132].to_vec();
+    out.extend_from_slice(&meta);
+    out.extend_from_slice(&encoder.finish().unwrap());
+    out
+}
+
+/// A deflated copy of the axial series, written to a fresh folder, with `edit` applied to each
+/// slice's data set.
+fn deflated_series(edit: impl Fn(&mut Vec<u8>)) -> tempfile::TempDir {
+    let dir = tempfile::TempDir::new().unwrap();
+    for entry in std::fs::read_dir(fixture("dicom-axial")).unwrap() {
+        let path = entry.unwrap().path();
+        let bytes = deflated(&std::fs::read(&path).unwrap(), &edit);
+        std::fs::write(dir.path().join(path.file_name().unwrap()), bytes).unwrap();
+    }
+    dir
+}
+
+#[test]
+fn a_deflated_dicom_series_reads_as_the_reference_volume() {
+    let reference = read_metaimage(&fixture("reference.mha")).unwrap();
+    let dir = deflated_series(|_| {});
+    assert_eq!(
+        volpt_scene::read_dicom_series(dir.path()).unwrap(),
+        reference
+    );
+}
+
+/// The deflated syntax gets the same check: its data set is inflated (real bytes, within the
+/// memory limit) and a length it claims beyond them (PixelData claiming almost 4 GiB) is refused
+/// before dicom-object would allocate it.
+#[test]
+fn a_deflated_dicom_element_claiming_4_gib_is_refused_before_parsing() {
+    let dir = deflated_series(|data_set| {
+        let tag = b"\xe0\x7f\x10\x00OW\x00\x00";
+        let at = data_set.windows(tag.len()).position(|w| w == tag).unwrap() + tag.len();
+        data_set[at..at + 4].copy_from_slice(&0xFFFF_FFF0u32.to_le_bytes());
+    });
     let (_, problem) = problem(volpt_scene::read_dicom_series(dir.path()));
     assert!(problem.to_string().contains("(7FE0,0010)"), "{problem}");
 }

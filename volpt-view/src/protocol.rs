@@ -36,6 +36,12 @@ pub const SETTABLE: &[&str] = &[
     "medium.albedo",
     "phase.g",
     "camera.fov",
+    "sun.direction",
+    "sun.irradiance",
+    "sun.angular_radius",
+    "light.position",
+    "light.intensity",
+    "light.direction",
 ];
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
@@ -121,11 +127,12 @@ pub fn param_value(key: &str, value: &serde_json::Value) -> Result<ParamValue, P
             .as_i64()
             .map(ParamValue::Int)
             .ok_or_else(|| wrong("an integer")),
-        "medium.scale" | "phase.g" | "camera.fov" => number()
+        "medium.scale" | "phase.g" | "camera.fov" | "sun.angular_radius" => number()
             .filter(|v| v.abs() <= f64::from(f32::MAX))
             .map(|v| ParamValue::Float(v as f32))
             .ok_or_else(|| wrong("a number")),
-        "medium.albedo" => {
+        "medium.albedo" | "sun.direction" | "sun.irradiance" | "light.position"
+        | "light.intensity" | "light.direction" => {
             let rgb: Option<Vec<f32>> = value.as_array().and_then(|a| {
                 a.iter()
                     .map(|c| c.as_f64().filter(|v| v.is_finite()).map(|v| v as f32))
@@ -133,7 +140,7 @@ pub fn param_value(key: &str, value: &serde_json::Value) -> Result<ParamValue, P
             });
             match rgb.as_deref() {
                 Some(&[r, g, b]) => Ok(ParamValue::Rgb([r, g, b])),
-                _ => Err(wrong("[r, g, b]")),
+                _ => Err(wrong("three numbers ([r, g, b] or [x, y, z])")),
             }
         }
         _ => Err(ProtocolError::Invalid(format!(
