@@ -13,7 +13,8 @@
 # 2. Tiles on the GPU: fill1024.vdb, fill4096.vdb and a 16384^3 box of 64 root tiles (written here
 #    from fill4096.vdb, as volpt-scene/tests/vdb_tiles.rs does) render within 60 s each (BEFORE:
 #    fill4096 takes about 10 s to load, the 16384^3 box is refused).
-# 3. A/B (`volpt bench`, regeneration-sk, fast math, TRIALS trials, rounds BEFORE/AFTER alternated
+# 3. A/B (`volpt bench` with AB_ARGS, by default `--strategy regeneration-sk --math fast`; AB_ARGS=
+#    (empty) measures the defaults; TRIALS trials, rounds BEFORE/AFTER alternated
 #    twice): the grey scenes with --bricked (the any-layout kernels the sparse lookup lives in:
 #    smoke, bucky, cgg-logo), sparse bucky.vdb, and the large cloud kept sparse if
 #    bundle/vdb-bench/large-cloud-*.vdb is there.
@@ -24,6 +25,7 @@ set -uo pipefail
 cd "$(dirname "$0")"
 OUT=${OUT:-$PWD/out}
 mkdir -p "$OUT"
+AB_ARGS=${AB_ARGS---strategy regeneration-sk --math fast}
 BEFORE=${BEFORE:-$PWD/bin/volpt-before}
 AFTER=${AFTER:-$PWD/bin/volpt}
 for b in "$BEFORE" "$AFTER"; do
@@ -102,8 +104,7 @@ for entry in "${SCENES[@]}"; do
     for round in 1 2; do
         for bin in "$BEFORE" "$AFTER"; do
             # shellcheck disable=SC2086
-            if timeout 300 "$bin" bench "$file" $params --spp "$SPP" --backend cuda --strategy regeneration-sk \
-                --math fast --trials "$TRIALS" --json >"$OUT/tmp.json" 2>"$OUT/tmp.log"; then
+            if timeout 300 "$bin" bench "$file" $params --spp "$SPP" --backend cuda $AB_ARGS --trials "$TRIALS" --json >"$OUT/tmp.json" 2>"$OUT/tmp.log"; then
                 python3 -c "import json,sys; r=json.load(open(sys.argv[1])); print(f\"AB {sys.argv[2]:<14} {sys.argv[3]:<20} round {sys.argv[4]} {r['time_median_s']*1e3:9.2f} ms  {r['paths_per_s']/1e6:8.2f} M paths/s\")" \
                     "$OUT/tmp.json" "$(basename "$bin")" "$name" "$round" | tee -a "$OUT/sparse-table.txt"
             else

@@ -32,11 +32,15 @@ impl PerspectiveCamera {
         let sy = (py as f32 + u.y) / self.height as f32;
         let x = (1.0 - 2.0 * sx) * self.tan_half_fov.x;
         let y = (1.0 - 2.0 * sy) * self.tan_half_fov.y;
-        if self.orthographic {
-            let origin = self.origin + self.axis_x * x + self.axis_y * y;
-            return Ray::new(origin, crate::math::normalize(self.axis_z));
-        }
-        let dir = crate::math::normalize(self.axis_x * x + self.axis_y * y + self.axis_z);
-        Ray::new(self.origin, dir)
+        let film = self.axis_x * x + self.axis_y * y;
+        // Selects, not a branch: a branch here, inside the strategies' path loops, cost the grid
+        // kernels ~5-8% on an H200 (bench/results/2026-11-29-h200-session10). The pinhole's
+        // arithmetic is the same as without the orthographic case.
+        let (origin, dir) = if self.orthographic {
+            (self.origin + film, self.axis_z)
+        } else {
+            (self.origin, film + self.axis_z)
+        };
+        Ray::new(origin, crate::math::normalize(dir))
     }
 }

@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Session 10's device calls (2026-11-29), from a folder laid out like `cargo xtask device-bundle`'s
+# (bin/volpt or bin/volpt.xz, scenes/, data/, the bench/device scripts).
+#
+#   bash dev/session10.sh kernels   # the grey grid scenes' regression, bisected: the same binary
+#                                   # (main at f8f3c96) runs each cut PTX of ab/*.ptx[.xz] (ab.sh,
+#                                   # regeneration-sk, fast math, two rounds), and ptxas -v reports
+#                                   # every PTX of ab/ and ab-ptxas/ (kernels of other host ABIs,
+#                                   # compiled but not run)
+#
+# Each part writes under $OUT/<part>/; the summaries are gathered in $OUT/summary-<mode>.txt.
+set -uo pipefail
+cd "$(dirname "$0")"
+OUT=${OUT:-$PWD/out}
+mode=${1:?usage: session10.sh kernels}
+mkdir -p "$OUT"
+for f in bin/*.xz ab/*.xz ab-ptxas/*.xz; do [ -f "$f" ] && xz -d -f "$f"; done
+chmod +x bin/* 2>/dev/null
+summary=$OUT/summary-$mode.txt
+part() { # part NAME LIMIT_S CMD...: CMD with OUT=$OUT/NAME under a time limit
+    local name=$1 limit=$2; shift 2
+    local t0; t0=$(date +%s)
+    mkdir -p "$OUT/$name"
+    OUT=$OUT/$name timeout "$limit" "$@" >"$OUT/$name/stdout.txt" 2>&1
+    echo "== $name: exit $? after $(($(date +%s) - t0)) s (limit $limit s)" | tee -a "$summary"
+}
+echo "== $(date -u +%Y-%m-%dT%H:%MZ) $(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader | head -n 1)" | tee "$summary"
+case $mode in
+kernels)
+    ARCH=sm_$(nvidia-smi --query-gpu=compute_cap --format=csv,noheader | head -n 1 | tr -d '.')
+    mkdir -p "$OUT/ptxas"
+    # ab.sh reports ab/*.ptx itself (in each round's folder); these are only compiled.
+    for ptx in ab-ptxas/*.ptx; do
+        [ -f "$ptx" ] && ptxas -arch="$ARCH" -v "$ptx" -o /dev/null >"$OUT/ptxas/ptxas-$(basename "$ptx" .ptx).txt" 2>&1 &
+    done
+    for round in 1 2; do
+        part "ab-round$round" 240 env STRATEGIES=regeneration-sk TRIALS=5 bash ab.sh
+    done
+    wait
+    # "ptx kernel: ptxas's Used line" for every report.
+    for r in "$OUT"/ptxas/ptxas-*.txt "$OUT"/ab-round1/ptxas-*.txt; do
+        [ -f "$r" ] && awk -v p="$(basename "$r" .txt)" '/Compiling entry function/ {k=$0; sub(/.*function ./, "", k); sub(/. for .*/, "", k)}
+            /Used [0-9]+ registers/ {u=$0; sub(/.*Used/, "Used", u); print p, k ":", u}' "$r"
+    done >"$OUT/ptxas/registers.txt"
+    ;;
+esac
+for f in "$OUT"/ab-round*/ab.txt "$OUT"/ptxas/registers.txt; do
+    [ -f "$f" ] && { echo "---- $f"; cat "$f"; } >>"$summary"
+done
+for d in "$OUT"/*/; do tail -n 3 "$d/stdout.txt" 2>/dev/null | sed "s|^|$(basename "$d"): |" >>"$summary"; done
+cat "$summary"
