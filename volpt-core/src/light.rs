@@ -1,6 +1,7 @@
 //! Lights besides the environment: a distant light (the sun: a disc of angular radius `r`, a delta
 //! direction at `r = 0`) and a point light whose emission a spot's cone may limit. They light the
-//! medium by next-event estimation at its scattering events ([`next_event_estimate`]) where nothing
+//! medium by next-event estimation at its scattering events ([`samples`], weighed in `path`'s
+//! next-event estimation with the environment's sample, one shadow ray each) where nothing
 //! but the medium lies between a collision and the light: behind an index-matched boundary. A
 //! dielectric boundary bends the shadow ray, so a delta light cannot be reached through it (Mitsuba
 //! 3's `volpath` treats the surface as an occluder there and renders no direct light, silently;
@@ -15,12 +16,11 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::bsdf::Bsdf;
 use crate::math::{normalize, sqrt, PI};
-use crate::path::{power_heuristic, shadow_transmittance, PathOf, Truncation};
-use crate::phase::PhaseFunction;
+use crate::path::{power_heuristic, PathOf};
 use crate::sampling::direction_about;
 use crate::scene::Scene;
 use crate::spectral::SpectralState;
-use crate::{Ray, Spectrum, Vec2, Vec3};
+use crate::{Spectrum, Vec2, Vec3};
 
 /// A distant light (Mitsuba 3's `directional` at radius 0; pbrt-v4's `DistantLight`): uniform
 /// radiance from a disc of angular radius `r` about `to_light`, normalised so that the radiance
@@ -305,8 +305,8 @@ impl From<&LightsParams> for Lights {
 }
 
 /// One light's contribution as next-event estimation sees it from a collision: the look direction,
-/// how far the light is (infinite for the sun), the light arriving (radiance, or intensity over
-/// distance squared for a point) and the sample's density (1 for a delta light).
+/// how far the light is (infinite for the sun and the environment), the light arriving (radiance,
+/// or intensity over distance squared for a point) and the sample's density (1 for a delta light).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct LightSample {
     pub dir: Vec3,
@@ -364,22 +364,20 @@ pub(crate) fn sample_spot(spot: &SpotLight, p: Vec3) -> Option<LightSample> {
     })
 }
 
-/// Next-event estimation of the lights at a scattering event at `p` (Veach 1997, ch. 9; pbrt-v4
-/// section 14.2.2, `SampleLd`): each light that is on adds
-/// `throughput * phase(w) * T(p, w) * L(w) * w_light / p_light(w)`, `T` estimated by ratio tracking
-/// up to the light (to the boundary for the sun). A delta light (the sun at radius 0, a point or
-/// spot: `L / p` is then `irradiance`, or `I falloff / r^2`) is reached by no other strategy, so its
-/// weight is 1; a sun with extent is also reached by the phase function's sample when the path
-/// escapes into the disc ([`escaped_sun`]), so both take the power heuristic
-/// `w_light = p_light^2 / (p_light^2 + phase^2)`. Valid behind an index-matched boundary only.
-/// False (and the path is cut) when ratio tracking runs out of steps.
+/// The lights' samples for next-event estimation from a collision at `p` (the sun's, then the
+/// point or spot's; `None` for a light that is off or sends nothing to `p`), which
+/// [`crate::path`]'s next-event estimation weighs with the environment's in one loop. A delta
+/// light (the sun at radius 0, a point or spot: `L / p` is then the irradiance, or
+/// `I falloff / r^2`) is reached by no other strategy, so its weight is 1; a sun with extent is
+/// also reached by the phase function's sample when the path escapes into the disc
+/// ([`escaped_sun`]), so both take the power heuristic (pbrt-v4 section 14.2.2, `SampleLd`).
+/// Draws the sun's two numbers only for a sun with extent.
 #[inline(always)]
-pub(crate) fn next_event_estimate<S: Scene>(
+pub(crate) fn samples<S: Scene>(
     scene: &S,
     path: &mut PathOf<S>,
     p: Vec3,
-    phase: &S::Phase,
-) -> bool {
+) -> [Option<LightSample>; 2] {
     let lights = scene.lights();
     let sun = if lights.sun.is_on() {
         let u = if lights.sun.is_delta() {
@@ -396,33 +394,21 @@ pub(crate) fn next_event_estimate<S: Scene>(
     } else {
         None
     };
-    // One loop over both, not an array of them: a GPU would keep an indexed array in local memory,
-    // and one body keeps one copy of ratio tracking in the kernels.
-    for slot in 0..2 {
-        let Some(light) = (if slot == 0 { sun } else { spot }) else {
-            continue;
-        };
-        let phase = phase.eval(path.ray.dir, light.dir);
-        let mis = if light.delta {
-            1.0
-        } else {
-            power_heuristic(light.pdf, phase)
-        };
-        let shadow = Ray::new(p, light.dir);
-        let Some(transmittance) = shadow_transmittance(scene, path, shadow, light.distance) else {
-            path.truncate(Truncation::TrackingSteps);
-            return false;
-        };
-        path.radiance += path.spectral.next_event_light(
-            path.throughput,
-            light.light,
-            mis,
-            phase,
-            light.pdf,
-            transmittance,
-        );
+    [sun, spot]
+}
+
+impl From<crate::environment::LightSample> for LightSample {
+    /// The environment's sample: a direction of the map, from infinitely far away.
+    #[inline(always)]
+    fn from(l: crate::environment::LightSample) -> Self {
+        Self {
+            dir: l.dir,
+            distance: f32::INFINITY,
+            light: l.radiance,
+            pdf: l.pdf,
+            delta: false,
+        }
     }
-    true
 }
 
 /// The sun's light reaching a path that escapes along its disc, weighted against next-event

@@ -411,13 +411,10 @@ pub fn scatter<S: Scene>(scene: &S, path: &mut PathOf<S>, p: Vec3, albedo: Optio
     }
     let next_event = PathOf::<S>::uses_next_event(scene);
     let phase = collision_phase(scene, p);
-    if next_event && !next_event_estimate(scene, path, p, &phase) {
-        return;
-    }
-    // The scene's other lights, behind an index-matched boundary whatever the estimator: a delta
-    // light is reached by no other strategy.
+    // The scene's other lights are sampled behind an index-matched boundary whatever the
+    // estimator: a delta light is reached by no other strategy.
     let lights = S::Bsdf::IS_NULL && scene.lights().any();
-    if lights && !light::next_event_estimate(scene, path, p, &phase) {
+    if (next_event || lights) && !next_event_estimate(scene, path, p, &phase, next_event) {
         return;
     }
     let sample = phase.sample(path.ray.dir, path.rng.next_2d());
@@ -441,37 +438,62 @@ fn collision_phase<S: Scene>(scene: &S, p: Vec3) -> S::Phase {
 }
 
 /// Next-event estimation at a scattering event at `p` (Veach 1997, ch. 9; pbrt-v4 section 14.2.2):
-/// a look direction `w` sampled from the environment with density `p_env` adds
+/// a look direction `w` sampled from the environment (if `environment`) with density `p_env` adds
 /// `throughput * phase(w) * T(p, w) * L_env(w) * w_env / p_env`, with `T` the transmittance to the
 /// box estimated by ratio tracking and `w_env = p_env^2 / (p_env^2 + phase(w)^2)` the power
 /// heuristic; the path's phase-sampled continuation keeps `phase(wo)` so that, should it escape,
-/// its light takes the complementary weight. Both strategies together are unbiased. Valid only
-/// where nothing but the medium lies between `p` and the environment: an index-matched boundary.
-/// False (and the path is cut) when ratio tracking runs out of steps.
+/// its light takes the complementary weight. Both strategies together are unbiased. Each of the
+/// scene's other lights adds the same with its own sample ([`light::samples`]: weight 1 for a
+/// delta light; `T` up to a point light). Valid only where nothing but the medium lies between
+/// `p` and the lights: an index-matched boundary. False (and the path is cut) when ratio tracking
+/// runs out of steps.
 #[inline(always)]
 fn next_event_estimate<S: Scene>(
     scene: &S,
     path: &mut PathOf<S>,
     p: Vec3,
     phase: &S::Phase,
+    environment: bool,
 ) -> bool {
-    let Some(light) = scene.environment().sample(path.rng.next_2d()) else {
-        return true;
+    let env = if environment {
+        scene
+            .environment()
+            .sample(path.rng.next_2d())
+            .map(light::LightSample::from)
+    } else {
+        None
     };
-    let phase = phase.eval(path.ray.dir, light.dir);
-    let shadow = Ray::new(p, light.dir);
-    let Some(transmittance) = shadow_transmittance(scene, path, shadow, f32::INFINITY) else {
-        path.truncate(Truncation::TrackingSteps);
-        return false;
-    };
-    path.radiance += path.spectral.next_event_light(
-        path.throughput,
-        light.radiance,
-        power_heuristic(light.pdf, phase),
-        phase,
-        light.pdf,
-        transmittance,
-    );
+    let [sun, spot] = light::samples(scene, path, p);
+    // One loop over the samples, not an array of them (a GPU would keep an indexed array in local
+    // memory): one body keeps one copy of ratio tracking in the kernels.
+    for slot in 0..3 {
+        let Some(light) = (match slot {
+            0 => env,
+            1 => sun,
+            _ => spot,
+        }) else {
+            continue;
+        };
+        let phase = phase.eval(path.ray.dir, light.dir);
+        let mis = if light.delta {
+            1.0
+        } else {
+            power_heuristic(light.pdf, phase)
+        };
+        let shadow = Ray::new(p, light.dir);
+        let Some(transmittance) = shadow_transmittance(scene, path, shadow, light.distance) else {
+            path.truncate(Truncation::TrackingSteps);
+            return false;
+        };
+        path.radiance += path.spectral.next_event_light(
+            path.throughput,
+            light.light,
+            mis,
+            phase,
+            light.pdf,
+            transmittance,
+        );
+    }
     true
 }
 
@@ -481,7 +503,7 @@ fn next_event_estimate<S: Scene>(
 /// enter it again. `None` when tracking runs out of steps. Per channel for a chromatic medium
 /// ([`SpectralState::Transmittance`]).
 #[inline(always)]
-pub(crate) fn shadow_transmittance<S: Scene>(
+fn shadow_transmittance<S: Scene>(
     scene: &S,
     path: &mut PathOf<S>,
     shadow: Ray,
