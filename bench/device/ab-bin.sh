@@ -15,10 +15,12 @@ for b in "$BEFORE" "$AFTER"; do
 done
 SPP=${SPP:-100}
 TRIALS=${TRIALS:-3}
-STRATEGIES=${STRATEGIES:-regeneration-sk regeneration-block-sk}
+STRATEGIES=${STRATEGIES:-regeneration-sk regeneration-block-sk}  # "defaults": no --strategy, no --math
 MATH=${MATH:-fast}
 T=${T:-60}
 "$AFTER" scene generate scenes >/dev/null
+# A strategy's flags; "defaults" is no flag but --backend cuda (the schedule and math volpt picks).
+flags() { [ "$1" = defaults ] || echo "--strategy $1 --math $MATH"; }
 SCENES=(
     "homogeneous-cube-null:scenes/homogeneous-cube/scene.xml:-Dboundary=null"
     "homogeneous-cube:scenes/homogeneous-cube/scene.xml:"
@@ -36,8 +38,7 @@ SCENES=(
             for round in 1 2; do
                 for bin in "$BEFORE" "$AFTER"; do
                     # shellcheck disable=SC2086
-                    timeout "$T" "$bin" bench "$file" $params --spp "$spp" --backend cuda --strategy "$s" \
-                        --math "$MATH" --trials "$TRIALS" --json >"$OUT/tmp.json" 2>"$OUT/tmp.log" \
+                    timeout "$T" "$bin" bench "$file" $params --spp "$spp" --backend cuda $(flags "$s") --trials "$TRIALS" --json >"$OUT/tmp.json" 2>"$OUT/tmp.log" \
                         || { echo "FAIL $(basename "$bin") $name $s"; continue; }
                     python3 -c "import json,sys; r=json.load(open(sys.argv[1])); print(f\"{sys.argv[2]:<14} {sys.argv[3]:<22} {sys.argv[4]:<22} round {sys.argv[5]} {r['time_median_s']*1e3:9.2f} ms  {r['segments_per_s']/1e9:7.3f} G seg/s  {r['paths_per_s']/1e6:8.2f} M paths/s\")" \
                         "$OUT/tmp.json" "$(basename "$bin")" "$name" "$s" "$round"

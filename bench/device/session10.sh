@@ -2,6 +2,13 @@
 # Session 10's device calls (2026-11-29), from a folder laid out like `cargo xtask device-bundle`'s
 # (bin/volpt or bin/volpt.xz, scenes/, data/, the bench/device scripts).
 #
+#   bash dev/session10.sh checks    # main's final binary: every strategy and fast math against the
+#                                   # CPU (short form), orthographic, materials, chromatic, and the
+#                                   # helpers' device scripts named in EXTRA (lights, mesh, materials,
+#                                   # print); keeps the binary in /tmp/session10 for the next call
+#   bash dev/session10.sh ab        # bin/volpt-before against the kept binary: AB picks ab-bin
+#                                   # (grey box scenes, regeneration-sk and the defaults) and
+#                                   # sparse-table (exact checks, tiles, the bricked and sparse A/B)
 #   bash dev/session10.sh kernels   # the grey grid scenes' regression, bisected: the same binary
 #                                   # (main at f8f3c96) runs each cut PTX of ab/*.ptx[.xz] (ab.sh,
 #                                   # regeneration-sk, fast math, two rounds), and ptxas -v reports
@@ -12,7 +19,9 @@
 set -uo pipefail
 cd "$(dirname "$0")"
 OUT=${OUT:-$PWD/out}
-mode=${1:?usage: session10.sh kernels}
+mode=${1:?usage: session10.sh checks|ab|kernels}
+KEEP=/tmp/session10
+mkdir -p "$KEEP"
 mkdir -p "$OUT"
 for f in bin/*.xz ab/*.xz ab-ptxas/*.xz; do [ -f "$f" ] && xz -d -f "$f"; done
 chmod +x bin/* 2>/dev/null
@@ -26,6 +35,33 @@ part() { # part NAME LIMIT_S CMD...: CMD with OUT=$OUT/NAME under a time limit
 }
 echo "== $(date -u +%Y-%m-%dT%H:%MZ) $(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader | head -n 1)" | tee "$summary"
 case $mode in
+checks)
+    cp bin/volpt "$KEEP/volpt"
+    for check in ${CHECKS:-strategies orthographic materials chromatic}; do
+        case $check in
+        strategies) part strategies 130 env TRIALS=3 T=30 PROBE_T=15 \
+            SCENES_ONLY="^(homogeneous-cube-null|cgg-logo|smoke|bucky)$" EXACT_STRATEGIES="regeneration-sk" \
+            FAST_STRATEGIES="regeneration-sk regeneration-warp-sk regeneration-block-sk streaming-sk" \
+            CAPS="64" bash strategies.sh ;;
+        materials) part materials 90 bash materials.sh ;;
+        chromatic) part chromatic 100 env FILMS=${FILMS:-8} bash chromatic.sh ;;
+        orthographic) part orthographic 90 bash orthographic.sh ;;
+        esac
+    done
+    for extra in ${EXTRA:-}; do
+        [ -f "$extra" ] && part "$(basename "$extra" .sh)" "${EXTRA_LIMIT:-150}" bash "$extra"
+    done
+    ;;
+ab)
+    cp "$KEEP/volpt" bin/volpt
+    for ab in ${AB:-ab-bin sparse-table}; do
+        case $ab in
+        ab-bin) part ab-bin 200 env STRATEGIES="regeneration-sk defaults" TRIALS=3 bash ab-bin.sh ;;
+        sparse-table) part sparse-table 200 bash sparse-table.sh ;;
+        sparse-defaults) part sparse-defaults 200 env AB_ARGS= bash sparse-table.sh ;;
+        esac
+    done
+    ;;
 kernels)
     ARCH=sm_$(nvidia-smi --query-gpu=compute_cap --format=csv,noheader | head -n 1 | tr -d '.')
     mkdir -p "$OUT/ptxas"
@@ -44,7 +80,7 @@ kernels)
     done >"$OUT/ptxas/registers.txt"
     ;;
 esac
-for f in "$OUT"/ab-round*/ab.txt "$OUT"/ptxas/registers.txt; do
+for f in "$OUT"/*/summary.txt "$OUT"/ab-bin/ab-bin.txt "$OUT"/*/sparse-table.txt "$OUT"/ab-round*/ab.txt "$OUT"/ptxas/registers.txt; do
     [ -f "$f" ] && { echo "---- $f"; cat "$f"; } >>"$summary"
 done
 for d in "$OUT"/*/; do tail -n 3 "$d/stdout.txt" 2>/dev/null | sed "s|^|$(basename "$d"): |" >>"$summary"; done

@@ -16,6 +16,7 @@ pyo3::import_exception!(volpt.errors, RenderError);
 pyo3::import_exception!(volpt.errors, CheckpointError);
 pyo3::import_exception!(volpt.errors, MergeError);
 pyo3::import_exception!(volpt.errors, ImageError);
+pyo3::import_exception!(volpt.errors, PrintError);
 
 /// The Python exception for `error`: the class of its variant, with its message.
 pub fn to_py(error: Error) -> PyErr {

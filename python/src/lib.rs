@@ -9,6 +9,7 @@
 //! - [`backend`]: `volpt.Backend`, the CPU or GPUs with all their options, opened once.
 //! - [`film`]: `volpt.Film` (images, files, bytes, pickling), `volpt.merge`, `volpt.read_exr`.
 //! - [`observer`]: progress, Ctrl-C and notes while a render runs with the GIL released.
+//! - [`print`]: `volpt.compensate_print`, the scattering compensation of a colour 3D print.
 //!
 //! The package around it (`python/volpt/__init__.py`) adds `volpt.load`'s keyword parameters and
 //! the exception classes; the stubs (`python/volpt/_volpt.pyi`) document every class and method.
@@ -19,6 +20,7 @@ mod errors;
 mod film;
 mod observer;
 mod params;
+mod print;
 mod scene;
 
 use pyo3::prelude::*;
@@ -30,6 +32,7 @@ fn _volpt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scene::load, m)?)?;
     m.add_function(wrap_pyfunction!(film::merge, m)?)?;
     m.add_function(wrap_pyfunction!(film::read_exr, m)?)?;
+    m.add_function(wrap_pyfunction!(print::compensate_print, m)?)?;
     m.add_class::<scene::Scene>()?;
     m.add_class::<params::SceneParameters>()?;
     m.add_class::<film::Film>()?;

@@ -69,6 +69,15 @@ impl PyObserver {
         })
     }
 
+    /// Keeps `error` to raise after the render, and cancels it: the next look at
+    /// [`Observer::cancelled`] stops it.
+    pub fn fail(&self, error: PyErr) {
+        self.error
+            .lock()
+            .expect("not poisoned")
+            .get_or_insert(error);
+    }
+
     /// After the render: the exception that cancelled it, if one did.
     pub fn take_error(&self) -> Option<PyErr> {
         self.error.lock().expect("not poisoned").take()
@@ -108,6 +117,9 @@ impl Observer for PyObserver {
     }
 
     fn cancelled(&self) -> bool {
+        if self.error.lock().expect("not poisoned").is_some() {
+            return true;
+        }
         Python::with_gil(|py| {
             let result = py.check_signals().and_then(|()| match &self.callback {
                 Some(callback) => callback

@@ -41,7 +41,7 @@ pub struct Scene {
 
 /// `backend=` of a render: a [`Backend`] (whose options are its own), or a kind's name with
 /// `strategy=` and `math=`, opened for this render.
-enum Chosen<'py> {
+pub(crate) enum Chosen<'py> {
     Given(PyRef<'py, Backend>),
     Opened(Box<Backend>),
 }
@@ -57,7 +57,7 @@ impl std::ops::Deref for Chosen<'_> {
     }
 }
 
-fn choose<'py>(
+pub(crate) fn choose<'py>(
     backend: &Bound<'py, PyAny>,
     strategy: Option<&str>,
     math: Option<&str>,

@@ -21,13 +21,14 @@ from typing import Any, Mapping, Optional
 from . import errors
 from ._volpt import PARAMS, SETTINGS, STRATEGIES, Backend, Film, Scene, SceneParameters, __version__
 from ._volpt import load as _load
-from ._volpt import merge, read_exr
+from ._volpt import compensate_print, merge, read_exr
 from .errors import (
     CheckpointError,
     GridError,
     ImageError,
     MergeError,
     ParamError,
+    PrintError,
     RenderError,
     SceneError,
     SceneNotFoundError,
@@ -88,6 +89,7 @@ __all__ = [
     "load",
     "merge",
     "read_exr",
+    "compensate_print",
     "Scene",
     "SceneParameters",
     "Backend",

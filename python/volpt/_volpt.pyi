@@ -36,6 +36,47 @@ def read_exr(path: Union[str, os.PathLike[str]]) -> npt.NDArray[np.float32]:
     """The first RGB layer of an OpenEXR file, float32 (H, W, 3): what ``volpt render -o`` and
     ``Film.write`` write. Raises ``ImageError``."""
 
+def compensate_print(
+    target: Union[str, os.PathLike[str]],
+    materials: Union[str, os.PathLike[str]],
+    out: Union[str, os.PathLike[str]],
+    *,
+    layers: int = 100,
+    colour_layers: int = 40,
+    voxel_size: Optional[Tuple[float, float, float]] = None,
+    spp: int = 16,
+    max_spp: int = 4096,
+    iterations: Optional[int] = None,
+    step: Optional[float] = None,
+    noise_ratio: Optional[float] = 0.25,
+    ior: Optional[float] = 1.5,
+    seed: int = 0,
+    backend: Union[str, Backend, None] = None,
+    progress: Union[bool, Callable[[int, int], Any], None] = None,
+    iteration: Optional[Callable[[int, Dict[str, Any]], Any]] = None,
+) -> Dict[str, Any]:
+    """Compensates a colour 3D print's scattering, as ``volpt print compensate`` does (the same
+    record from the same arguments; docs/printing.md): the naive print of ``target`` (a PNG, one
+    texel of the print's top per pixel) is predicted by a render from straight above, the colours
+    its ``colour_layers`` aim for are corrected by the predicted error, and so on, at most
+    ``iterations`` predictions (default 10) with update ``step`` (default 1). ``materials`` is a
+    TOML material table (``[[materials]]`` with name, colour, sigma_s, sigma_a, g; five of them
+    named cyan, magenta, yellow, black and white; optionally ``voxel_size``). Noise control: a
+    prediction whose noise (the mean CIEDE2000 of one standard error) exceeds ``noise_ratio``
+    times the update's step is made again with four times the samples, up to ``max_spp``
+    (``None`` turns it off). ``ior`` is the resin surface's (``None``: no surface).
+
+    Writes into ``out``: target.png, prediction.png, comparison.png, iteration_NN/prediction.png
+    and delta_e.png, iterations.csv, delta_e.svg and the best print's slice stack (slices/).
+    Returns ``{"iterations": [{"mean", "p95", "noise", "spp"}, ...], "best", "size", "seconds",
+    "out"}``; ``iteration(k, {"mean", "p95", "noise", "spp"})`` is called as each iteration ends
+    (an exception it raises stops the loop as Ctrl-C does, and is raised). ``progress`` is as ``Scene.render``'s, per render.
+    The GIL is released; Ctrl-C writes the record of the iterations finished and raises
+    ``KeyboardInterrupt`` (the record of an interrupted loop is whole but for the iterations not
+    made). Raises ``PrintError`` for a file or argument it cannot use,
+    ``SettingsError`` for a bad backend, ``RenderError`` for a failed render.
+    """
+
 class Scene:
     """A loaded scene: its grids, its settings and the parameters that change between renders."""
 

@@ -68,6 +68,12 @@ class ImageError(VolptError):
     """An image that cannot be written or read."""
 
 
+class PrintError(VolptError, ValueError):
+    """A colour 3D print's compensation that cannot run: a target or material table volpt cannot
+    read (the file, field, expected and found values), an output folder already holding a
+    record's slices, or arguments out of range."""
+
+
 __all__ = [
     "VolptError",
     "SceneError",
@@ -80,4 +86,5 @@ __all__ = [
     "CheckpointError",
     "MergeError",
     "ImageError",
+    "PrintError",
 ]

@@ -108,17 +108,16 @@ impl Terminal {
         }
     }
 
-    /// Stops the render between chunks on Ctrl-C (a second Ctrl-C ends the process at once).
-    pub fn interruptible(mut self) -> anyhow::Result<Self> {
+    /// Stops the render between chunks on Ctrl-C, saying `message` (a second Ctrl-C ends the
+    /// process at once).
+    pub fn interruptible(mut self, message: &'static str) -> anyhow::Result<Self> {
         let interrupted = Arc::new(AtomicBool::new(false));
         let flag = interrupted.clone();
         ctrlc::set_handler(move || {
             if flag.swap(true, Ordering::SeqCst) {
                 std::process::exit(130);
             }
-            eprintln!(
-                "\ninterrupted: saving the samples finished so far (Ctrl-C again to quit now)"
-            );
+            eprintln!("{message}");
         })
         .map_err(|e| anyhow::anyhow!("installing the Ctrl-C handler: {e}"))?;
         self.interrupted = Some(interrupted);
@@ -144,6 +143,14 @@ impl Observer for Terminal {
         self.interrupted
             .as_ref()
             .is_some_and(|f| f.load(Ordering::SeqCst))
+    }
+
+    /// An interruptible terminal looks at Ctrl-C twice a second (a render's samples are the
+    /// same however they are chunked).
+    fn check_every(&self) -> Option<Duration> {
+        self.interrupted
+            .as_ref()
+            .map(|_| Duration::from_millis(500))
     }
 }
 

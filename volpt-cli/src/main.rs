@@ -7,6 +7,7 @@ mod compare;
 mod converge;
 mod info;
 mod plot;
+mod print;
 mod volume;
 
 use std::fmt::Write as _;
@@ -70,6 +71,9 @@ enum Command {
     /// Serve an interactive viewer as a web page: orbit, pan and zoom, progressive refinement,
     /// parameters, snapshots (open the printed URL; over SSH, `ssh -L PORT:localhost:PORT HOST`).
     View(ViewArgs),
+    /// Colour 3D printing: compensate a print's scattering (docs/printing.md).
+    #[command(subcommand)]
+    Print(print::PrintCommand),
     /// Plot a `volpt converge` run again from the converge.csv in DIR (SVG and PNG).
     Plot {
         dir: PathBuf,
@@ -461,6 +465,7 @@ fn run() -> Result<()> {
         }
         Command::Converge(args) => converge::run(&args),
         Command::Selftest { math } => selftest(math),
+        Command::Print(command) => print::run_command(command),
         Command::Plot { dir, title } => {
             let title = title.unwrap_or_else(|| export_name(&dir));
             converge::replot(&dir, &title)
@@ -565,7 +570,9 @@ fn render_command(args: RenderArgs) -> Result<()> {
                 resume: args.resume.clone(),
                 interval: std::time::Duration::from_secs_f64(args.checkpoint_interval),
             };
-            let terminal = Terminal::new(true).interruptible()?;
+            let terminal = Terminal::new(true).interruptible(
+                "\ninterrupted: saving the samples finished so far (Ctrl-C again to quit now)",
+            )?;
             let (film, rendered) =
                 volpt::render_checkpointed(&backend, &scene, &checkpointing, &terminal)?;
             terminal.finish();

@@ -27,6 +27,8 @@ const COMMANDS: &[&str] = &[
     "converge",
     "selftest",
     "plot",
+    "print compensate",
+    "print delta-e",
 ];
 
 fn root() -> PathBuf {

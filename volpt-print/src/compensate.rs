@@ -23,6 +23,19 @@
 //! loop stops. Each iteration's aims, prediction, per-texel CIEDE2000 map, mean and 95th
 //! percentile are kept; the result is the print of the iteration with the lowest mean.
 //!
+//! **Noise** (a rendered prediction is an estimate): each prediction's noise is measured as the
+//! mean, over texels, of the CIEDE2000 between the prediction and the prediction moved by one
+//! standard error per channel ([`Predictor::standard_error`]). The update moves the aims by
+//! `step` times the error, whose size in CIEDE2000 is about `step * mean`; a prediction whose
+//! noise is above [`Options::noise_ratio`] times that would let the noise steer the update. Such a
+//! prediction is made again with more samples ([`Predictor::more_samples`]: four times as many,
+//! half the noise) until its noise is below the bound or the predictor is at its most samples;
+//! later iterations keep the samples reached (the error the loop removes only shrinks). So the
+//! update follows the signal: its noise is at most `noise_ratio` of the step it takes.
+//!
+//! **Interruption**: a prediction cut short by its observer (Ctrl-C, [`Predictor::interrupted`])
+//! ends the loop with the iterations finished before it ([`Compensation::interrupted`]).
+//!
 //! The loop is written against [`Predictor`]: the real one renders the print with volpt (an
 //! orthographic top view, one pixel per surface texel).
 
@@ -41,6 +54,30 @@ pub trait Predictor {
     /// The linear RGB colour of each surface texel of `print`, seen from straight above under the
     /// predictor's illumination: `width * height` values, row-major.
     fn predict(&mut self, print: &VoxelPrint) -> Result<Vec<LinearRgb>, Self::Error>;
+
+    /// The last prediction's standard error per texel and channel, if the predictor estimates
+    /// it (an exact predictor has none: no noise to control).
+    fn standard_error(&self) -> Option<&[LinearRgb]> {
+        None
+    }
+
+    /// Makes later predictions with four times the samples; `false` (and no change) when the
+    /// predictor is at its most samples or has no samples to add.
+    fn more_samples(&mut self) -> bool {
+        false
+    }
+
+    /// The samples per texel the next prediction takes, if the predictor samples (for the
+    /// record).
+    fn samples(&self) -> Option<u32> {
+        None
+    }
+
+    /// Whether the last prediction was cut short by its observer (Ctrl-C): not a whole
+    /// prediction, so the loop ends without it.
+    fn interrupted(&self) -> bool {
+        false
+    }
 }
 
 /// The print the loop builds: its materials and voxel size, and the halftone of its inks.
@@ -64,6 +101,9 @@ pub struct Options {
     /// How often an iteration that does not improve halves the step and retries from the best
     /// iteration before the loop stops.
     pub backtracks: u32,
+    /// A prediction's noise (see the module docs) may be at most this fraction of the update's
+    /// step, `step * mean`; `None` takes every prediction as it comes.
+    pub noise_ratio: Option<f64>,
 }
 
 impl Default for Options {
@@ -73,6 +113,7 @@ impl Default for Options {
             step: 1.0,
             min_improvement: 1e-3,
             backtracks: 2,
+            noise_ratio: Some(0.25),
         }
     }
 }
@@ -88,6 +129,11 @@ pub struct Iteration {
     /// 95th percentile of `delta_e` ([`volpt::metrics::quantile`]: linear between order
     /// statistics, as NumPy's default).
     pub p95: f64,
+    /// The prediction's noise: the mean CIEDE2000 of one standard error (0 where the predictor
+    /// estimates none).
+    pub noise: f64,
+    /// The samples per texel the prediction took, if the predictor samples.
+    pub samples: Option<u32>,
 }
 
 /// The loop's record and its result.
@@ -97,6 +143,8 @@ pub struct Compensation {
     /// The iteration whose print is `print` (the lowest mean CIEDE2000).
     pub best: usize,
     pub print: VoxelPrint,
+    /// The loop was stopped by its predictor's observer (Ctrl-C) before it ended by itself.
+    pub interrupted: bool,
 }
 
 #[derive(Debug, Error)]
@@ -109,6 +157,8 @@ pub enum CompensateError<E: std::error::Error + 'static> {
         expected: String,
         found: String,
     },
+    #[error("interrupted before the first prediction finished")]
+    Interrupted,
 }
 
 /// The print whose surface texels aim for `aims` (`width` x `height`).
@@ -143,6 +193,82 @@ fn update(
         .collect()
 }
 
+/// The mean CIEDE2000 between each texel's prediction and the prediction moved by one standard
+/// error in every channel: how far the noise alone moves a texel's colour.
+pub fn noise(prediction: &[LinearRgb], standard_error: &[LinearRgb]) -> f64 {
+    if prediction.is_empty() {
+        return 0.0;
+    }
+    let sum: f64 = prediction
+        .iter()
+        .zip(standard_error)
+        .map(|(p, e)| {
+            let moved = LinearRgb([0, 1, 2].map(|c| p.0[c] + e.0[c]));
+            ciede2000(p.to_lab(), moved.to_lab())
+        })
+        .sum();
+    sum / prediction.len() as f64
+}
+
+/// One prediction of a print, made again with more samples while its noise would steer an update
+/// of `step` (see the module docs); `None` when the predictor was interrupted.
+struct Predicted {
+    prediction: Vec<LinearRgb>,
+    delta_e: Vec<f64>,
+    mean: f64,
+    noise: f64,
+    samples: Option<u32>,
+}
+
+fn predict<P: Predictor>(
+    predictor: &mut P,
+    print: &VoxelPrint,
+    target_lab: &[Lab],
+    step: f64,
+    options: &Options,
+) -> Result<Option<Predicted>, CompensateError<P::Error>> {
+    loop {
+        let prediction = predictor
+            .predict(print)
+            .map_err(CompensateError::Predictor)?;
+        if predictor.interrupted() {
+            return Ok(None);
+        }
+        let not_finite = prediction
+            .iter()
+            .filter(|c| !c.0.iter().all(|v| v.is_finite()))
+            .count();
+        if prediction.len() != target_lab.len() || not_finite > 0 {
+            return Err(CompensateError::Invalid {
+                field: "prediction",
+                expected: format!("{} finite colours", target_lab.len()),
+                found: format!("{} values, {not_finite} not finite", prediction.len()),
+            });
+        }
+        let delta_e: Vec<f64> = prediction
+            .iter()
+            .zip(target_lab)
+            .map(|(p, t)| ciede2000(p.to_lab(), *t))
+            .collect();
+        let mean = delta_e.iter().sum::<f64>() / delta_e.len() as f64;
+        let noise = predictor
+            .standard_error()
+            .map_or(0.0, |e| self::noise(&prediction, e));
+        let too_noisy = options
+            .noise_ratio
+            .is_some_and(|ratio| noise > ratio * step * mean);
+        if !(too_noisy && predictor.more_samples()) {
+            return Ok(Some(Predicted {
+                prediction,
+                delta_e,
+                mean,
+                noise,
+                samples: predictor.samples(),
+            }));
+        }
+    }
+}
+
 /// Runs the loop for a `target` image (linear RGB, `width` x `height`, row-major); `observe` sees
 /// each iteration as it ends (progress).
 pub fn compensate<P: Predictor>(
@@ -166,10 +292,11 @@ pub fn compensate<P: Predictor>(
             format!("{} values", target.len()),
         ));
     }
-    if !(options.step > 0.0 && options.step <= 1.0) || options.max_iterations == 0 {
+    let ratio_ok = options.noise_ratio.is_none_or(|r| r > 0.0);
+    if !(options.step > 0.0 && options.step <= 1.0) || options.max_iterations == 0 || !ratio_ok {
         return Err(invalid(
             "options",
-            "a step in (0, 1] and at least one iteration".into(),
+            "a step in (0, 1], at least one iteration and a noise ratio above 0".into(),
             format!("{options:?}"),
         ));
     }
@@ -182,35 +309,29 @@ pub fn compensate<P: Predictor>(
     let mut best: Option<(usize, VoxelPrint)> = None;
     let mut step = options.step;
     let mut backtracks = 0;
+    let mut interrupted = false;
     while iterations.len() < options.max_iterations {
         let print = print_for(setup, &aims, width, height)
             .map_err(|(field, expected, found)| invalid(field, expected, found))?;
-        let prediction = predictor
-            .predict(&print)
-            .map_err(CompensateError::Predictor)?;
-        let not_finite = prediction
-            .iter()
-            .filter(|c| !c.0.iter().all(|v| v.is_finite()))
-            .count();
-        if prediction.len() != texels || not_finite > 0 {
-            return Err(invalid(
-                "prediction",
-                format!("{texels} finite colours"),
-                format!("{} values, {not_finite} not finite", prediction.len()),
-            ));
-        }
-        let delta_e: Vec<f64> = prediction
-            .iter()
-            .zip(&target_lab)
-            .map(|(p, t)| ciede2000(p.to_lab(), *t))
-            .collect();
-        let mean = delta_e.iter().sum::<f64>() / texels as f64;
+        let Some(predicted) = predict(predictor, &print, &target_lab, step, options)? else {
+            interrupted = true;
+            break;
+        };
+        let Predicted {
+            prediction,
+            delta_e,
+            mean,
+            noise,
+            samples,
+        } = predicted;
         let iteration = Iteration {
             aims: std::mem::take(&mut aims),
             prediction,
             p95: quantile(&delta_e, 0.95),
             delta_e,
             mean,
+            noise,
+            samples,
         };
         observe(&iteration);
         let k = iterations.len();
@@ -230,10 +351,11 @@ pub fn compensate<P: Predictor>(
         let from = &iterations[best.as_ref().expect("set above").0];
         aims = update(&from.aims, target, &from.prediction, step);
     }
-    let (best, print) = best.expect("at least one iteration ran");
+    let (best, print) = best.ok_or(CompensateError::Interrupted)?;
     Ok(Compensation {
         iterations,
         best,
         print,
+        interrupted,
     })
 }

@@ -9,18 +9,23 @@
 //! - [`halftone`]: the printer's naive ink mix and its 3D ordered dithering into voxels.
 //! - [`compensate`]: the scattering compensation loop, against a [`compensate::Predictor`].
 //! - [`predict`]: the real predictor, a volpt render of the print from straight above.
+//! - [`target`]: a compensation's target image, read from a PNG.
+//! - [`record`]: a compensation's record (predictions, ΔE maps and plot, the slice stack).
+//! - [`job`]: a whole compensation as the front ends run it (CLI and Python).
 //! - [`error`]: what reading or writing a print can refuse ([`PrintError`]).
 
 pub mod colour;
 pub mod compensate;
 pub mod error;
 pub mod halftone;
+pub mod job;
 pub mod material;
 pub mod predict;
 pub mod print;
 pub mod record;
 pub mod slices;
+pub mod target;
 
 pub use error::PrintError;
-pub use material::{Inks, Material};
+pub use material::{Inks, Material, MaterialFile};
 pub use print::VoxelPrint;

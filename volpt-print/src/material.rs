@@ -92,3 +92,55 @@ impl Inks {
         [self.cyan, self.magenta, self.yellow, self.black, self.white]
     }
 }
+
+/// A material table file (`--materials M.toml`): `[[materials]]` as in a slice stack's
+/// `materials.toml`, and optionally the print's `voxel_size`. A stack's own `materials.toml` is
+/// one: its `width`, `height` and `layers` are taken and not used (a compensation's print has the
+/// target's size and the depth asked for).
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialFile {
+    pub voxel_size: Option<[f64; 3]>,
+    pub materials: Vec<Material>,
+    #[serde(default, rename = "width")]
+    _width: Option<u32>,
+    #[serde(default, rename = "height")]
+    _height: Option<u32>,
+    #[serde(default, rename = "layers")]
+    _layers: Option<u32>,
+}
+
+impl MaterialFile {
+    /// Reads and checks the table in `path` (every material's numbers, distinct palette colours).
+    pub fn read(path: &std::path::Path) -> Result<MaterialFile, crate::PrintError> {
+        let text = volpt_scene::limits::read_text(path)?;
+        let file: MaterialFile = toml::from_str(&text).map_err(|e| crate::PrintError::Toml {
+            path: path.to_path_buf(),
+            source: Box::new(e),
+        })?;
+        let invalid = |field: String, expected: &str, found: String| crate::PrintError::Invalid {
+            path: path.to_path_buf(),
+            field,
+            expected: expected.into(),
+            found,
+        };
+        for (k, m) in file.materials.iter().enumerate() {
+            if let Some((field, expected, found)) = m.problem() {
+                return Err(invalid(format!("materials[{k}].{field}"), expected, found));
+            }
+        }
+        crate::print::check_table(&file.materials)
+            .map_err(|(field, expected, found)| invalid(field.into(), &expected, found))?;
+        if let Some(size) = file
+            .voxel_size
+            .filter(|s| !s.iter().all(|v| v.is_finite() && *v > 0.0))
+        {
+            return Err(invalid(
+                "voxel_size".into(),
+                "three finite sizes > 0",
+                format!("{size:?}"),
+            ));
+        }
+        Ok(file)
+    }
+}

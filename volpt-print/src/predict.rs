@@ -27,9 +27,16 @@
 //! `|a - b| / 2` per channel (the mean of two equal-variance estimates has variance
 //! `E[(a - b)^2] / 4`), kept as [`RenderPredictor::standard_error`]: the update moves an aim by
 //! `step` times the prediction's error, so a standard error well below the error the loop is
-//! removing is what "enough samples" means.
+//! removing is what "enough samples" means: the loop asks for four times the samples
+//! ([`Predictor::more_samples`], up to [`RenderPredictor::max_spp`]) while a prediction's noise is
+//! above its bound ([`crate::compensate`]'s module docs).
+//!
+//! **Progress and interruption**: each render reports to the predictor's observer
+//! ([`RenderPredictor::with_observer`]), which may stop it (Ctrl-C); a prediction so stopped is
+//! not whole, and [`Predictor::interrupted`] says so.
 
 use std::path::Path;
+use std::sync::Arc;
 
 use thiserror::Error;
 use volpt::scene_files::material::{IndexedDesc, MaterialDesc};
@@ -38,7 +45,7 @@ use volpt::scene_files::{
     FovAxis, GridLookup, GridStorage, IntegratorDesc, MediumDesc, Projection, SceneBuilder,
     SceneDescription, SceneError,
 };
-use volpt::{Backend, Quiet, RenderRequest, RenderSettings, Scene};
+use volpt::{Backend, Observer, Quiet, RenderRequest, RenderSettings, Scene};
 
 use crate::colour::LinearRgb;
 use crate::compensate::Predictor;
@@ -52,16 +59,20 @@ pub enum PredictError {
 }
 
 /// Renders prints from above with volpt (see the module docs).
-pub struct RenderPredictor {
-    backend: Backend,
-    /// Samples per texel and channel.
+pub struct RenderPredictor<'b> {
+    backend: &'b Backend,
+    /// Samples per texel of the next prediction (one chromatic render: every channel).
     pub spp: u32,
+    /// The most samples per texel [`Predictor::more_samples`] raises `spp` to.
+    pub max_spp: u32,
     pub seed: u32,
     /// The resin's surface.
     pub boundary: BsdfDesc,
     /// The scene of the last print's geometry, whose grids the next prediction replaces.
     scene: Option<(Geometry, Scene)>,
     standard_error: Vec<LinearRgb>,
+    observer: Arc<dyn Observer + Send + Sync>,
+    interrupted: bool,
 }
 
 /// What fixes a prediction's scene apart from its voxels' indices.
@@ -71,16 +82,20 @@ struct Geometry {
     voxel_size: [f64; 3],
     materials: Vec<MaterialDesc>,
     boundary: BsdfDesc,
-    spp: u32,
 }
 
-impl RenderPredictor {
-    /// A predictor rendering on `backend` with `spp` samples per texel and channel, a smooth
-    /// dielectric surface of IOR 1.5 (the order of the photopolymer resins') in air.
-    pub fn new(backend: Backend, spp: u32) -> Self {
+impl<'b> RenderPredictor<'b> {
+    /// The most samples per texel a predictor takes unless told otherwise.
+    pub const MAX_SPP: u32 = 4096;
+
+    /// A predictor rendering on `backend` with `spp` samples per texel (at most
+    /// [`RenderPredictor::MAX_SPP`] when the loop asks for more), a smooth dielectric surface of
+    /// IOR 1.5 (the order of the photopolymer resins') in air.
+    pub fn new(backend: &'b Backend, spp: u32) -> Self {
         RenderPredictor {
             backend,
             spp,
+            max_spp: spp.max(Self::MAX_SPP),
             seed: 0,
             boundary: BsdfDesc::Dielectric {
                 int_ior: 1.5,
@@ -88,13 +103,21 @@ impl RenderPredictor {
             },
             scene: None,
             standard_error: Vec::new(),
+            observer: Arc::new(Quiet),
+            interrupted: false,
         }
     }
 
-    /// The last prediction's standard error per texel and channel, estimated from its two
-    /// independent halves (see the module docs).
-    pub fn standard_error(&self) -> &[LinearRgb] {
-        &self.standard_error
+    /// The same predictor, its renders reporting their progress to `observer`, which may stop
+    /// them (a stopped prediction is [`Predictor::interrupted`]).
+    pub fn with_observer(mut self, observer: Arc<dyn Observer + Send + Sync>) -> Self {
+        self.observer = observer;
+        self
+    }
+
+    /// The backend the predictor renders on.
+    pub fn backend(&self) -> &'b Backend {
+        self.backend
     }
 
     /// The scene a prediction of `print` renders (the module docs): to inspect it, export it
@@ -103,8 +126,83 @@ impl RenderPredictor {
         PrintScene {
             print,
             geometry: self.geometry(print),
+            spp: self.spp,
         }
         .build(&[])
+    }
+
+    /// The scene a prediction of `print` renders (as [`RenderPredictor::description`]) as a volpt
+    /// TOML scene whose volume is the slice stack in the folder `slices` (relative to the TOML
+    /// file): `volpt render` renders it, `volpt scene export` writes it for Mitsuba 3. Its image is
+    /// the top view as a camera sees it: the prediction's rows reversed (a prediction's row 0 is
+    /// texel row 0, a slice's top row; the camera's top row is the print's far edge, y at its
+    /// largest).
+    pub fn toml_scene(&self, print: &VoxelPrint, slices: &str) -> String {
+        let [w, h, d] = print.resolution();
+        let [sx, sy, sz] = print.voxel_size();
+        let size = [f64::from(w) * sx, f64::from(h) * sy, f64::from(d) * sz];
+        let mut t = String::new();
+        let mut line = |text: String| {
+            t.push_str(&text);
+            t.push('\n');
+        };
+        line("# A voxel print as volpt-print predicts it: its top view under white light, one pixel a".into());
+        line(
+            "# texel (docs/printing.md). `volpt render` renders it; `volpt scene export` writes it"
+                .into(),
+        );
+        line("# for Mitsuba 3.".into());
+        line("[volume]".into());
+        line(format!("file = {slices:?}"));
+        line("format = \"png\"".into());
+        line(format!(
+            "bounds = [[0.0, 0.0, 0.0], [{:?}, {:?}, {:?}]]",
+            size[0], size[1], size[2]
+        ));
+        for m in print.materials() {
+            line(String::new());
+            line("[[materials]]".into());
+            line(format!("name = {:?}", m.name));
+            line(format!("colour = {:?}", m.colour));
+            line(format!("sigma_s = {:?}", m.sigma_s));
+            line(format!("sigma_a = {:?}", m.sigma_a));
+            line(format!("g = {:?}", m.g));
+        }
+        line(String::new());
+        line("[boundary]".into());
+        match self.boundary {
+            BsdfDesc::Null => line("bsdf = \"null\"".into()),
+            BsdfDesc::Dielectric { int_ior, ext_ior } => line(format!(
+                "bsdf = \"dielectric\"\nint_ior = {int_ior:?}\next_ior = {ext_ior:?}"
+            )),
+            BsdfDesc::RoughDielectric {
+                alpha,
+                int_ior,
+                ext_ior,
+            } => line(format!(
+                "bsdf = \"roughdielectric\"\nalpha = {alpha:?}\nint_ior = {int_ior:?}\n\
+                 ext_ior = {ext_ior:?}"
+            )),
+        }
+        line(String::new());
+        line("[camera]".into());
+        line("projection = \"orthographic\"".into());
+        let centre = [0.5 * size[0], 0.5 * size[1]];
+        line(format!(
+            "origin = [{:?}, {:?}, {:?}]",
+            centre[0],
+            centre[1],
+            size[2] + sz
+        ));
+        line(format!("target = [{:?}, {:?}, 0.0]", centre[0], centre[1]));
+        line("up = [0.0, 1.0, 0.0]".into());
+        line(format!("extent = [{:?}, {:?}]", size[0], size[1]));
+        line(String::new());
+        line(format!("[film]\nwidth = {w}\nheight = {h}\n"));
+        line(format!("[sampler]\nspp = {}\n", self.spp.max(1)));
+        line("[integrator]\nmax_depth = -1\nrr_depth = 5\n".into());
+        line("[environment]\nradiance = 1.0".into());
+        t
     }
 
     fn geometry(&self, print: &VoxelPrint) -> Geometry {
@@ -113,7 +211,6 @@ impl RenderPredictor {
             voxel_size: print.voxel_size(),
             materials: print.materials().iter().map(MaterialDesc::from).collect(),
             boundary: self.boundary,
-            spp: self.spp,
         }
     }
 }
@@ -122,6 +219,7 @@ impl RenderPredictor {
 struct PrintScene<'a> {
     print: &'a VoxelPrint,
     geometry: Geometry,
+    spp: u32,
 }
 
 impl SceneBuilder for PrintScene<'_> {
@@ -170,7 +268,7 @@ impl SceneBuilder for PrintScene<'_> {
                 width: w,
                 height: h,
             },
-            spp: self.geometry.spp,
+            spp: self.spp,
             integrator: IntegratorDesc {
                 max_depth: None,
                 rr_depth: Some(5),
@@ -194,7 +292,7 @@ impl SceneBuilder for PrintScene<'_> {
     }
 }
 
-impl Predictor for RenderPredictor {
+impl Predictor for RenderPredictor<'_> {
     type Error = PredictError;
 
     fn predict(&mut self, print: &VoxelPrint) -> Result<Vec<LinearRgb>, PredictError> {
@@ -205,6 +303,7 @@ impl Predictor for RenderPredictor {
                 let builder = PrintScene {
                     print,
                     geometry: geometry.clone(),
+                    spp: self.spp.max(1),
                 };
                 self.scene = Some((
                     geometry.clone(),
@@ -217,13 +316,26 @@ impl Predictor for RenderPredictor {
         // Two independent halves (spp / 2 and the rest), averaged by their sample counts.
         let halves = [self.spp / 2, self.spp - self.spp / 2];
         let mut images = Vec::new();
+        // Stopped already (Ctrl-C while the loop halftoned): no render to start.
+        self.interrupted = self.observer.cancelled();
+        if self.interrupted {
+            self.standard_error.clear();
+            return Ok(Vec::new());
+        }
         for (k, &n) in halves.iter().enumerate() {
             if n == 0 {
                 continue;
             }
             let mut film = scene.film();
             let request = RenderRequest::samples(0..n).with_seed(self.seed.wrapping_add(k as u32));
-            self.backend.render(scene, &mut film, request, &Quiet)?;
+            let rendered = self
+                .backend
+                .render(scene, &mut film, request, &*self.observer)?;
+            if rendered.cancelled(&(0..n)) {
+                self.interrupted = true;
+                self.standard_error.clear();
+                return Ok(Vec::new());
+            }
             images.push((f64::from(n), film.image(n)));
         }
         let total: f64 = images.iter().map(|(n, _)| n).sum();
@@ -244,6 +356,26 @@ impl Predictor for RenderPredictor {
         }
         self.standard_error = errors;
         Ok(texels)
+    }
+
+    /// Estimated from the prediction's two independent halves (see the module docs).
+    fn standard_error(&self) -> Option<&[LinearRgb]> {
+        Some(&self.standard_error)
+    }
+
+    fn more_samples(&mut self) -> bool {
+        let more = self.spp.saturating_mul(4).min(self.max_spp);
+        let grew = more > self.spp;
+        self.spp = more;
+        grew
+    }
+
+    fn samples(&self) -> Option<u32> {
+        Some(self.spp)
+    }
+
+    fn interrupted(&self) -> bool {
+        self.interrupted
     }
 }
 

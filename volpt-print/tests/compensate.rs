@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{BlurModel, Rng};
+use common::{BlurModel, NoisyBlur, Rng};
 use volpt::metrics::quantile;
 use volpt_print::colour::{LinearRgb, Srgb};
 use volpt_print::compensate::{compensate, print_for, Options, Predictor, Setup};
@@ -60,6 +60,7 @@ fn a_reachable_target_is_reached() {
         step: 1.0,
         min_improvement: 0.0,
         backtracks: 2,
+        noise_ratio: None,
     };
     let result = compensate(&target, SIZE, &setup, &options, &mut model(), |_| {}).unwrap();
     let naive = result.iterations[0].mean;
@@ -109,6 +110,7 @@ fn the_error_falls_monotonically_on_a_blur_until_the_loop_stops() {
         step: 1.0,
         min_improvement: 1e-3,
         backtracks: 0,
+        noise_ratio: None,
     };
     let result = compensate(&target, SIZE, &setup, &options, &mut model(), |it| {
         seen.push(it.mean)
@@ -222,6 +224,92 @@ fn the_record_holds_every_iteration_and_the_best_prints_slices() {
                 .is_file());
         }
     }
+    for file in ["target.png", "prediction.png", "comparison.png"] {
+        assert!(dir.path().join(file).is_file(), "{file}");
+    }
+    let svg = std::fs::read_to_string(dir.path().join("delta_e.svg")).unwrap();
+    // One line per series (mean, 95th percentile, noise), a point per iteration each.
+    assert_eq!(svg.matches("<polyline").count(), 3, "{svg}");
+    assert_eq!(
+        svg.matches("<circle").count(),
+        3 * result.iterations.len() + 1
+    );
     let slices = volpt_print::slices::read_slices(&dir.path().join("slices")).unwrap();
     assert_eq!(slices, result.print);
+}
+
+/// The bars' compensation on the blur seen through render-like noise, from 1 sample per texel,
+/// with the noise control at `ratio` or without it: the result, and the predictor.
+fn noisy_run(ratio: Option<f64>) -> (volpt_print::compensate::Compensation, NoisyBlur) {
+    let setup = setup();
+    let print = print_for(&setup, &bars(), SIZE[0], SIZE[1]).unwrap();
+    let target = model().predict(&print).unwrap();
+    let mut noisy = NoisyBlur::new(model(), 0.25, 1, 1 << 14, 5);
+    let options = Options {
+        max_iterations: 8,
+        min_improvement: 0.0,
+        backtracks: 8,
+        noise_ratio: ratio,
+        ..Options::default()
+    };
+    let result = compensate(&target, SIZE, &setup, &options, &mut noisy, |_| {}).unwrap();
+    (result, noisy)
+}
+
+#[test]
+fn the_noise_control_keeps_every_prediction_s_noise_below_its_share_of_the_step() {
+    let ratio = 0.25;
+    let (result, noisy) = noisy_run(Some(ratio));
+    for (k, it) in result.iterations.iter().enumerate() {
+        eprintln!(
+            "iteration {k}: mean {:.3}, noise {:.4}, spp {:?}",
+            it.mean, it.noise, it.samples
+        );
+        // The step only halves from 1, so `mean` bounds `step * mean` from above.
+        assert!(
+            it.noise <= ratio * it.mean || it.samples == Some(noisy.max_spp),
+            "iteration {k}: noise {} above {ratio} x mean {}",
+            it.noise,
+            it.mean
+        );
+    }
+    // It asks for samples only as needed: the naive prediction at 1 sample is far above its
+    // bound, and the last quadrupling halved a noise that was above the bound, so the kept noise
+    // is not far below it. Later iterations keep the samples reached.
+    let first = &result.iterations[0];
+    assert!(first.samples > Some(1));
+    assert!(
+        first.noise > 0.4 * ratio * first.mean,
+        "noise {}, mean {}",
+        first.noise,
+        first.mean
+    );
+    let samples: Vec<_> = result.iterations.iter().map(|i| i.samples).collect();
+    assert!(samples.windows(2).all(|w| w[0] <= w[1]), "{samples:?}");
+}
+
+#[test]
+fn without_the_noise_control_the_noise_drives_the_update_and_with_it_the_print_is_better() {
+    let setup = setup();
+    let print = print_for(&setup, &bars(), SIZE[0], SIZE[1]).unwrap();
+    let target = model().predict(&print).unwrap();
+    let target_lab: Vec<_> = target.iter().map(|c| c.to_lab()).collect();
+    // Each run's kept print, predicted without noise.
+    let exact_mean = |result: &volpt_print::compensate::Compensation| {
+        let seen = model().predict(&result.print).unwrap();
+        seen.iter()
+            .zip(&target_lab)
+            .map(|(p, t)| volpt_print::colour::ciede2000(p.to_lab(), *t))
+            .sum::<f64>()
+            / seen.len() as f64
+    };
+    let (controlled, with) = noisy_run(Some(0.25));
+    let (free, without) = noisy_run(None);
+    let [c, f] = [&controlled, &free].map(exact_mean);
+    eprintln!(
+        "exact mean dE00 of the kept print: controlled {c:.3} ({} samples per texel spent), \
+         uncontrolled {f:.3} ({})",
+        with.spent, without.spent
+    );
+    assert!(c < 0.5 * f, "controlled {c}, uncontrolled {f}");
 }

@@ -44,7 +44,8 @@ fn an_absorbing_print_transmits_exp_minus_sigma_a_thickness_per_texel_and_channe
     // distribution, reweighted per channel): each texel's standard error is measured from
     // independent batches.
     let (spp, batches) = (128, 32);
-    let mut predictor = RenderPredictor::new(Backend::cpu(), spp);
+    let backend = Backend::cpu();
+    let mut predictor = RenderPredictor::new(&backend, spp);
     predictor.boundary = BsdfDesc::Null;
     let mut runs = Vec::new();
     let mut halves_square = 0.0;
@@ -60,6 +61,7 @@ fn an_absorbing_print_transmits_exp_minus_sigma_a_thickness_per_texel_and_channe
         );
         halves_square += predictor
             .standard_error()
+            .unwrap()
             .iter()
             .flat_map(|e| e.0.map(|v| v * v))
             .sum::<f64>();
@@ -119,9 +121,11 @@ fn the_loop_runs_on_rendered_predictions_and_keeps_its_best() {
             volpt_print::colour::Srgb::from_u8(v).to_linear()
         })
         .collect();
-    let mut predictor = RenderPredictor::new(Backend::cpu(), 64);
+    let backend = Backend::cpu();
+    let mut predictor = RenderPredictor::new(&backend, 64);
     let options = Options {
         max_iterations: 3,
+        noise_ratio: None,
         ..Options::default()
     };
     let result = compensate(&target, [w, h], &setup, &options, &mut predictor, |_| {}).unwrap();
@@ -171,9 +175,11 @@ fn compensation_lowers_the_error_of_rendered_predictions() {
             volpt_print::colour::Srgb::from_u8(v).to_linear()
         })
         .collect();
-    let mut predictor = RenderPredictor::new(Backend::cpu(), 128);
+    let backend = Backend::cpu();
+    let mut predictor = RenderPredictor::new(&backend, 128);
     let options = Options {
         max_iterations: 4,
+        noise_ratio: None,
         ..Options::default()
     };
     let result = compensate(&target, [w, h], &setup, &options, &mut predictor, |_| {}).unwrap();
@@ -283,7 +289,8 @@ fn the_chromatic_prediction_equals_the_grey_renders_of_its_channels_in_expectati
     let indices = (0..w * h * d).map(|_| rng.below(5) as u8).collect();
     let print = VoxelPrint::new(materials, [0.1, 0.1, 0.05], [w, h, d], indices).unwrap();
     let (spp, batches) = (32, 96);
-    let mut predictor = RenderPredictor::new(Backend::cpu(), spp);
+    let backend = Backend::cpu();
+    let mut predictor = RenderPredictor::new(&backend, spp);
     let chromatic: Vec<Vec<[f64; 3]>> = (0..batches)
         .map(|k| {
             predictor.seed = 2 * k;
@@ -342,4 +349,60 @@ fn the_chromatic_prediction_equals_the_grey_renders_of_its_channels_in_expectati
     // And the channels differ from each other: the test sees a channel mix-up.
     let spread: f64 = a.iter().map(|t| (t[0].0 - t[2].0).abs()).sum::<f64>() / a.len() as f64;
     assert!(spread > 0.02, "channels too alike to tell apart: {spread}");
+}
+
+/// The record's TOML scene of a print (its slice stack beside it) loads to the scene the
+/// predictor renders: the same film, samples, surface, box, material table and voxels, and an
+/// orthographic camera of the same frame (to f32 rounding: one is built from a lookat and an
+/// extent, the other directly).
+#[test]
+fn a_record_s_toml_scene_is_the_scene_the_predictor_renders() {
+    let materials = common::inks();
+    let [w, h, d] = [7u32, 5, 4];
+    let indices: Vec<u8> = (0..w * h * d)
+        .map(|i| ((i * 7 + i / 3) % 5) as u8)
+        .collect();
+    let print = VoxelPrint::new(materials, [0.05, 0.04, 0.03], [w, h, d], indices).unwrap();
+    let backend = Backend::cpu();
+    let mut predictor = RenderPredictor::new(&backend, 24);
+    predictor.boundary = BsdfDesc::Dielectric {
+        int_ior: 1.45,
+        ext_ior: 1.0,
+    };
+    let dir = tempfile::tempdir().unwrap();
+    volpt_print::slices::write_slices(&print, &dir.path().join("stack")).unwrap();
+    let toml = dir.path().join("print.toml");
+    std::fs::write(&toml, predictor.toml_scene(&print, "stack")).unwrap();
+    let loaded = volpt::scene_files::SceneAssembler::new(Default::default())
+        .assemble(volpt::scene_files::builder_for(&toml).unwrap().as_ref())
+        .unwrap();
+    let built = predictor.description(&print).unwrap();
+    assert_eq!((loaded.film.width, loaded.film.height), (w, h));
+    assert_eq!(loaded.spp, built.spp);
+    assert_eq!(loaded.boundary, built.boundary);
+    assert_eq!(loaded.integrator, built.integrator);
+    assert_eq!(loaded.environment, built.environment);
+    let indexed = |desc: &volpt::SceneDescription| match &desc.medium.density {
+        volpt::scene_files::DensityDesc::Indexed(v) => v.clone(),
+        _ => panic!("a material-indexed medium"),
+    };
+    let (a, b) = (indexed(&loaded), indexed(&built));
+    assert_eq!(a.materials(), b.materials());
+    assert_eq!((a.resolution, a.bounds), (b.resolution, b.bounds));
+    assert_eq!(a.packed_indices(), b.packed_indices());
+    assert_eq!(loaded.camera.projection, built.camera.projection);
+    for (r, (x, y)) in loaded
+        .camera
+        .to_world
+        .iter()
+        .zip(&built.camera.to_world)
+        .enumerate()
+    {
+        for k in 0..4 {
+            assert!(
+                (x[k] - y[k]).abs() <= 1e-6 * y[k].abs().max(1.0),
+                "row {r}: TOML {x:?}, predictor {y:?}"
+            );
+        }
+    }
 }

@@ -148,12 +148,34 @@ pub struct CameraSpec {
     pub target: [f32; 3],
     #[serde(default = "y_up")]
     pub up: [f32; 3],
-    /// Full field of view in degrees along `fov_axis`.
-    #[serde(default = "thesis_fov")]
-    pub fov: f32,
+    /// Full field of view in degrees along `fov_axis` (perspective; default 0.7).
+    pub fov: Option<f32>,
     /// `x` (default), `y`, `smaller`, `larger` or `diagonal`, as in Mitsuba.
     #[serde(default)]
     pub fov_axis: FovAxisName,
+    /// `perspective` (default) or `orthographic` (Mitsuba 3's sensors).
+    #[serde(default)]
+    pub projection: ProjectionName,
+    /// Orthographic: the film's size in world units, `width` or `[width, height]` (the height
+    /// defaults to the width times the film's aspect, height / width).
+    pub extent: Option<OneOrTwo>,
+}
+
+/// `camera.projection`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ProjectionName {
+    #[default]
+    Perspective,
+    Orthographic,
+}
+
+/// One number or two.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(untagged)]
+pub enum OneOrTwo {
+    One(f64),
+    Two([f64; 2]),
 }
 
 impl Default for CameraSpec {
@@ -162,8 +184,10 @@ impl Default for CameraSpec {
             origin: thesis_origin(),
             target: [0.0; 3],
             up: y_up(),
-            fov: thesis_fov(),
+            fov: None,
             fov_axis: FovAxisName::default(),
+            projection: ProjectionName::default(),
+            extent: None,
         }
     }
 }
@@ -584,10 +608,8 @@ fn finish(
         FovAxisName::Larger => FovAxis::Larger,
         FovAxisName::Diagonal => FovAxis::Diagonal,
     };
-    if !(c.fov > 0.0 && c.fov < 180.0) {
-        return Err(cx.invalid("camera.fov", "degrees in (0, 180)", c.fov));
-    }
-    let to_world = look_at(c.origin, c.target, c.up).ok_or_else(|| {
+    let fov = c.fov.unwrap_or_else(thesis_fov);
+    let mut to_world = look_at(c.origin, c.target, c.up).ok_or_else(|| {
         cx.invalid(
             "camera",
             "an origin apart from the target and an up vector not along the view",
@@ -604,6 +626,58 @@ fn finish(
             format!("{}x{}", file.film.width, file.film.height),
         ));
     }
+    let projection = match c.projection {
+        ProjectionName::Perspective => {
+            if c.extent.is_some() {
+                return Err(cx.invalid(
+                    "camera.extent",
+                    "no extent on a perspective camera (its field of view is `fov`)",
+                    "an extent",
+                ));
+            }
+            if !(fov > 0.0 && fov < 180.0) {
+                return Err(cx.invalid("camera.fov", "degrees in (0, 180)", fov));
+            }
+            Projection::Perspective
+        }
+        ProjectionName::Orthographic => {
+            if let Some(fov) = c.fov {
+                return Err(cx.invalid(
+                    "camera.fov",
+                    "no field of view on an orthographic camera (its film's size is `extent`)",
+                    fov,
+                ));
+            }
+            // Mitsuba 3's orthographic film spans camera-space x in [-1, 1] and y in
+            // [-h/w, h/w], scaled by the frame: half the width on x, and on y half the height
+            // times w/h.
+            let aspect = f64::from(file.film.width) / f64::from(file.film.height);
+            let [w, h] = match c.extent {
+                Some(OneOrTwo::One(w)) => [w, w / aspect],
+                Some(OneOrTwo::Two(size)) => size,
+                None => {
+                    return Err(cx.invalid(
+                        "camera.extent",
+                        "the film's size in world units on an orthographic camera",
+                        "none",
+                    ))
+                }
+            };
+            if !(w.is_finite() && h.is_finite() && w > 0.0 && h > 0.0) {
+                return Err(cx.invalid(
+                    "camera.extent",
+                    "a width and height above 0",
+                    format!("{w}, {h}"),
+                ));
+            }
+            let scale = [0.5 * w, 0.5 * h * aspect];
+            for row in to_world.iter_mut().take(3) {
+                row[0] = (f64::from(row[0]) * scale[0]) as f32;
+                row[1] = (f64::from(row[1]) * scale[1]) as f32;
+            }
+            Projection::Orthographic
+        }
+    };
     let depth = |d: i64, field: &str| match d {
         -1 => Ok(None),
         d if d >= 0 && d <= u32::MAX as i64 => Ok(Some(d as u32)),
@@ -613,9 +687,9 @@ fn finish(
     Ok(SceneDescription {
         camera: CameraDesc {
             to_world,
-            fov_degrees: c.fov,
+            fov_degrees: fov,
             fov_axis,
-            projection: Projection::Perspective,
+            projection,
         },
         film: FilmDesc {
             width: file.film.width,

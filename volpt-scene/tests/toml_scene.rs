@@ -198,3 +198,81 @@ fn camera_frame_is_mitsubas_lookat() {
     let to_world = load(&path, Config::default()).unwrap().camera.to_world;
     assert_lookat_frame(&to_world, origin, target, up);
 }
+
+/// An orthographic TOML camera is Mitsuba 3's `orthographic` sensor whose frame is the lookat
+/// scaled by half the extent (x) and by half the extent's height times the film's aspect (y):
+/// the same frame as the Mitsuba XML spelling it so, for both spellings of `extent`.
+#[test]
+fn an_orthographic_camera_is_mitsubas_sensor_scaled_to_its_extent() {
+    let camera = |extent: &str| {
+        format!(
+            "[camera]\nprojection = \"orthographic\"\norigin = [0.5, 1.0, 9.0]\n\
+             target = [0.5, 1.0, 0.0]\nup = [0.0, 1.0, 0.0]\nextent = {extent}\n\
+             [film]\nwidth = 40\nheight = 20\n"
+        )
+    };
+    let dir = tempfile::tempdir().unwrap();
+    // Film 40 x 20 (aspect 2): extent [3, 1.2] scales x by 1.5 and y by 0.6 x 2 = 1.2; extent 3
+    // alone has height 1.5, y scaled by 1.5.
+    for (extent, [sx, sy]) in [("[3.0, 1.2]", [1.5, 1.2]), ("3.0", [1.5, 1.5])] {
+        let (_d, path) = scene(&camera(extent));
+        let toml = load(&path, Config::default()).unwrap();
+        assert_eq!(
+            toml.camera.projection,
+            volpt_scene::Projection::Orthographic
+        );
+        let xml = write(
+            dir.path(),
+            "ortho.xml",
+            &format!(
+                r#"<scene version="3.0.0"><sensor type="orthographic">
+                <transform name="to_world"><scale x="{sx}" y="{sy}"/>
+                <lookat origin="0.5, 1, 9" target="0.5, 1, 0" up="0, 1, 0"/></transform>
+                <film type="hdrfilm"><integer name="width" value="40"/><integer name="height" value="20"/></film>
+                </sensor><shape type="cube"><bsdf type="null"/><medium type="homogeneous" name="interior"/></shape></scene>"#
+            ),
+        );
+        let mitsuba = volpt_scene::load_mitsuba(&xml).unwrap();
+        for (r, (a, b)) in toml
+            .camera
+            .to_world
+            .iter()
+            .zip(&mitsuba.camera.to_world)
+            .enumerate()
+        {
+            for k in 0..4 {
+                assert!(
+                    (a[k] - b[k]).abs() < 1e-6,
+                    "extent {extent}: row {r}: TOML {a:?}, Mitsuba {b:?}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn an_orthographic_camera_needs_an_extent_and_takes_no_field_of_view() {
+    let ortho = "[camera]\nprojection = \"orthographic\"\n";
+    for (extra, expected) in [
+        (ortho.to_string(), "camera.extent: expected the film's size"),
+        (
+            format!("{ortho}extent = 2.0\nfov = 30.0\n"),
+            "camera.fov: expected no field of view on an orthographic camera",
+        ),
+        (
+            format!("{ortho}extent = [2.0, -1.0]\n"),
+            "camera.extent: expected a width and height above 0",
+        ),
+        (
+            "[camera]\nextent = 2.0\n".to_owned(),
+            "camera.extent: expected no extent on a perspective camera",
+        ),
+        (
+            "[camera]\nprojection = \"fisheye\"\n".to_owned(),
+            "projection",
+        ),
+    ] {
+        let e = error(&extra);
+        assert!(e.contains(expected), "{extra:?}: {e}");
+    }
+}

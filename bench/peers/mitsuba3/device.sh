@@ -5,6 +5,9 @@
 #
 #   bash bench/peers/mitsuba3/device.sh            # GPU (cuda_ad_rgb vs volpt --backend cuda), then CPU
 #   MODE=gpu bash bench/peers/mitsuba3/device.sh   # only the GPU rows; MODE=cpu only the CPU rows
+#   MODE=print bash bench/peers/mitsuba3/device.sh # issue 40: compensated prints against naive ones,
+#                                                  # rendered by Mitsuba 3 (bundle/print.sh's records;
+#                                                  # it runs first if they are missing), print.py
 #
 # Settings: GPU_RES/GPU_SPP (default 400/100, the thesis settings), CPU_RES/CPU_SPP (default 100/64:
 # Mitsuba's LLVM backend is slow on these dense scenes), SCENES (names, default the seven grey
@@ -114,6 +117,20 @@ compare() { # label backend res spp machine
     done
     return $failures
 }
+
+if [ "$MODE" = print ]; then
+    RECORDS=$RES_DIR/print
+    if [ ! -f "$RECORDS/lines/print.toml" ]; then
+        OUT=$RECORDS bash bundle/print.sh >"$RES_DIR/print-sh.log" 2>&1
+        log "bundle/print.sh: $(tail -n 1 "$RECORDS/summary.txt" 2>/dev/null)"
+    fi
+    "$PY" bench/peers/mitsuba3/print.py --volpt "$VOLPT" --spp "${PRINT_SPP:-256}" --fine lines \
+        "$RECORDS/lines" "$RECORDS/photo" "$RECORDS/gradient" 2>"$RES_DIR/print-mitsuba.log" \
+        | tee -a "$RES_DIR/device-summary.txt"
+    status=${PIPESTATUS[0]}
+    log "print: $([ "$status" = 0 ] && echo PASS || echo "FAIL (status $status; $RES_DIR/print-mitsuba.log)")"
+    exit "$status"
+fi
 
 failures=0
 if [ "$MODE" = all ] || [ "$MODE" = gpu ]; then

@@ -107,3 +107,67 @@ impl Predictor for BlurModel {
         Ok(blurred.into_iter().map(LinearRgb).collect())
     }
 }
+
+/// [`BlurModel`] seen through noise, as a render with `spp` samples is: every texel and channel
+/// gets Gaussian noise of standard deviation `sigma_1 / sqrt(spp)` (Box-Muller on a seeded
+/// generator), which it reports as its standard error; [`Predictor::more_samples`] quadruples
+/// `spp` up to `max_spp`. Counts the samples it has spent per texel.
+pub struct NoisyBlur {
+    pub model: BlurModel,
+    pub sigma_1: f64,
+    pub spp: u32,
+    pub max_spp: u32,
+    pub rng: Rng,
+    pub spent: u64,
+    error: Vec<LinearRgb>,
+}
+
+impl NoisyBlur {
+    pub fn new(model: BlurModel, sigma_1: f64, spp: u32, max_spp: u32, seed: u64) -> Self {
+        NoisyBlur {
+            model,
+            sigma_1,
+            spp,
+            max_spp,
+            rng: Rng(seed),
+            spent: 0,
+            error: Vec::new(),
+        }
+    }
+}
+
+impl Predictor for NoisyBlur {
+    type Error = std::convert::Infallible;
+
+    fn predict(&mut self, print: &VoxelPrint) -> Result<Vec<LinearRgb>, Self::Error> {
+        let exact = self.model.predict(print)?;
+        let sigma = self.sigma_1 / f64::from(self.spp).sqrt();
+        self.spent += u64::from(self.spp);
+        self.error = vec![LinearRgb([sigma; 3]); exact.len()];
+        let rng = &mut self.rng;
+        Ok(exact
+            .into_iter()
+            .map(|c| {
+                LinearRgb(c.0.map(|v| {
+                    let (u, w) = (1.0 - rng.unit(), rng.unit());
+                    v + sigma * (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * w).cos()
+                }))
+            })
+            .collect())
+    }
+
+    fn standard_error(&self) -> Option<&[LinearRgb]> {
+        Some(&self.error)
+    }
+
+    fn more_samples(&mut self) -> bool {
+        let more = (4 * self.spp).min(self.max_spp);
+        let grew = more > self.spp;
+        self.spp = more;
+        grew
+    }
+
+    fn samples(&self) -> Option<u32> {
+        Some(self.spp)
+    }
+}
