@@ -1,11 +1,15 @@
 """The viewer in a real browser: Debian's chromium, headless, driven by Playwright.
 
 Usage: browser_test.py URL SCREENSHOT.png
+       browser_test.py --materials URL
 
 Opens the page, waits for a converged image and checks that it is not blank, drags the mouse
 across the canvas and checks that the image changed (a new epoch, still, converged), raises the
-exposure and checks that the image got brighter, and saves a screenshot of the page. Exits
-non-zero, saying why, on any failure. Runs against a server on loopback only.
+exposure and checks that the image got brighter, and saves a screenshot of the page. With
+`--materials` (a material-indexed scene of two materials, "cyan" then "white"): checks that the
+panel lists both with their coefficients, then sets cyan's red absorption in its field and checks
+that the server took it (the frame's parameters) and that the image changed. Exits non-zero,
+saying why, on any failure. Runs against a server on loopback only.
 """
 
 import sys
@@ -54,7 +58,46 @@ def converged(extra="true"):
             f"&& v.header.width === v.hello.width && ({extra})")
 
 
+def materials(url):
+    """One edit of a material's coefficient through the panel."""
+    started = time.monotonic()
+    errors = []
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path="/usr/bin/chromium", args=ARGS)
+        page = browser.new_page(viewport={"width": 1000, "height": 640})
+        page.on("pageerror", lambda e: errors.append(str(e)))
+        page.goto(url)
+        wait_for(page, converged("v.header.params.materials.length === 2"), "a converged frame of two materials")
+        if page.locator("#materials-box").is_hidden():
+            sys.exit("browser test: the materials panel is hidden")
+        legends = page.locator("#materials legend").all_inner_texts()
+        if legends != ["cyan", "white"]:
+            sys.exit(f"browser test: the panel lists {legends}, expected cyan and white")
+        shown = page.input_value("#mat0-sigma_a0")
+        if float(shown) != 6.0:
+            sys.exit(f"browser test: cyan's red absorption shows {shown}, expected 6")
+        before = page.evaluate(SAMPLE)
+        epoch = page.evaluate("() => window.volptView.header.epoch")
+        page.fill("#mat0-sigma_a0", "0.5")
+        page.dispatch_event("#mat0-sigma_a0", "change")
+        wait_for(page, converged(f"v.header.epoch > {epoch} && v.header.params.materials[0].sigma_a[0] === 0.5"),
+                 "a converged frame with cyan's red absorption 0.5")
+        after = page.evaluate(SAMPLE)
+        changed = difference(before, after)
+        print(f"after cyan's red absorption 6 -> 0.5: mean {stats(before)[0]:.1f} -> {stats(after)[0]:.1f}, "
+              f"mean block change {changed:.1f}")
+        if changed < 1.0:
+            sys.exit(f"browser test: the material edit did not change the image (change {changed:.2f})")
+        browser.close()
+    if errors:
+        sys.exit(f"browser test: the page raised {errors}")
+    print(f"browser test (materials): passed in {time.monotonic() - started:.1f} s")
+
+
 def main():
+    if sys.argv[1] == "--materials":
+        materials(sys.argv[2])
+        return
     url, screenshot = sys.argv[1], sys.argv[2]
     started = time.monotonic()
     errors = []

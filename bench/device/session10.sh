@@ -5,7 +5,9 @@
 #   bash dev/session10.sh checks    # main's final binary: every strategy and fast math against the
 #                                   # CPU (short form), orthographic, materials, chromatic, and the
 #                                   # helpers' device scripts named in EXTRA (lights, mesh, materials,
-#                                   # print); keeps the binary in /tmp/session10 for the next call
+#                                   # print); keeps the binary in /tmp/session10 for the next call,
+#                                   # and a call without bin/volpt uses the kept one
+#                                   # (CHECKS=none EXTRA="mesh.sh ..." runs the helpers' scripts only)
 #   bash dev/session10.sh ab        # bin/volpt-before against the kept binary: AB picks ab-bin
 #                                   # (grey box scenes, regeneration-sk and the defaults) and
 #                                   # sparse-table (exact checks, tiles, the bricked and sparse A/B)
@@ -36,7 +38,8 @@ part() { # part NAME LIMIT_S CMD...: CMD with OUT=$OUT/NAME under a time limit
 echo "== $(date -u +%Y-%m-%dT%H:%MZ) $(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader | head -n 1)" | tee "$summary"
 case $mode in
 checks)
-    cp bin/volpt "$KEEP/volpt"
+    # A call without a binary uses the one an earlier call kept.
+    if [ -f bin/volpt ]; then cp bin/volpt "$KEEP/volpt"; else mkdir -p bin && cp "$KEEP/volpt" bin/volpt; fi
     for check in ${CHECKS:-strategies orthographic materials chromatic}; do
         case $check in
         strategies) part strategies 130 env TRIALS=3 T=30 PROBE_T=15 \

@@ -36,7 +36,7 @@ def write_png(path: Path, width: int, height: int, rgb) -> Path:
 
 
 def bars(x: int, y: int):
-    return (200, 40, 40) if (x // 2) % 2 == 0 else (40, 60, 200 - 10 * y)
+    return (200, 40, 40) if (x // 2) % 2 == 0 else (40, 60, 200 - 3 * (y % 60))
 
 
 def test_the_record_equals_the_command_line_s(tmp_path, volpt_bin):
@@ -53,7 +53,7 @@ def test_the_record_equals_the_command_line_s(tmp_path, volpt_bin):
     its = result["iterations"]
     assert result["size"] == (10, 8) and 1 <= len(its) <= 3
     assert [k for k, _ in seen] == list(range(len(its))) and [it for _, it in seen] == its
-    assert all(it["mean"] > 0 and it["p95"] >= it["mean"] * 0 and it["spp"] >= 4 for it in its)
+    assert all(it["mean"] > 0 and it["p95"] >= 0 and it["spp"] >= 4 for it in its)
     assert its[result["best"]]["mean"] == min(it["mean"] for it in its)
     py, cli = tmp_path / "py", tmp_path / "cli"
     files = sorted(p.relative_to(cli) for p in cli.rglob("*") if p.is_file())

@@ -59,6 +59,7 @@ pub fn cube_scene(
                 max: [0.5; 3],
             },
             bsdf,
+            mesh: None,
         },
         medium,
         environment: EnvironmentDesc::Constant([env; 3]),

@@ -312,6 +312,29 @@ fn chromatic_extinction_comes_back_under_volpathmis() {
     assert_eq!(loaded.medium.albedo, desc.medium.albedo);
 }
 
+/// A density per channel (a three-channel `sigma_t` grid) comes back exactly, under
+/// `volpathmis`, and with nearest lookups its grids are written and read back `nearest`.
+#[test]
+fn a_density_per_channel_comes_back_with_its_filter() {
+    let bounds = Bounds {
+        min: [-0.5; 3],
+        max: [0.5; 3],
+    };
+    let mut medium = homogeneous(1.0, 0.8, PhaseDesc::Isotropic);
+    medium.density = DensityDesc::Grid(grid([4, 3, 5], 3, bounds, GridConvention::Cell));
+    medium.scale = 7.0;
+    let desc = cube_scene(8, 8, medium, BsdfDesc::Null, 1.0);
+    for lookup in [GridLookup::Trilinear, GridLookup::Nearest] {
+        let mut desc = desc.clone();
+        desc.medium.lookup = lookup;
+        let dir = tempfile::tempdir().expect("temp dir");
+        let loaded = export_and_load(&desc, dir.path());
+        let xml = std::fs::read_to_string(dir.path().join("exported.xml")).unwrap();
+        assert!(xml.contains("<integrator type=\"volpathmis\">"), "{xml}");
+        assert_eq!(loaded.medium, as_written(&desc).medium, "{lookup:?}");
+    }
+}
+
 /// A material-indexed volume, which Mitsuba 3 cannot read as a table, is written as its table
 /// expanded per voxel: RGB `gridvolume`s of the extinction (times `scale`) and the albedo, read
 /// `nearest`, cell-centred over the volume's box, under `volpathmis`; each voxel's values are its

@@ -68,6 +68,7 @@ fn scene(
         boundary: BoundaryDesc {
             bounds: unit_cube(),
             bsdf: BsdfDesc::Null,
+            mesh: None,
         },
         medium,
         environment,

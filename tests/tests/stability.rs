@@ -450,6 +450,7 @@ fn rays_through_edges_corners_faces_and_from_the_boundary() {
             boundary: BoundaryDesc {
                 bounds: unit_bounds(),
                 bsdf: rough(0.1, 1.05, 1.01),
+                mesh: None,
             },
             ..furnace
         };

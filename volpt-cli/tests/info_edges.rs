@@ -67,6 +67,7 @@ fn scene(g: f32, last: f32, last_green: f32, int_ior: f32) -> SceneDescription {
                 int_ior,
                 ext_ior: 1.2,
             },
+            mesh: None,
         },
         medium: MediumDesc {
             density: DensityDesc::Grid(grid([3, 2, 4], &[2.0], &[last])),

@@ -393,6 +393,10 @@ pub trait SceneAbi: Scene + Sized {
     fn names() -> [&'static str; 4];
     fn to_params(&self, upload: &mut Upload<'_>) -> Self::Params;
 
+    /// Whether the kernels can render this scene: not one whose boundary is a mesh, which its
+    /// parameters would carry as its bounding box.
+    fn on_device(&self) -> bool;
+
     /// The device side of [`SceneAbi::to_params`].
     ///
     /// # Safety
@@ -400,9 +404,49 @@ pub trait SceneAbi: Scene + Sized {
     unsafe fn from_params(p: &Self::Params) -> Self;
 }
 
-impl<M, B, P, E> SceneAbi for VolumeScene<M, B, P, E>
+/// A boundary shape as the kernels receive it: today every kernel's scene is a box scene
+/// (`SceneParams::bounds_min`/`bounds_max`), so a shape travels as its box, and only a box
+/// shape can ([`DeviceShape::on_device`]).
+pub trait DeviceShape: Sized {
+    /// Whether the kernels trace this shape: a mesh is not (yet) a kernel's boundary.
+    fn on_device(&self) -> bool;
+    /// The box the kernels receive.
+    fn device_box(&self) -> Aabb;
+    /// The shape a kernel rebuilds from its box.
+    fn from_device_box(b: Aabb) -> Self;
+}
+
+impl DeviceShape for Aabb {
+    #[inline(always)]
+    fn on_device(&self) -> bool {
+        true
+    }
+    #[inline(always)]
+    fn device_box(&self) -> Aabb {
+        *self
+    }
+    #[inline(always)]
+    fn from_device_box(b: Aabb) -> Self {
+        b
+    }
+}
+
+impl DeviceShape for crate::shape::BoundaryShape<'_> {
+    fn on_device(&self) -> bool {
+        matches!(self, crate::shape::BoundaryShape::Box(_))
+    }
+    fn device_box(&self) -> Aabb {
+        crate::shape::Shape::bounds(self)
+    }
+    fn from_device_box(b: Aabb) -> Self {
+        crate::shape::BoundaryShape::Box(b)
+    }
+}
+
+impl<M, B, P, E, S> SceneAbi for VolumeScene<M, B, P, E, S>
 where
     Self: Scene,
+    S: DeviceShape,
     M: Component,
     B: Component,
     P: Component,
@@ -414,13 +458,17 @@ where
         [M::NAME, B::NAME, P::NAME, E::NAME]
     }
 
+    fn on_device(&self) -> bool {
+        self.bounds.on_device()
+    }
+
     fn to_params(&self, upload: &mut Upload<'_>) -> Self::Params {
         #[allow(clippy::let_unit_value)]
         let () = Self::Params::LAYOUT;
         SceneParams {
             camera: CameraParams::from(&self.camera),
-            bounds_min: self.bounds.min.to_array(),
-            bounds_max: self.bounds.max.to_array(),
+            bounds_min: self.bounds.device_box().min.to_array(),
+            bounds_max: self.bounds.device_box().max.to_array(),
             settings: SettingsParams::from(&self.settings),
             lights: LightsParams::from(&self.lights),
             medium: self.medium.to_params(upload),
@@ -436,10 +484,10 @@ where
         unsafe {
             Self {
                 camera: PerspectiveCamera::from(&p.camera),
-                bounds: Aabb::new(
+                bounds: S::from_device_box(Aabb::new(
                     Vec3::from_array(p.bounds_min),
                     Vec3::from_array(p.bounds_max),
-                ),
+                )),
                 medium: M::from_params(&p.medium),
                 boundary: B::from_params(&p.boundary),
                 phase: P::from_params(&p.phase),

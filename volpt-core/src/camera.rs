@@ -33,9 +33,10 @@ impl PerspectiveCamera {
         let x = (1.0 - 2.0 * sx) * self.tan_half_fov.x;
         let y = (1.0 - 2.0 * sy) * self.tan_half_fov.y;
         let film = self.axis_x * x + self.axis_y * y;
-        // Selects, not a branch: a branch here, inside the strategies' path loops, cost the grid
-        // kernels ~5-8% on an H200 (bench/results/2026-11-29-h200-session10). The pinhole's
-        // arithmetic is the same as without the orthographic case.
+        // Selects, not a branch: a branch here, inside the strategies' path loops, took smoke's
+        // kernel from 80 to 95 registers and 5% more time on an H200
+        // (bench/results/2026-11-29-h200-session10). The pinhole's arithmetic is the same as
+        // without the orthographic case.
         let (origin, dir) = if self.orthographic {
             (self.origin + film, self.axis_z)
         } else {

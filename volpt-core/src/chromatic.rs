@@ -2,7 +2,9 @@
 //! spectral MIS that tracks it without bias and without the variance of one channel's tracking.
 //!
 //! `sigma_t(p) = extinction * density(p)`: an RGB extinction times an optional density grid (none:
-//! density 1, a homogeneous chromatic medium); the albedo is a constant or an RGB grid. Or a
+//! density 1, a homogeneous chromatic medium) of one channel, or of three (a density per channel:
+//! Mitsuba's RGB `sigma_t` `gridvolume`); the albedo is a constant or an RGB grid; RGB grids are
+//! read trilinearly or, where their lookup says so, nearest. Or a
 //! material-indexed volume ([`crate::material`]): extinction, albedo and phase asymmetry from the
 //! table row of the voxel's material. Which of these a medium has is a run-time branch inside the
 //! one type, so chromatic media add one value to the registry's medium axis, not a cartesian
@@ -31,8 +33,8 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::abi::{Component, GridParams, Upload};
-use crate::grid::{DenseTrilinear, Grid, GridPlacement, GridReads};
-use crate::majorant::{MajorantGrid, MajorantGridParams};
+use crate::grid::{DenseTrilinear, Grid, GridLookup, GridPlacement, GridReads};
+use crate::majorant::{build_majorants, MajorantGrid, MajorantGridParams};
 use crate::material::{MaterialGrid, MaterialGridParams};
 use crate::medium::{Medium, TrackedMedium};
 use crate::rng::Rng;
@@ -44,8 +46,11 @@ use crate::{Spectrum, Vec3};
 pub struct ChromaticMedium<'a> {
     /// The extinction per channel where the density is 1.
     pub extinction: Spectrum,
-    /// `None`: the density is 1 everywhere (a homogeneous medium).
+    /// `None`: the density is 1 everywhere (a homogeneous medium), unless `density_rgb` has it.
     pub density: Option<Grid<'a, 1>>,
+    /// A density per channel (read where `density` is `None`): `extinction` then scales each
+    /// channel of this grid.
+    pub density_rgb: Option<Grid<'a, 3>>,
     /// `max(extinction) * max(density)`: a bound of every channel.
     pub majorant: f32,
     /// Per-cell bounds of every channel ([`crate::majorant`]); `None` tracks with `majorant`.
@@ -77,9 +82,38 @@ impl<'a> ChromaticMedium<'a> {
         Self {
             extinction,
             density,
+            density_rgb: None,
             majorant: extinction.max_element() * max_density,
             majorants: None,
             channel_majorant: extinction * max_density,
+            channel_majorants: None,
+            albedo,
+            albedo_grid,
+            materials: None,
+        }
+    }
+
+    /// A medium of `extinction` times a density per channel (`density`'s three), whose
+    /// majorants are derived from them: each channel's is its own largest density times its
+    /// extinction.
+    pub fn per_channel(
+        extinction: Spectrum,
+        density: Grid<'a, 3>,
+        albedo: Spectrum,
+        albedo_grid: Option<Grid<'a, 3>>,
+    ) -> Self {
+        let mut max_density = Spectrum::ZERO;
+        for v in density.samples().chunks_exact(3) {
+            max_density = max_density.max(Spectrum::new(v[0], v[1], v[2]));
+        }
+        let channel_majorant = extinction * max_density;
+        Self {
+            extinction,
+            density: None,
+            density_rgb: Some(density),
+            majorant: channel_majorant.max_element(),
+            majorants: None,
+            channel_majorant,
             channel_majorants: None,
             albedo,
             albedo_grid,
@@ -93,6 +127,7 @@ impl<'a> ChromaticMedium<'a> {
         Self {
             extinction: Spectrum::ZERO,
             density: None,
+            density_rgb: None,
             majorant: materials.max_extinction(),
             majorants: None,
             channel_majorant: materials.max_extinction_rgb(),
@@ -120,7 +155,8 @@ impl Medium for ChromaticMedium<'_> {
 
     /// A cell's from [`ChromaticMedium::channel_majorants`] where it has them; else the global
     /// bounds scaled as the cell's bound of every channel is (`extinction * density` keeps the
-    /// channels in proportion), or for a material-indexed volume that bound in every channel.
+    /// channels in proportion), or for a material-indexed volume or a density per channel that
+    /// bound in every channel.
     #[inline(always)]
     fn majorant_rgb(&self, bound: f32, cell: Option<usize>) -> Spectrum {
         let Some(cell) = cell else {
@@ -130,8 +166,8 @@ impl Medium for ChromaticMedium<'_> {
             let c = &channels[3 * cell..3 * cell + 3];
             return Spectrum::new(c[0], c[1], c[2]);
         }
-        if self.materials.is_some() {
-            // Materials' channels are not in proportion: only the bound of all holds for each.
+        if self.materials.is_some() || self.density_rgb.is_some() {
+            // Such channels are not in proportion: only the bound of all holds for each.
             return Spectrum::splat(bound);
         }
         if self.majorant > 0.0 {
@@ -152,9 +188,10 @@ impl Medium for ChromaticMedium<'_> {
         if let Some(materials) = &self.materials {
             return materials.sigma_t(p);
         }
-        match &self.density {
-            Some(grid) => self.extinction * DenseTrilinear::lookup(grid, p)[0],
-            None => self.extinction,
+        match (&self.density, &self.density_rgb) {
+            (Some(grid), _) => self.extinction * DenseTrilinear::lookup(grid, p)[0],
+            (None, Some(grid)) => self.extinction * Spectrum::from_array(read(grid, p)),
+            (None, None) => self.extinction,
         }
     }
 
@@ -163,9 +200,9 @@ impl Medium for ChromaticMedium<'_> {
         if let Some(materials) = &self.materials {
             return materials.uniform_sigma_t();
         }
-        match self.density {
-            Some(_) => None,
-            None => Some(self.extinction),
+        match (self.density, self.density_rgb) {
+            (None, None) => Some(self.extinction),
+            _ => None,
         }
     }
 
@@ -175,7 +212,7 @@ impl Medium for ChromaticMedium<'_> {
             return materials.albedo(p);
         }
         match &self.albedo_grid {
-            Some(grid) => Spectrum::from_array(DenseTrilinear::lookup(grid, p)),
+            Some(grid) => Spectrum::from_array(read(grid, p)),
             None => self.albedo,
         }
     }
@@ -192,6 +229,10 @@ impl<'a> TrackedMedium<'a> for ChromaticMedium<'a> {
         self.density.map(|g| (g, self.extinction.max_element()))
     }
 
+    fn channel_densities(&self) -> Option<(Grid<'a, 3>, Spectrum)> {
+        self.density_rgb.map(|g| (g, self.extinction))
+    }
+
     fn track_with(&mut self, grid: Option<MajorantGrid<'a>>) {
         self.majorants = grid;
     }
@@ -202,6 +243,56 @@ impl<'a> TrackedMedium<'a> for ChromaticMedium<'a> {
 
     fn materials(&self) -> Option<MaterialGrid<'a>> {
         self.materials
+    }
+}
+
+/// A dense grid's value at `p`, trilinear, or the nearest sample's where the grid says so (an
+/// RGB grid exported from a material-indexed volume, Mitsuba's `filter_type` `nearest`): a
+/// run-time branch, the trilinear read's arithmetic unchanged.
+#[inline(always)]
+fn read(grid: &Grid<'_, 3>, p: Vec3) -> [f32; 3] {
+    if grid.lookup == GridLookup::Nearest {
+        grid.lookup_dense_nearest(p)
+    } else {
+        DenseTrilinear::lookup(grid, p)
+    }
+}
+
+/// Fills `channels` (three values per cell of a `res` grid over `bounds`, x fastest) with each
+/// channel's bound of `extinction * density` inside each cell, and `bound` (one per cell) with
+/// the largest of the three: [`build_majorants`] of each channel, copied in turn into `plane`
+/// (one value per sample; the grid's samples are interleaved).
+pub fn build_channel_majorants(
+    density: &Grid<'_, 3>,
+    extinction: Spectrum,
+    bounds: crate::Aabb,
+    res: [u32; 3],
+    plane: &mut [f32],
+    channels: &mut [f32],
+    bound: &mut [f32],
+) {
+    assert_eq!(
+        channels.len(),
+        3 * bound.len(),
+        "three channel bounds a cell"
+    );
+    assert_eq!(
+        3 * plane.len(),
+        density.data.len(),
+        "one plane value a sample"
+    );
+    for c in 0..3 {
+        for (v, s) in plane.iter_mut().zip(density.data.chunks_exact(3)) {
+            *v = s[c];
+        }
+        let one = Grid::<1>::new(plane, density.res, density.mapping).with_lookup(density.lookup);
+        build_majorants(&one, extinction[c], bounds, res, bound);
+        for (k, &b) in bound.iter().enumerate() {
+            channels[3 * k + c] = b;
+        }
+    }
+    for (b, c) in bound.iter_mut().zip(channels.chunks_exact(3)) {
+        *b = c[0].max(c[1]).max(c[2]);
     }
 }
 
@@ -232,6 +323,7 @@ pub fn rescale(r: &mut Spectrum, w: Spectrum) {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct ChromaticParams {
     pub density: GridParams,
+    pub density_rgb: GridParams,
     pub albedo_grid: GridParams,
     pub majorants: MajorantGridParams,
     pub materials: MaterialGridParams,
@@ -261,6 +353,7 @@ impl Component for ChromaticMedium<'_> {
     fn to_params(&self, upload: &mut Upload<'_>) -> ChromaticParams {
         ChromaticParams {
             density: optional_grid(self.density.as_ref(), upload),
+            density_rgb: optional_grid(self.density_rgb.as_ref(), upload),
             albedo_grid: optional_grid(self.albedo_grid.as_ref(), upload),
             majorants: MajorantGridParams::new(self.majorants.as_ref(), upload),
             materials: MaterialGridParams::new(self.materials.as_ref(), upload),
@@ -279,6 +372,8 @@ impl Component for ChromaticMedium<'_> {
             extinction: Spectrum::from_array(p.extinction),
             // SAFETY: forwarded to the caller.
             density: (p.density.len > 0).then(|| unsafe { p.density.grid::<1>() }),
+            // SAFETY: forwarded to the caller.
+            density_rgb: (p.density_rgb.len > 0).then(|| unsafe { p.density_rgb.grid::<3>() }),
             majorant: p.majorant,
             // SAFETY: forwarded to the caller.
             majorants: unsafe { p.majorants.grid() },

@@ -331,6 +331,13 @@ impl<'a, const C: usize> Grid<'a, C> {
         self.interpolate(p, dense_index, GridLookup::Trilinear, None)
     }
 
+    /// [`Grid::lookup`] of a dense grid read nearest, without the other layouts' code.
+    #[inline(always)]
+    pub fn lookup_dense_nearest(&self, p: Vec3) -> [f32; C] {
+        debug_assert!(self.layout == GridLayout::Dense);
+        self.interpolate(p, dense_index, GridLookup::Nearest, None)
+    }
+
     /// The index-space coordinates of the last sample along each axis.
     #[inline(always)]
     fn max_index(&self) -> Vec3 {

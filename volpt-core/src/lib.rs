@@ -17,6 +17,7 @@ pub mod bsdf;
 pub mod camera;
 pub mod chromatic;
 pub mod environment;
+pub mod flight;
 pub mod frame;
 pub mod fresnel;
 pub mod geometry;
@@ -63,7 +64,7 @@ pub use path::{Estimator, PathCounters, PathOf, PathSettings, PathState, Roulett
 pub use phase::{HenyeyGreenstein, Isotropic, PhaseFunction};
 pub use rng::Rng;
 pub use scene::{Scene, VolumeScene, WithShape};
-pub use shape::Shape;
+pub use shape::{BoundaryShape, Shape};
 pub use spectral::{HeroChannel, SpectralState};
 
 /// Linear RGB radiance, throughput or albedo.

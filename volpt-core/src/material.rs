@@ -1,7 +1,8 @@
 //! Material-indexed volumes: one material index per voxel and a table of materials, each with its
 //! RGB extinction, RGB albedo and Henyey-Greenstein `g` (a colour 3D print: five resins, one per
-//! voxel; Elek et al. 2017). The index grid stays one byte a voxel on the device, not the 28 of
-//! expanded coefficients; a collision reads its voxel's index, then the table.
+//! voxel; Elek et al. 2017). The index grid stays one byte a voxel on the device (two for a table
+//! of more than 256 materials: a print of many mixtures), not the 28 of expanded coefficients; a
+//! collision reads its voxel's index, then the table.
 //!
 //! The voxels tile the grid's box (cell-centred, Mitsuba 3's convention) and are read nearest:
 //! the coefficients at `p` are those of the voxel containing `p`, constant inside it, with no
@@ -23,8 +24,28 @@ use crate::{Aabb, Spectrum, Vec3};
 /// largest channel. Eight, so that a material is one aligned 32-byte read on a GPU.
 pub const MATERIAL_FLOATS: usize = 8;
 
-/// The most materials a table holds: indices are bytes.
-pub const MAX_MATERIALS: usize = 256;
+/// The most materials a table holds: indices are at most 16 bits.
+pub const MAX_MATERIALS: usize = 1 << 16;
+
+/// The most materials a table of byte indices holds; a larger table's indices are 16 bits
+/// ([`wide_indices`]).
+pub const MAX_BYTE_MATERIALS: usize = 256;
+
+/// Whether a table of `materials` materials has 16-bit indices (two to a `u32`) rather than
+/// bytes (four to a `u32`): the storage is the table's choice, a run-time branch of the one
+/// lookup, so that more materials add no kernel.
+pub const fn wide_indices(materials: usize) -> bool {
+    materials > MAX_BYTE_MATERIALS
+}
+
+/// The `u32` words that hold `voxels` indices into a table of `materials` materials.
+pub const fn index_words(voxels: usize, materials: usize) -> usize {
+    if wide_indices(materials) {
+        voxels.div_ceil(2)
+    } else {
+        voxels.div_ceil(4)
+    }
+}
 
 /// One material's coefficients, as a table row holds them.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -57,7 +78,8 @@ impl Material {
 }
 
 /// A material-indexed volume: `res` voxels tiling `bounds`, x fastest, each index a byte packed
-/// four to a `u32` (little end first), and the table's rows ([`MATERIAL_FLOATS`] each), whose
+/// four to a `u32` (little end first; 16 bits, two to a `u32`, where `wide`), and the table's
+/// rows ([`MATERIAL_FLOATS`] each), whose
 /// extinctions `scale` multiplies. Borrowed, so that the same type wraps host memory and device
 /// memory.
 #[derive(Clone, Copy, Debug)]
@@ -69,14 +91,17 @@ pub struct MaterialGrid<'a> {
     pub scale: f32,
     /// The one material every voxel holds, or [`MaterialGrid::MIXED`].
     pub only: u32,
+    /// 16-bit indices ([`wide_indices`] of the table's length).
+    pub wide: bool,
 }
 
 impl<'a> MaterialGrid<'a> {
     /// [`MaterialGrid::only`] of a grid of more than one material.
     pub const MIXED: u32 = u32::MAX;
 
-    /// `indices` must hold `res_x * res_y * res_z` bytes (rounded up to whole words), each below
-    /// the table's length; the loaders check both and return errors first.
+    /// `indices` must hold `res_x * res_y * res_z` indices ([`index_words`] words: bytes, or 16
+    /// bits for a table of more than 256 materials), each below the table's length; the loaders
+    /// check both and return errors first.
     pub fn new(
         indices: &'a [u32],
         res: [u32; 3],
@@ -85,9 +110,14 @@ impl<'a> MaterialGrid<'a> {
         scale: f32,
     ) -> Self {
         let voxels = res.iter().map(|&r| r as usize).product::<usize>();
-        assert_eq!(indices.len(), voxels.div_ceil(4), "index grid size");
         assert!(table.len().is_multiple_of(MATERIAL_FLOATS) && !table.is_empty());
         let materials = table.len() / MATERIAL_FLOATS;
+        assert!(materials <= MAX_MATERIALS, "table size");
+        assert_eq!(
+            indices.len(),
+            index_words(voxels, materials),
+            "index grid size"
+        );
         let mut grid = Self {
             indices,
             res,
@@ -95,6 +125,7 @@ impl<'a> MaterialGrid<'a> {
             table,
             scale,
             only: Self::MIXED,
+            wide: wide_indices(materials),
         };
         let first = grid.index(0);
         assert!(
@@ -116,7 +147,11 @@ impl<'a> MaterialGrid<'a> {
     /// The material index of voxel `i` (x fastest).
     #[inline(always)]
     pub fn index(&self, i: usize) -> u32 {
-        (self.indices[i >> 2] >> ((i & 3) * 8)) & 0xff
+        if self.wide {
+            (self.indices[i >> 1] >> ((i & 1) * 16)) & 0xffff
+        } else {
+            (self.indices[i >> 2] >> ((i & 3) * 8)) & 0xff
+        }
     }
 
     /// The row of the material in the voxel containing `p`, or `None` outside the grid's box.
@@ -185,7 +220,7 @@ impl<'a> MaterialGrid<'a> {
     pub fn max_extinction(&self) -> f32 {
         let present = self.present();
         (0..MAX_MATERIALS)
-            .filter(|&k| present[k])
+            .filter(|&k| present.contains(k))
             .map(|k| self.table[k * MATERIAL_FLOATS + 7] * self.scale)
             .fold(0.0, f32::max)
     }
@@ -194,7 +229,7 @@ impl<'a> MaterialGrid<'a> {
     pub fn max_extinction_rgb(&self) -> Spectrum {
         let present = self.present();
         (0..MAX_MATERIALS)
-            .filter(|&k| present[k])
+            .filter(|&k| present.contains(k))
             .map(|k| self.row_sigma_t(k))
             .fold(Spectrum::ZERO, Spectrum::max)
     }
@@ -207,18 +242,28 @@ impl<'a> MaterialGrid<'a> {
     }
 
     /// Which materials the grid holds.
-    pub fn present(&self) -> [bool; MAX_MATERIALS] {
-        let mut present = [false; MAX_MATERIALS];
+    pub fn present(&self) -> Present {
+        let mut present = Present([0; MAX_MATERIALS / 64]);
         let voxels = self.res.iter().map(|&r| r as usize).product::<usize>();
         for i in 0..voxels {
-            present[self.index(i) as usize] = true;
+            let k = self.index(i) as usize;
+            present.0[k / 64] |= 1 << (k % 64);
         }
         present
     }
 
-    /// The index grid's bytes on the device: one a voxel.
+    /// The index grid's bytes on the device: one a voxel (two where `wide`).
     pub fn device_bytes(&self) -> u64 {
         self.indices.len() as u64 * 4
+    }
+}
+
+/// A set of material indices (8 KiB: one bit a possible material).
+pub struct Present([u64; MAX_MATERIALS / 64]);
+
+impl Present {
+    pub fn contains(&self, k: usize) -> bool {
+        k < MAX_MATERIALS && self.0[k / 64] & (1 << (k % 64)) != 0
     }
 }
 
@@ -275,15 +320,9 @@ fn for_each_cell_bound(
     let cell = bounds.extent() / Vec3::new(res[0] as f32, res[1] as f32, res[2] as f32);
     let voxel_scale = Vec3::new(grid.res[0] as f32, grid.res[1] as f32, grid.res[2] as f32)
         / grid.bounds.extent();
-    // Each material's extinction, once (not once per voxel read).
-    let materials = grid.table.len() / MATERIAL_FLOATS;
-    let mut sigma_t = [Spectrum::ZERO; MAX_MATERIALS];
-    for (k, s) in sigma_t.iter_mut().enumerate().take(materials) {
-        *s = grid.row_sigma_t(k);
-    }
     for i in 0..cells {
         if grid.only != MaterialGrid::MIXED {
-            put(i, sigma_t[grid.only as usize]);
+            put(i, grid.row_sigma_t(grid.only as usize));
             continue;
         }
         let x = (i % res[0] as usize) as u32;
@@ -303,7 +342,7 @@ fn for_each_cell_bound(
         for vz in range(2) {
             for vy in range(1) {
                 for vx in range(0) {
-                    max = max.max(sigma_t[grid.index((vz * ny + vy) * nx + vx) as usize]);
+                    max = max.max(grid.row_sigma_t(grid.index((vz * ny + vy) * nx + vx) as usize));
                 }
             }
         }
@@ -326,7 +365,8 @@ pub struct MaterialGridParams {
     pub bounds_min: [f32; 3],
     pub bounds_max: [f32; 3],
     pub scale: f32,
-    pub padding: u32,
+    /// 1: 16-bit indices ([`MaterialGrid::wide`]), 0: bytes.
+    pub wide: u32,
 }
 
 impl MaterialGridParams {
@@ -345,7 +385,7 @@ impl MaterialGridParams {
             bounds_min: grid.bounds.min.to_array(),
             bounds_max: grid.bounds.max.to_array(),
             scale: grid.scale,
-            padding: 0,
+            wide: grid.wide as u32,
         }
     }
 
@@ -376,6 +416,7 @@ impl MaterialGridParams {
             table,
             scale: self.scale,
             only: self.only,
+            wide: self.wide != 0,
         })
     }
 }

@@ -92,6 +92,12 @@ pub trait TrackedMedium<'a> {
         None
     }
 
+    /// A density per channel and each channel's scale (a chromatic medium's three-channel
+    /// grid), whose majorant grid tightens tracking, each channel's cells bounded on its own.
+    fn channel_densities(&self) -> Option<(Grid<'a, 3>, Spectrum)> {
+        None
+    }
+
     /// Tracks with `grid` (`None`: with the global majorant).
     fn track_with(&mut self, grid: Option<MajorantGrid<'a>>) {
         let _ = grid;

@@ -309,7 +309,8 @@ fn advance<S: Scene, const DEFER_SCATTER: bool>(scene: &S, path: &mut PathOf<S>)
         return None;
     }
     if path.inside {
-        let t_exit = scene.shape().exit_distance(&path.ray);
+        // Cast through a mesh only if the flight may reach it.
+        let t_exit = scene.shape().flight_exit(&path.ray);
         let collision = path.spectral.free_flight(
             scene.medium(),
             &path.ray,
@@ -510,7 +511,7 @@ fn shadow_transmittance<S: Scene>(
     distance: f32,
 ) -> Option<Transmittance<S>> {
     let mut transmittance = chord_transmittance(scene, path, &shadow, distance)?;
-    if S::Shape::CONVEX {
+    if scene.shape().convex() {
         return Some(transmittance);
     }
     let (mut shadow, mut distance) = (shadow, distance);
@@ -576,7 +577,7 @@ fn boundary_next_event_estimate<S: Scene>(scene: &S, path: &mut PathOf<S>, hit: 
         return;
     }
     // A non-convex shape may stand in the way, which bends the shadow ray.
-    if !S::Shape::CONVEX
+    if !scene.shape().convex()
         && scene
             .shape()
             .entry(&Ray::new(hit.point, light.dir))

@@ -6,7 +6,9 @@
 //! closed triangle mesh ([`crate::mesh::TriangleMesh`]) answers them with a ray cast through its
 //! BVH. Every answer's normal is the surface's outward geometric normal.
 
+use crate::flight::{FlightEnd, LazyExit};
 use crate::geometry::{Aabb, BoxHit, Ray};
+use crate::mesh::TriangleMesh;
 
 /// A closed surface bounding the medium.
 ///
@@ -18,6 +20,13 @@ pub trait Shape {
     /// Whether every ray leaves the shape once and never meets it again: a path's light that
     /// leaves it reaches the environment, and a shadow ray needs one exit.
     const CONVEX: bool;
+
+    /// [`Shape::CONVEX`] for this shape: a shape chosen at run time ([`BoundaryShape`]) knows only
+    /// then. A compile-time constant for every other shape.
+    #[inline(always)]
+    fn convex(&self) -> bool {
+        Self::CONVEX
+    }
 
     fn bounds(&self) -> Aabb;
 
@@ -32,10 +41,25 @@ pub trait Shape {
 
     /// `exit(ray).t`, the same bits, for a free flight that needs only the distance.
     fn exit_distance(&self, ray: &Ray) -> f32;
+
+    /// `exit_distance(ray)` as a free flight compares with it: the distance itself for a box, a
+    /// mesh's found only if a flight gets far enough to need it ([`crate::flight`]).
+    type Exit<'a>: FlightEnd
+    where
+        Self: 'a;
+
+    fn flight_exit<'a>(&'a self, ray: &'a Ray) -> Self::Exit<'a>;
 }
 
 impl Shape for Aabb {
     const CONVEX: bool = true;
+
+    type Exit<'a> = f32;
+
+    #[inline(always)]
+    fn flight_exit<'a>(&'a self, ray: &'a Ray) -> f32 {
+        Aabb::exit_distance(self, ray)
+    }
 
     #[inline(always)]
     fn bounds(&self) -> Aabb {
@@ -61,4 +85,96 @@ impl Shape for Aabb {
     fn exit_distance(&self, ray: &Ray) -> f32 {
         Aabb::exit_distance(self, ray)
     }
+}
+
+/// The boundary a scene file describes, chosen at run time: its box, or a closed triangle mesh.
+/// One scene type serves both, so a mesh boundary costs no second copy of every variant's code;
+/// a box pays one well-predicted branch per question. The mesh's questions are functions of their
+/// own (`inline(never)`): one copy of the BVH traversal, whatever the variant.
+#[derive(Clone, Copy, Debug)]
+pub enum BoundaryShape<'a> {
+    Box(Aabb),
+    Mesh(TriangleMesh<'a>),
+}
+
+impl Shape for BoundaryShape<'_> {
+    const CONVEX: bool = false;
+
+    type Exit<'e>
+        = LazyExit<'e>
+    where
+        Self: 'e;
+
+    #[inline(always)]
+    fn flight_exit<'e>(&'e self, ray: &'e Ray) -> LazyExit<'e> {
+        match self {
+            BoundaryShape::Box(b) => LazyExit::known(Aabb::exit_distance(b, ray), ray),
+            BoundaryShape::Mesh(m) => m.flight_exit(ray),
+        }
+    }
+
+    #[inline(always)]
+    fn convex(&self) -> bool {
+        matches!(self, BoundaryShape::Box(_))
+    }
+
+    #[inline(always)]
+    fn bounds(&self) -> Aabb {
+        match self {
+            BoundaryShape::Box(b) => *b,
+            BoundaryShape::Mesh(m) => m.bounds,
+        }
+    }
+
+    #[inline(always)]
+    fn contains(&self, p: crate::Vec3) -> bool {
+        match self {
+            BoundaryShape::Box(b) => Aabb::contains(b, p),
+            BoundaryShape::Mesh(m) => mesh_contains(m, p),
+        }
+    }
+
+    #[inline(always)]
+    fn entry(&self, ray: &Ray) -> Option<BoxHit> {
+        match self {
+            BoundaryShape::Box(b) => Aabb::entry(b, ray),
+            BoundaryShape::Mesh(m) => mesh_entry(m, ray),
+        }
+    }
+
+    #[inline(always)]
+    fn exit(&self, ray: &Ray) -> BoxHit {
+        match self {
+            BoundaryShape::Box(b) => Aabb::exit(b, ray),
+            BoundaryShape::Mesh(m) => mesh_exit(m, ray),
+        }
+    }
+
+    #[inline(always)]
+    fn exit_distance(&self, ray: &Ray) -> f32 {
+        match self {
+            BoundaryShape::Box(b) => Aabb::exit_distance(b, ray),
+            BoundaryShape::Mesh(m) => mesh_exit_distance(m, ray),
+        }
+    }
+}
+
+#[inline(never)]
+fn mesh_contains(mesh: &TriangleMesh<'_>, p: crate::Vec3) -> bool {
+    mesh.contains(p)
+}
+
+#[inline(never)]
+fn mesh_entry(mesh: &TriangleMesh<'_>, ray: &Ray) -> Option<BoxHit> {
+    mesh.entry(ray)
+}
+
+#[inline(never)]
+fn mesh_exit(mesh: &TriangleMesh<'_>, ray: &Ray) -> BoxHit {
+    mesh.exit(ray)
+}
+
+#[inline(never)]
+fn mesh_exit_distance(mesh: &TriangleMesh<'_>, ray: &Ray) -> f32 {
+    mesh.exit_distance(ray)
 }

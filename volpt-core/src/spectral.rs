@@ -11,6 +11,7 @@ use core::fmt::Debug;
 use core::ops::MulAssign;
 
 use crate::chromatic::choose_hero;
+use crate::flight::FlightEnd;
 use crate::medium::Medium;
 use crate::rng::Rng;
 use crate::tracking::{
@@ -34,7 +35,7 @@ pub trait SpectralState: Copy + Debug {
         &mut self,
         medium: &M,
         ray: &Ray,
-        t_max: f32,
+        t_max: impl FlightEnd,
         rng: &mut Rng,
         steps: &mut u32,
         max_steps: u32,
@@ -87,7 +88,7 @@ impl SpectralState for () {
         &mut self,
         medium: &M,
         ray: &Ray,
-        t_max: f32,
+        t_max: impl FlightEnd,
         rng: &mut Rng,
         steps: &mut u32,
         max_steps: u32,
@@ -165,7 +166,7 @@ impl SpectralState for HeroChannel {
         &mut self,
         medium: &M,
         ray: &Ray,
-        t_max: f32,
+        t_max: impl FlightEnd,
         rng: &mut Rng,
         steps: &mut u32,
         max_steps: u32,

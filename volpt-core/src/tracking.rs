@@ -2,6 +2,7 @@
 //! the medium's majorants: one global bound, or a majorant grid walked cell by cell.
 
 use crate::chromatic::rescale;
+use crate::flight::FlightEnd;
 use crate::majorant::Dda;
 use crate::math::{exp, ln};
 use crate::medium::Medium;
@@ -78,7 +79,7 @@ impl<F: FnMut(&mut Rng, f32, f32) -> bool> TentativeCollision for F {
 pub fn walk_majorants<M: Medium>(
     medium: &M,
     ray: &Ray,
-    t_max: f32,
+    mut t_max: impl FlightEnd,
     rng: &mut Rng,
     steps: &mut u32,
     max_steps: u32,
@@ -87,7 +88,7 @@ pub fn walk_majorants<M: Medium>(
     let Some(grid) = medium.majorant_grid() else {
         let majorant = at.rate(medium.majorant(), None);
         if majorant <= 0.0 {
-            at.leave(t_max);
+            at.leave(t_max.exact());
             return FreeFlight::Escaped;
         }
         let majorant = normal_majorant(majorant);
@@ -96,8 +97,8 @@ pub fn walk_majorants<M: Medium>(
         loop {
             let bits = rng.next_u64();
             t -= ln(1.0 - unit_f32(bits)) * inv_majorant;
-            if t >= t_max {
-                at.leave(t_max);
+            if t_max.reached(t) {
+                at.leave(t_max.exact());
                 return FreeFlight::Escaped;
             }
             if *steps >= max_steps {
@@ -116,7 +117,7 @@ pub fn walk_majorants<M: Medium>(
     // its cell. The same numbers drawn in the same order, the same arithmetic.
     let mut dda = Dda::new(grid, ray);
     let mut start = 0.0f32;
-    let mut cell = Cell::new(&dda, grid, t_max, start, &mut at);
+    let mut cell = Cell::new(&dda, grid, &mut t_max, start, &mut at);
     loop {
         if cell.majorant > 0.0 {
             let bits = rng.next_u64();
@@ -136,12 +137,12 @@ pub fn walk_majorants<M: Medium>(
         }
         at.leave(cell.end);
         // Anything but `end < t_max` ends the walk, a NaN `end` or `t_max` included.
-        if cell.end.partial_cmp(&t_max) != Some(core::cmp::Ordering::Less) {
+        if !t_max.before(cell.end) {
             return FreeFlight::Escaped;
         }
         start = start.max(cell.end);
         dda.advance(grid, ray.dir);
-        cell = Cell::new(&dda, grid, t_max, start, &mut at);
+        cell = Cell::new(&dda, grid, &mut t_max, start, &mut at);
     }
 }
 
@@ -160,7 +161,7 @@ impl Cell {
     fn new(
         dda: &Dda,
         grid: &crate::majorant::MajorantGrid<'_>,
-        t_max: f32,
+        t_max: &mut impl FlightEnd,
         start: f32,
         at: &mut impl TentativeCollision,
     ) -> Self {
@@ -175,7 +176,7 @@ impl Cell {
         Self {
             majorant,
             inv_majorant: 1.0 / majorant,
-            end: cell_end.min(t_max),
+            end: t_max.clip(cell_end),
             t: start,
         }
     }
@@ -206,7 +207,7 @@ fn normal_majorant(majorant: f32) -> f32 {
 pub fn delta_tracking<M: Medium>(
     medium: &M,
     ray: &Ray,
-    t_max: f32,
+    t_max: impl FlightEnd,
     rng: &mut Rng,
     steps: &mut u32,
     max_steps: u32,
@@ -312,7 +313,7 @@ impl<M: Medium> TentativeCollision for &mut RatioProduct<'_, M> {
 pub fn spectral_delta_tracking<M: Medium>(
     medium: &M,
     ray: &Ray,
-    t_max: f32,
+    t_max: impl FlightEnd,
     rng: &mut Rng,
     hero: u8,
     r_u: &mut Spectrum,

@@ -3,8 +3,10 @@
 //! a test no weight can be tuned to pass), for a homogeneous and a grid medium (with its majorant
 //! grid and an albedo grid), path tracing and next-event estimation, behind each boundary kind;
 //! that the spectral MIS weights stay finite and bounded on media whose channels are 10^10 apart;
-//! that each channel's own majorant leaves a homogeneous medium without null collisions; and that
-//! it lowers the variance at equal samples against one majorant for all channels.
+//! that each channel's own majorant leaves a homogeneous medium without null collisions; that it
+//! lowers the variance at equal samples against one majorant for all channels, and lets every
+//! hero's path live as long as the longest-lived channel's light; and that a density per channel
+//! renders as per-channel scales of a grey grid (bit for bit under the global majorant).
 //!
 //! With `VOLPT_FULL_POWER=1` each comparison has the power to see a 1% bias at 10 standard errors:
 //! it asserts that the standard error of the difference is at most 0.1% of the mean (2^23 paths a
@@ -15,6 +17,7 @@
 mod common;
 
 use common::{Moments, Z_MAX};
+use volpt_core::chromatic::build_channel_majorants;
 use volpt_core::grid::DenseTrilinear;
 use volpt_core::majorant::{build_majorants, MajorantGrid};
 use volpt_core::microfacet::Ggx;
@@ -502,4 +505,202 @@ fn own_channel_majorants_lower_the_variance_at_equal_samples() {
     }
     eprintln!("tracking steps: own {own_steps}, one {one_steps}");
     assert!(own_steps < one_steps);
+}
+
+/// A density per channel (Mitsuba's RGB `sigma_t` grid times its scale,
+/// [`ChromaticMedium::per_channel`]) renders as the same medium given as per-channel scales of a
+/// grey grid ([`ChromaticMedium::new`]): bit for bit, path by path, under the global majorant,
+/// with channels a power of two apart (so that the grid of `d * 2^c` interpolates to exactly
+/// `2^c` times `d`'s interpolation: the same arithmetic, the same paths); and in expectation with each medium's majorant grid (the per-channel one's
+/// bounds come from each channel's samples, [`build_channel_majorants`], and bound each channel's
+/// extinction in every cell, checked at 100,000 points).
+#[test]
+fn a_density_per_channel_renders_as_per_channel_scales_of_its_grey_grid() {
+    const SCALE: f32 = 1.25;
+    const CHANNELS: [f32; 3] = [1.0, 2.0, 4.0];
+    const SCALES: [f32; 3] = [
+        SCALE * CHANNELS[0],
+        SCALE * CHANNELS[1],
+        SCALE * CHANNELS[2],
+    ];
+    let grids = Grids::new();
+    let rgb: Vec<f32> = grids
+        .density
+        .iter()
+        .flat_map(|d| CHANNELS.map(|e| d * e))
+        .collect();
+    let albedo = Grid::new(&grids.albedo, RES, Grids::mapping());
+    let scaled = ChromaticMedium::new(
+        Spectrum::from_array(SCALES),
+        Some(grids.density()),
+        Spectrum::ZERO,
+        Some(albedo),
+    );
+    let per_channel = ChromaticMedium::per_channel(
+        Spectrum::splat(SCALE),
+        Grid::new(&rgb, RES, Grids::mapping()),
+        Spectrum::ZERO,
+        Some(albedo),
+    );
+    assert_eq!(per_channel.majorant, scaled.majorant);
+    assert_eq!(per_channel.channel_majorant, scaled.channel_majorant);
+    same_paths(scaled, per_channel, rough(), Estimator::PathTracing);
+    same_paths(scaled, per_channel, NullBoundary, Estimator::NextEvent);
+
+    // Each medium with its majorant grid (2^3 cells).
+    let mut grey_grids = Grids::new();
+    grey_grids.build_majorants(SCALES[2]);
+    let mut scaled = scaled;
+    scaled.majorants = Some(grey_grids.majorant_grid());
+    let (mut plane, mut channels, mut cells) = (vec![0.0; 64], vec![0.0; 24], vec![0.0; 8]);
+    let rgb_grid = per_channel.density_rgb.unwrap();
+    build_channel_majorants(
+        &rgb_grid,
+        Spectrum::splat(SCALE),
+        bounds(),
+        [2, 2, 2],
+        &mut plane,
+        &mut channels,
+        &mut cells,
+    );
+    let mut per_channel = per_channel;
+    per_channel.majorants = Some(MajorantGrid::new(&cells, [2, 2, 2], bounds()));
+    per_channel.channel_majorants = Some(&channels);
+    let mut rng = Rng::new(9, 0, 0);
+    for _ in 0..100_000 {
+        let p = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - Vec3::ONE;
+        let cell = [p.x, p.y, p.z].map(|v| ((v + 1.0) as usize).min(1));
+        let k = cell[0] + 2 * cell[1] + 4 * cell[2];
+        let sigma = per_channel.sigma_t_rgb(p);
+        for c in 0..3 {
+            assert!(
+                sigma[c] <= channels[3 * k + c],
+                "{p:?}: channel {c} {sigma:?}"
+            );
+        }
+        assert_eq!(
+            cells[k],
+            channels[3 * k..3 * k + 3]
+                .iter()
+                .copied()
+                .fold(0.0, f32::max)
+        );
+    }
+    let grey = render(
+        &scene(scaled, rough(), Estimator::PathTracing),
+        power().0,
+        1,
+    );
+    let rgb = render(
+        &scene(per_channel, rough(), Estimator::PathTracing),
+        power().0,
+        2,
+    );
+    assert_identity("density per channel, rough, PT", rgb, [grey; 3]);
+    let grey = render(
+        &scene(scaled, NullBoundary, Estimator::NextEvent),
+        power().0,
+        1,
+    );
+    let rgb = render(
+        &scene(per_channel, NullBoundary, Estimator::NextEvent),
+        power().0,
+        2,
+    );
+    assert_identity("density per channel, null, NEE", rgb, [grey; 3]);
+}
+
+/// Asserts that `a` and `b` trace the same paths to the same light, bit for bit.
+fn same_paths<B: Bsdf + Copy>(
+    a: ChromaticMedium<'_>,
+    b: ChromaticMedium<'_>,
+    boundary: B,
+    estimator: Estimator,
+) {
+    let (a, b) = (scene(a, boundary, estimator), scene(b, boundary, estimator));
+    for sample in 0..4096 {
+        let mut p = PathState::from_camera(&a, sample % 4, (sample / 4) % 4, sample / 16, 5);
+        let mut q = PathState::from_camera(&b, sample % 4, (sample / 4) % 4, sample / 16, 5);
+        trace(&a, &mut p);
+        trace(&b, &mut q);
+        assert_eq!(
+            (p.radiance, p.segments, p.tracking_steps),
+            (q.radiance, q.segments, q.tracking_steps),
+            "{estimator:?}, sample {sample}"
+        );
+    }
+}
+
+/// Why a chromatic slab's paths are longer with each channel's own majorant than with one for all
+/// (`bench/peers/mitsuba3`'s chromatic-slab: 104.5 against 81.6 segments per path): both count a
+/// segment per free flight (a real collision or a boundary interaction; null collisions are
+/// tracking steps, not segments), and the free flights of a hero are its own medium's either way.
+/// What differs is when a path ends: in the slab (no roulette) only by leaving it or by the
+/// negligible-weight roulette, which watches `max_c(throughput_c r_c)`. Under one majorant (the
+/// red's 100) a red hero's every collision is real and multiplies `r_c / r_red` by
+/// `sigma_c / 100` (0.93, 0.96): `r` drifts to the red, whose albedo is 0.8, and the path's weight
+/// falls as `(0.99 x 0.96)^k`, so no red-hero path outlives about 570 collisions. With own
+/// majorants `r_c / r_h` changes by `(sigma_c / sigma_h) exp(-(sigma_c - sigma_h) t)`, whose
+/// logarithm has mean `ln(0.96) + 0.04 ~ -0.0008` per collision: `r` stays flat, every hero's path
+/// lives as long as the blue's light (albedo 0.99: about 2,750 collisions), and the three heroes'
+/// paths are alike. The added segments carry the blue's light of long walks, which one majorant
+/// left to the roulette (its variance; both are unbiased, the identity tests).
+#[test]
+fn own_majorants_let_every_hero_live_as_long_as_the_longest_lived_channel() {
+    let exact = ChromaticMedium::new(
+        Spectrum::new(100.0, 93.0, 96.0),
+        None,
+        Spectrum::new(0.8, 0.9677419, 0.9895833),
+        None,
+    );
+    let shared = ChromaticMedium {
+        channel_majorant: Spectrum::splat(exact.majorant),
+        ..exact
+    };
+    // Per hero: paths, segments, and paths of more than 1,000 segments.
+    let lengths = |medium: ChromaticMedium<'static>| {
+        // The slab's box, boundary and settings (no roulette but the negligible weight's).
+        let boundary = RoughDielectric {
+            eta: 1.05 / 1.01,
+            distribution: Ggx { alpha: 0.1 },
+        };
+        let scene = VolumeScene {
+            bounds: Aabb::new(Vec3::new(-1.6, -1.6, -0.5), Vec3::new(1.6, 1.6, 0.5)),
+            settings: PathSettings {
+                rr_depth: u32::MAX,
+                ..Default::default()
+            },
+            ..scene(medium, boundary, Estimator::PathTracing)
+        };
+        let mut by_hero = [[0u64; 3]; 3];
+        for sample in 0..30_000 {
+            let mut path =
+                PathState::from_camera(&scene, sample % 4, (sample / 4) % 4, sample / 16, 7);
+            trace(&scene, &mut path);
+            let h = &mut by_hero[path.spectral.hero as usize];
+            h[0] += 1;
+            h[1] += path.segments as u64;
+            h[2] += (path.segments > 1000) as u64;
+        }
+        by_hero
+    };
+    let (own, one) = (lengths(exact), lengths(shared));
+    for (name, l) in [("own", own), ("one", one)] {
+        for (h, [n, segments, long]) in l.iter().enumerate() {
+            eprintln!(
+                "{name} majorants, hero {h}: {:.1} segments a path, {:.2}% of more than 1,000",
+                *segments as f64 / *n as f64,
+                100.0 * *long as f64 / *n as f64
+            );
+        }
+    }
+    let mean = |l: [u64; 3]| l[1] as f64 / l[0] as f64;
+    for h in 0..3 {
+        assert!((mean(own[h]) / mean(own[2]) - 1.0).abs() < 0.1, "{own:?}");
+        assert!(own[h][2] * 50 > own[h][0], "{own:?}");
+    }
+    // One majorant: the red hero's paths end within ~570 collisions, the blue's live long.
+    assert_eq!(one[0][2], 0, "{one:?}");
+    assert!(one[2][2] * 50 > one[2][0], "{one:?}");
+    assert!(mean(one[0]) < 0.6 * mean(own[0]), "{one:?} {own:?}");
 }

@@ -7,18 +7,23 @@ mod common;
 
 use common::{TestRng, Z_MAX};
 use volpt_core::mesh::build::{build, check_closed, BuildError, MeshBuffers};
+use volpt_core::mesh::distance::resolution_for;
 use volpt_core::mesh::primitives::{cuboid, sphere, torus, IndexedMesh};
 use volpt_core::microfacet::Ggx;
 use volpt_core::path::{sample_pixel, trace};
 use volpt_core::shape::Shape;
 use volpt_core::{
-    Aabb, ConstantEnvironment, Estimator, HenyeyGreenstein, HomogeneousMedium, NullBoundary,
-    PathCounters, PathSettings, PathState, PerspectiveCamera, Ray, Rng, RoughDielectric,
-    SmoothDielectric, Spectrum, Vec2, Vec3, VolumeScene,
+    Aabb, BoundaryShape, ConstantEnvironment, Estimator, HenyeyGreenstein, HomogeneousMedium,
+    NullBoundary, PathCounters, PathSettings, PathState, PerspectiveCamera, Ray, Rng,
+    RoughDielectric, SmoothDielectric, Spectrum, Vec2, Vec3, VolumeScene,
 };
 
+/// The mesh's buffers with a distance grid of 16 cells along the longest axis, so that the
+/// tests' flights skip the ray cast where they cannot reach the surface.
 fn built((vertices, triangles): &IndexedMesh) -> MeshBuffers {
-    build(vertices, triangles).expect("a closed mesh builds")
+    let buffers = build(vertices, triangles).expect("a closed mesh builds");
+    let res = resolution_for(buffers.bounds, 16);
+    buffers.with_distances(res)
 }
 
 fn unit_box() -> Aabb {
@@ -405,7 +410,7 @@ fn image<S: volpt_core::Scene>(scene: &S, spp: u32) -> (Vec<[f64; 3]>, PathCount
     (pixels, counters)
 }
 
-fn box_and_mesh<B: volpt_core::Bsdf + Copy>(boundary: B, estimator: Estimator) {
+fn box_and_mesh<B: volpt_core::Bsdf + Copy>(boundary: B, estimator: Estimator, sigma_t: f32) {
     let b = unit_box();
     let buffers = built(&cuboid(b));
     let settings = PathSettings {
@@ -416,7 +421,7 @@ fn box_and_mesh<B: volpt_core::Bsdf + Copy>(boundary: B, estimator: Estimator) {
         camera: camera(),
         bounds: b,
         medium: HomogeneousMedium {
-            sigma_t: 2.0,
+            sigma_t,
             albedo: Spectrum::new(0.95, 0.8, 0.6),
         },
         boundary,
@@ -435,27 +440,102 @@ fn box_and_mesh<B: volpt_core::Bsdf + Copy>(boundary: B, estimator: Estimator) {
         lights: volpt_core::Lights::NONE,
         settings,
     };
+    // The factory's scene: either held as a run-time `BoundaryShape`.
+    let as_run_time = |shape| VolumeScene {
+        bounds: shape,
+        camera: boxed.camera,
+        medium: boxed.medium,
+        boundary,
+        phase: boxed.phase,
+        environment: boxed.environment,
+        lights: volpt_core::Lights::NONE,
+        settings,
+    };
     let (want, want_counters) = image(&boxed, 8);
-    let (got, got_counters) = image(&meshed, 8);
-    let differ = want.iter().zip(&got).filter(|(a, b)| a != b).count();
-    assert_eq!(differ, 0, "{differ} of {} pixels differ", want.len());
-    assert_eq!(want_counters, got_counters);
+    for (what, (got, got_counters)) in [
+        ("mesh", image(&meshed, 8)),
+        (
+            "BoundaryShape::Box",
+            image(&as_run_time(BoundaryShape::Box(b)), 8),
+        ),
+        (
+            "BoundaryShape::Mesh",
+            image(&as_run_time(BoundaryShape::Mesh(buffers.mesh())), 8),
+        ),
+    ] {
+        let differ = want.iter().zip(&got).filter(|(a, b)| a != b).count();
+        assert_eq!(
+            differ,
+            0,
+            "{what}, sigma_t {sigma_t}: {differ} of {} pixels differ",
+            want.len()
+        );
+        assert_eq!(want_counters, got_counters, "{what}, sigma_t {sigma_t}");
+    }
 }
 
 /// The 12-triangle cube traces the box's paths: the same images and counters, bit for bit, behind
-/// every boundary kind and with next-event estimation.
+/// every boundary kind and with next-event estimation, in a thin medium and in a dense one (where
+/// most flights skip the ray cast by the distance grid).
 #[test]
 fn the_cube_mesh_renders_the_box_image_bit_for_bit() {
-    for estimator in [Estimator::PathTracing, Estimator::NextEvent] {
-        box_and_mesh(NullBoundary, estimator);
-        box_and_mesh(SmoothDielectric { eta: 1.5 }, estimator);
-        box_and_mesh(
-            RoughDielectric {
-                eta: 1.33,
-                distribution: Ggx { alpha: 0.3 },
-            },
-            estimator,
-        );
+    for sigma_t in [2.0, 40.0] {
+        for estimator in [Estimator::PathTracing, Estimator::NextEvent] {
+            box_and_mesh(NullBoundary, estimator, sigma_t);
+            box_and_mesh(SmoothDielectric { eta: 1.5 }, estimator, sigma_t);
+            box_and_mesh(
+                RoughDielectric {
+                    eta: 1.33,
+                    distribution: Ggx { alpha: 0.3 },
+                },
+                estimator,
+                sigma_t,
+            );
+        }
+    }
+}
+
+/// The distance grid's bound from a point never exceeds the exit distance of any ray from it (so
+/// a flight shorter than the bound truly collides inside), and it is large enough to be worth
+/// having: in the sphere, the torus and the box, at random points and directions, it spares a
+/// good part of the casts of flights a tenth of the shape's size long.
+#[test]
+fn the_distance_bound_never_exceeds_the_exit_and_spares_most_casts() {
+    let mut rng = TestRng::new(3);
+    for (what, mesh) in [
+        ("sphere", test_sphere()),
+        ("torus", test_torus()),
+        ("box", cuboid(unit_box())),
+    ] {
+        let buffers = built(&mesh);
+        let shape = buffers.mesh();
+        let b = shape.bounds;
+        let (mut inside, mut spared) = (0, 0);
+        for _ in 0..20_000 {
+            let p = b.min + (b.max - b.min) * Vec3::new(rng.f32(), rng.f32(), rng.f32());
+            if !shape.contains(p) {
+                continue;
+            }
+            inside += 1;
+            let safe = shape.distance.at(p);
+            let flight = 0.1 * (b.max - b.min).min_element();
+            if flight < safe {
+                spared += 1;
+            }
+            for _ in 0..8 {
+                let ray = Ray::new(p, rng.unit_vector());
+                let exit = shape.exit_distance(&ray);
+                assert!(
+                    safe <= exit,
+                    "{what}: bound {safe} beyond the exit {exit} of {ray:?}"
+                );
+            }
+        }
+        let fraction = f64::from(spared) / f64::from(inside);
+        eprintln!("{what}: {spared} of {inside} flights spared the cast ({fraction:.2})");
+        // The points deeper than a flight are 49% of the sphere; a grid of 16 cells loses a
+        // cell's part of that.
+        assert!(fraction > 0.3, "{what}: only {fraction:.2} spared");
     }
 }
 

@@ -1,6 +1,6 @@
 //! What packing a PTX module costs and gives: `cargo run --release -p volpt-cuda --example
 //! pack-stats -- MODULE.ptx [ENTRY]`. Prints, for the whole module as one stream (zstd at several
-//! levels, and gzip through flate2), and for the pack (`volpt_cuda::kernels::layout`): the size,
+//! levels, and gzip through flate2), and for the pack (`volpt_cuda::kernels::layout`) at both levels: the size,
 //! the time to write it, the time to read all of it back, and to cut one kernel (ENTRY, by default
 //! the module's first entry of its largest group) from the pack and from the whole text.
 //!
@@ -88,19 +88,26 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
 
-    let start = Instant::now();
-    let bytes = layout::pack(&ptx)?;
-    let write = start.elapsed();
+    let mut packs = Vec::new();
+    for level in [layout::DEV_LEVEL, layout::RELEASE_LEVEL] {
+        let start = Instant::now();
+        let bytes = layout::pack(&ptx, level)?;
+        let write = start.elapsed();
+        let pack = KernelPack::parse(&bytes)?;
+        let (read, module) = timed(|| pack.module().expect("the pack reads back"));
+        assert_eq!(module, ptx);
+        row(
+            &format!("pack, zstd {level}"),
+            bytes.len(),
+            ptx.len(),
+            write,
+            read,
+        );
+        packs.push(bytes);
+    }
+    // The release build's pack, as the binary carries it.
+    let bytes = packs.pop().expect("two levels");
     let pack = KernelPack::parse(&bytes)?;
-    let (read, module) = timed(|| pack.module().expect("the pack reads back"));
-    assert_eq!(module, ptx);
-    row(
-        &format!("pack, zstd {}", layout::LEVEL),
-        bytes.len(),
-        ptx.len(),
-        write,
-        read,
-    );
 
     let entry = match args.next() {
         Some(entry) => entry,

@@ -33,6 +33,11 @@ pub enum CudaError {
     MissingKernel(String),
     #[error(transparent)]
     Empty(#[from] volpt_film::NothingToRender),
+    #[error(
+        "the GPU kernels trace box boundaries only: a triangle-mesh boundary renders on the CPU \
+         (--backend cpu)"
+    )]
+    MeshBoundary,
     #[error(transparent)]
     Volume(#[from] volpt_gpu_mem::GpuMemError),
     #[error("CUDA driver call failed while {doing}: {source}")]

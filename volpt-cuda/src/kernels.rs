@@ -421,7 +421,7 @@ mod tests {
         .visible .entry a__y(\n)\n{\n\tret;\n}\n.visible .entry selftest(\n)\n{\n}\n// end\n";
 
     fn packed() -> Vec<u8> {
-        layout::pack(MODULE).unwrap()
+        layout::pack(MODULE, layout::DEV_LEVEL).unwrap()
     }
 
     #[test]
@@ -445,7 +445,7 @@ mod tests {
 
     #[test]
     fn a_module_without_entries_packs_too() {
-        let bytes = layout::pack(".version 6.0\n").unwrap();
+        let bytes = layout::pack(".version 6.0\n", layout::DEV_LEVEL).unwrap();
         let pack = KernelPack::parse(&bytes).unwrap();
         assert_eq!(pack.entries().count(), 0);
         assert_eq!(pack.module().unwrap(), ".version 6.0\n");

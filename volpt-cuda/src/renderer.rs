@@ -287,6 +287,9 @@ impl CudaRenderer {
         scene: &S,
         keep: Option<u64>,
     ) -> Result<(VolumePlacer, S::Params), CudaError> {
+        if !scene.on_device() {
+            return Err(CudaError::MeshBoundary);
+        }
         // SAFETY: the grids are `scene`'s, borrowed by the caller for as long as it holds the
         // placer.
         let mut volumes = unsafe { VolumePlacer::new(self.stream.clone(), self.volumes) }?;

@@ -276,6 +276,7 @@ impl SceneBuilder for PrintScene<'_> {
             boundary: BoundaryDesc {
                 bounds,
                 bsdf: self.geometry.boundary,
+                mesh: None,
             },
             medium: MediumDesc {
                 phase: volume.phase(),

@@ -60,6 +60,7 @@ impl SceneBuilder for Shell {
             boundary: BoundaryDesc {
                 bounds,
                 bsdf: BsdfDesc::Null,
+                mesh: None,
             },
             medium: MediumDesc {
                 density: DensityDesc::Grid(GridDesc {

@@ -261,8 +261,35 @@ pub struct BoundarySpec {
     pub int_ior: Ior,
     #[serde(default = "thesis_ext_ior")]
     pub ext_ior: Ior,
-    /// The boundary box; by default the volume's.
+    /// The boundary box; by default the volume's (or the mesh's bounding box).
     pub bounds: Option<[[f32; 3]; 2]>,
+    /// A closed triangle mesh (`.obj`, `.ply`, `.stl`) as the boundary instead of a box,
+    /// relative to the scene file; placed by `scale`, then `rotate`, then `translate`.
+    pub mesh: Option<String>,
+    /// The mesh file's unit in scene units, one factor or one per axis (`0.001` reads a
+    /// millimetre file in metres).
+    pub scale: Option<MeshScale>,
+    /// A rotation of the mesh about the origin: `{ axis = [x, y, z], angle = degrees }`,
+    /// counter-clockwise looking down the axis (Mitsuba's `<rotate>`).
+    pub rotate: Option<MeshRotation>,
+    /// Where the mesh's origin goes.
+    pub translate: Option<[f32; 3]>,
+}
+
+/// `boundary.scale`: one factor, or one per axis.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(untagged)]
+pub enum MeshScale {
+    Uniform(f32),
+    PerAxis([f32; 3]),
+}
+
+/// `boundary.rotate`.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshRotation {
+    pub axis: [f32; 3],
+    pub angle: f32,
 }
 
 impl Default for BoundarySpec {
@@ -273,6 +300,10 @@ impl Default for BoundarySpec {
             int_ior: thesis_int_ior(),
             ext_ior: thesis_ext_ior(),
             bounds: None,
+            mesh: None,
+            scale: None,
+            rotate: None,
+            translate: None,
         }
     }
 }
@@ -306,6 +337,80 @@ fn thesis_ext_ior() -> Ior {
 }
 
 impl BoundarySpec {
+    /// The mesh `[boundary]` names, read from `path` (the resolved `boundary.mesh`) and placed;
+    /// `None` for a box boundary.
+    pub(crate) fn mesh(
+        &self,
+        cx: &Cx<'_>,
+        path: Option<&std::path::Path>,
+    ) -> Result<Option<std::sync::Arc<crate::mesh::MeshDesc>>, SceneError> {
+        let Some(path) = path else {
+            for (field, set) in [
+                ("boundary.scale", self.scale.is_some()),
+                ("boundary.rotate", self.rotate.is_some()),
+                ("boundary.translate", self.translate.is_some()),
+            ] {
+                if set {
+                    return Err(cx.invalid(field, "a boundary.mesh to place", "no mesh"));
+                }
+            }
+            return Ok(None);
+        };
+        if let Some(b) = self.bounds {
+            return Err(cx.invalid(
+                "boundary.bounds",
+                "no box with a boundary.mesh (the mesh's bounding box is the boundary's)",
+                format!("{b:?}"),
+            ));
+        }
+        let scale = match self.scale {
+            None => [1.0; 3],
+            Some(MeshScale::Uniform(s)) => [s; 3],
+            Some(MeshScale::PerAxis(s)) => s,
+        };
+        if !scale.iter().all(|s| s.is_finite() && *s != 0.0) {
+            return Err(cx.invalid(
+                "boundary.scale",
+                "finite, non-zero factors",
+                format!("{scale:?}"),
+            ));
+        }
+        let rotation = match self.rotate {
+            None => [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            Some(MeshRotation { axis, angle }) => {
+                let axis = axis.map(f64::from);
+                let len = axis.iter().map(|a| a * a).sum::<f64>().sqrt();
+                if !(len.is_finite() && len > 0.0 && angle.is_finite()) {
+                    return Err(cx.invalid(
+                        "boundary.rotate",
+                        "{ axis = [x, y, z] (not zero), angle = degrees }",
+                        format!("axis {axis:?}, angle {angle}"),
+                    ));
+                }
+                rotation(axis.map(|a| a / len), f64::from(angle).to_radians())
+            }
+        };
+        let translate = self.translate.unwrap_or([0.0; 3]);
+        if !translate.iter().all(|t| t.is_finite()) {
+            return Err(cx.invalid(
+                "boundary.translate",
+                "three finite numbers",
+                format!("{translate:?}"),
+            ));
+        }
+        // translate * rotate * scale.
+        let mut to_world = [[0.0; 4]; 4];
+        for r in 0..3 {
+            for c in 0..3 {
+                to_world[r][c] = rotation[r][c] * f64::from(scale[c]);
+            }
+            to_world[r][3] = f64::from(translate[r]);
+        }
+        to_world[3][3] = 1.0;
+        let soup = crate::mesh::read_mesh(path)?;
+        crate::mesh::MeshDesc::placed(path, &soup, &to_world).map(Some)
+    }
+
     /// The surface `[boundary]` describes.
     pub(crate) fn bsdf(&self, cx: &Cx<'_>) -> Result<BsdfDesc, SceneError> {
         let ior = |ior: &Ior, field: &str| match ior {
@@ -413,4 +518,16 @@ impl FromDescription<'_> for RoughDielectric {
     fn general(input: &BoundaryInput) -> Option<Self> {
         Self::specialised(input, &mut |_| ())
     }
+}
+
+/// The rotation by `angle` radians about the unit `axis`, counter-clockwise looking down it
+/// (Rodrigues).
+fn rotation([x, y, z]: [f64; 3], angle: f64) -> [[f64; 3]; 3] {
+    let (s, c) = angle.sin_cos();
+    let t = 1.0 - c;
+    [
+        [t * x * x + c, t * x * y - s * z, t * x * z + s * y],
+        [t * x * y + s * z, t * y * y + c, t * y * z - s * x],
+        [t * x * z - s * y, t * y * z + s * x, t * z * z + c],
+    ]
 }

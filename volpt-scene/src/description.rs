@@ -13,6 +13,7 @@ pub use crate::boundary::BsdfDesc;
 pub use crate::environment::{EnvironmentDesc, LatLongDesc, LatLongRows};
 pub use crate::light::{LightsDesc, SpotCone, SpotDesc, SunDesc};
 pub use crate::medium::{AlbedoDesc, DensityDesc, GridLookup, GridStorage, MediumDesc};
+pub use crate::mesh::MeshDesc;
 pub use crate::phase::PhaseDesc;
 
 /// An axis-aligned box in world space.
@@ -101,11 +102,46 @@ pub struct IntegratorDesc {
     pub rr_depth: Option<u32>,
 }
 
-/// The shape that encloses the medium, and its surface.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+/// The shape that encloses the medium, and its surface: the box `bounds`, or a closed triangle
+/// mesh whose bounding box `bounds` is.
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct BoundaryDesc {
     pub bounds: Bounds,
     pub bsdf: BsdfDesc,
+    /// The mesh, if the boundary is one; shared, not copied, by the scenes made from this one.
+    #[serde(serialize_with = "serialize_mesh")]
+    pub mesh: Option<std::sync::Arc<MeshDesc>>,
+}
+
+fn serialize_mesh<S: serde::Serializer>(
+    mesh: &Option<std::sync::Arc<MeshDesc>>,
+    serializer: S,
+) -> Result<S::Ok, S::Error> {
+    mesh.as_deref().serialize(serializer)
+}
+
+impl BoundaryDesc {
+    /// The box `bounds` with surface `bsdf`.
+    pub fn box_(bounds: Bounds, bsdf: BsdfDesc) -> Self {
+        Self {
+            bounds,
+            bsdf,
+            mesh: None,
+        }
+    }
+
+    /// `mesh` with surface `bsdf`; its bounding box is the boundary's box.
+    pub fn mesh(mesh: std::sync::Arc<MeshDesc>, bsdf: BsdfDesc) -> Self {
+        let b = mesh.buffers.bounds;
+        Self {
+            bounds: Bounds {
+                min: b.min.to_array(),
+                max: b.max.to_array(),
+            },
+            bsdf,
+            mesh: Some(mesh),
+        }
+    }
 }
 
 /// Where the grid's samples sit inside its bounding box.

@@ -187,7 +187,7 @@ impl fmt::Display for MaterialProblem {
         match self {
             Self::TableSize { found } => write!(
                 f,
-                "materials: expected 1 to 256 materials (indices are bytes), found {found}"
+                "materials: expected 1 to 65536 materials (indices are at most 16 bits), found {found}"
             ),
             Self::IndexOutOfTable {
                 voxel,

@@ -11,7 +11,7 @@ use std::fmt;
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
-use volpt_core::material::{Material, MATERIAL_FLOATS, MAX_MATERIALS};
+use volpt_core::material::{wide_indices, Material, MATERIAL_FLOATS, MAX_MATERIALS};
 use volpt_core::Spectrum;
 
 use crate::description::{Bounds, GridConvention, GridDesc, SampleLayout};
@@ -88,15 +88,16 @@ pub struct IndexedDesc {
 }
 
 impl IndexedDesc {
-    /// The volume of `indices` (one byte per voxel, x fastest) over `bounds` with `materials`;
-    /// `path` names the index grid's file in errors. Refuses a table of more than 256 materials,
-    /// a grid whose size is not the resolution's, and an index outside the table.
-    pub fn new(
+    /// The volume of `indices` (one per voxel, x fastest: bytes, or `u16`s for more than 256
+    /// materials) over `bounds` with `materials`; `path` names the index grid's file in errors.
+    /// Refuses a table of more than 65536 materials, a grid whose size is not the resolution's,
+    /// and an index outside the table.
+    pub fn new<I: MaterialIndex>(
         path: &Path,
         materials: Vec<MaterialDesc>,
         resolution: [u32; 3],
         bounds: Bounds,
-        indices: &[u8],
+        indices: &[I],
     ) -> Result<Self, SceneError> {
         let error = |problem| SceneError::Material {
             path: path.to_owned(),
@@ -132,9 +133,9 @@ impl IndexedDesc {
     }
 
     /// Replaces every voxel's index (a printing application's next iteration): `indices` holds
-    /// one byte per voxel of the same resolution, each below the table's length. On an error the
-    /// volume is left as it was.
-    pub fn set_indices(&mut self, indices: &[u8]) -> Result<(), MaterialProblem> {
+    /// one per voxel of the same resolution (bytes or `u16`s), each below the table's length. On
+    /// an error the volume is left as it was.
+    pub fn set_indices<I: MaterialIndex>(&mut self, indices: &[I]) -> Result<(), MaterialProblem> {
         let voxels = self.voxels();
         if indices.len() as u64 != voxels {
             return Err(MaterialProblem::GridSize {
@@ -144,14 +145,14 @@ impl IndexedDesc {
             });
         }
         let count = self.materials.len();
-        if let Some(i) = indices.iter().position(|&k| k as usize >= count) {
+        if let Some(i) = indices.iter().position(|&k| k.get() as usize >= count) {
             return Err(MaterialProblem::IndexOutOfTable {
                 voxel: self.voxel(i as u64),
-                index: indices[i] as u32,
+                index: indices[i].get(),
                 materials: count,
             });
         }
-        self.indices = pack(indices);
+        self.indices = pack(indices, wide_indices(count));
         Ok(())
     }
 
@@ -185,7 +186,7 @@ impl IndexedDesc {
                 ];
                 return Err(error(MaterialProblem::NotAnIndex { voxel, value: v }));
             }
-            indices.push(v as u8);
+            indices.push(v as u16);
         }
         Self::new(path, materials, grid.resolution, grid.bounds, &indices)
     }
@@ -206,11 +207,16 @@ impl IndexedDesc {
     }
 
     /// The index of voxel `i` (x fastest).
-    pub fn index(&self, i: u64) -> u8 {
-        (self.indices[(i >> 2) as usize] >> ((i & 3) * 8)) as u8
+    pub fn index(&self, i: u64) -> u32 {
+        if wide_indices(self.materials.len()) {
+            (self.indices[(i >> 1) as usize] >> ((i & 1) * 16)) & 0xffff
+        } else {
+            (self.indices[(i >> 2) as usize] >> ((i & 3) * 8)) & 0xff
+        }
     }
 
-    /// The indices, four to a word (little end first), as the core's grid reads them.
+    /// The indices, four bytes to a word (little end first; two `u16`s for more than 256
+    /// materials), as the core's grid reads them.
     pub fn packed_indices(&self) -> &[u32] {
         &self.indices
     }
@@ -295,20 +301,49 @@ impl IndexedDesc {
         (expand(|m| m.sigma_t), expand(|m| m.albedo))
     }
 
-    /// Bytes on a GPU: one per voxel (rounded up to a word), and the table.
+    /// Bytes on a GPU: one per voxel (two for more than 256 materials; rounded up to a word),
+    /// and the table.
     pub fn device_bytes(&self) -> u64 {
         self.indices.len() as u64 * 4 + (self.materials.len() * MATERIAL_FLOATS * 4) as u64
     }
 }
 
-/// One byte per voxel, four to a word, little end first.
-fn pack(indices: &[u8]) -> Vec<u32> {
+/// A material index as a caller holds it: a byte, or a `u16` for a table of more than 256.
+pub trait MaterialIndex: Copy {
+    /// The index's value.
+    fn get(self) -> u32;
+    /// Index `k`, which the caller knows fits.
+    fn narrow(k: usize) -> Self;
+}
+
+impl MaterialIndex for u8 {
+    fn get(self) -> u32 {
+        self.into()
+    }
+    fn narrow(k: usize) -> Self {
+        k as u8
+    }
+}
+
+impl MaterialIndex for u16 {
+    fn get(self) -> u32 {
+        self.into()
+    }
+    fn narrow(k: usize) -> Self {
+        k as u16
+    }
+}
+
+/// The indices (each below the table's length, checked) packed as the core reads them: one byte
+/// per voxel, four to a word, or where `wide` two bytes, two to a word; little end first.
+fn pack<I: MaterialIndex>(indices: &[I], wide: bool) -> Vec<u32> {
+    let (per_word, bits) = if wide { (2, 16) } else { (4, 8) };
     indices
-        .chunks(4)
+        .chunks(per_word)
         .map(|c| {
-            let mut word = [0u8; 4];
-            word[..c.len()].copy_from_slice(c);
-            u32::from_le_bytes(word)
+            c.iter()
+                .enumerate()
+                .fold(0u32, |word, (j, k)| word | k.get() << (bits * j))
         })
         .collect()
 }
@@ -323,14 +358,16 @@ impl fmt::Display for InfoTable<'_> {
         writeln!(
             f,
             "material-indexed {}x{}x{} voxels, bounds {:?} .. {:?}, {} materials; GPU memory {} bytes \
-             (1 byte a voxel and the table)",
+             ({} a voxel and the table)",
             d.resolution[0],
             d.resolution[1],
             d.resolution[2],
             d.bounds.min,
             d.bounds.max,
             d.materials.len(),
-            d.device_bytes()
+            d.device_bytes(),
+            // More than 256 materials take u16 indices (`pack`).
+            if d.materials.len() > 256 { "2 bytes" } else { "1 byte" }
         )?;
         for (k, (m, n)) in d.materials.iter().zip(counts).enumerate() {
             let t = m.material();

@@ -28,7 +28,7 @@ use crate::material::{IndexedDesc, InfoTable, MaterialDesc};
 use crate::mitsuba::export::rgb_element;
 use crate::mitsuba::plugin::{quoted, Arg, Ctx, Plugin};
 use crate::mitsuba::preprocess::Dialect;
-use crate::mitsuba::volume::{constant_error, volume, Role, VolumeValue};
+use crate::mitsuba::volume::{constant_error, volume, Filter, Role, VolumeValue};
 use crate::mitsuba::xml::Element;
 use crate::phase::PhaseDesc;
 use crate::simplification::Simplification;
@@ -82,6 +82,10 @@ pub enum GridLookup {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub enum DensityDesc {
     Constant(f32),
+    /// One channel (a grey extinction), or three: a density per channel, a chromatic extinction
+    /// (Mitsuba 3's RGB `sigma_t` `gridvolume`; [`volpt_core::ChromaticMedium::per_channel`]).
+    /// The readers store a three-channel grid whose channels agree in every sample as one
+    /// channel ([`grey_if_equal`]).
     Grid(GridDesc),
     /// A constant density per channel: a chromatic extinction, `scale * rgb` (milk, skin, a
     /// print's resin; [`volpt_core::ChromaticMedium`]). Equal channels render as `Constant`.
@@ -110,7 +114,8 @@ pub(crate) type GridWriter<'a> =
 impl MediumDesc {
     /// Mitsuba's interior `<medium>`: `homogeneous` or `heterogeneous`, with its phase function.
     ///
-    /// A constant extinction may differ between R, G and B (a chromatic medium); a grid's is grey. Parameter names differ between generations (Mitsuba 0.6 `sigmaA`,
+    /// The extinction may differ between R, G and B (a chromatic medium): an RGB constant, or a
+    /// three-channel `gridvolume` (a density per channel, scaled by `scale`). Parameter names differ between generations (Mitsuba 0.6 `sigmaA`,
     /// `sigmaS`, `density`; Mitsuba 3 `sigma_t`, `albedo`) and both are accepted in either. Where
     /// a parameter is absent, Mitsuba 3's defaults apply (extinction 1, albedo 0.75); Mitsuba 0.6
     /// has material-preset defaults volpt does not carry, so there it must be given.
@@ -154,8 +159,9 @@ impl MediumDesc {
             Some(arg) => PhaseDesc::from_mitsuba(arg.target, ctx)?,
             None => PhaseDesc::Isotropic,
         };
-        let (density, albedo) = if kind == "homogeneous" {
-            homogeneous(&p)?
+        let (density, albedo, lookup) = if kind == "homogeneous" {
+            let (density, albedo) = homogeneous(&p)?;
+            (density, albedo, GridLookup::Trilinear)
         } else {
             heterogeneous(&p)?
         };
@@ -167,9 +173,29 @@ impl MediumDesc {
             scale,
             albedo,
             phase,
-            lookup: Default::default(),
+            lookup,
             storage: Default::default(),
         })
+    }
+}
+
+/// A density grid of three channels that agree in every sample as the grey grid it is (one
+/// channel): a chromatic medium whose channels are equal renders as a grey one. Other grids are
+/// returned as they are.
+pub(crate) fn grey_if_equal(grid: GridDesc) -> GridDesc {
+    let grey = grid.channels == 3
+        && grid.layout == SampleLayout::Dense
+        && grid
+            .data
+            .chunks_exact(3)
+            .all(|v| v[0].to_bits() == v[1].to_bits() && v[0].to_bits() == v[2].to_bits());
+    if !grey {
+        return grid;
+    }
+    GridDesc {
+        channels: 1,
+        data: grid.data.iter().step_by(3).copied().collect(),
+        ..grid
     }
 }
 
@@ -245,7 +271,11 @@ fn homogeneous(p: &Plugin<'_>) -> Result<(DensityDesc, AlbedoDesc), SceneError> 
     }
 }
 
-fn heterogeneous(p: &Plugin<'_>) -> Result<(DensityDesc, AlbedoDesc), SceneError> {
+/// A heterogeneous medium's extinction and albedo, and how its grids are read: nearest where
+/// every grid's `filter_type` says so (volpt reads a medium's grids one way), else trilinearly
+/// (grids whose filters differ are warned about).
+fn heterogeneous(p: &Plugin<'_>) -> Result<(DensityDesc, AlbedoDesc, GridLookup), SceneError> {
+    let mut filters = Vec::new();
     let density = match p.find(&["density", "sigma_t"])? {
         None => DensityDesc::Constant(default_for(
             p,
@@ -253,7 +283,10 @@ fn heterogeneous(p: &Plugin<'_>) -> Result<(DensityDesc, AlbedoDesc), SceneError
             "<volume name=\"density\">",
         )?),
         Some(arg) => match volume(&arg, p.ctx, Role::Density)? {
-            VolumeValue::Grid(grid) => DensityDesc::Grid(grid),
+            VolumeValue::Grid(grid, filter) => {
+                filters.push(filter);
+                DensityDesc::Grid(grey_if_equal(grid))
+            }
             VolumeValue::Constant(v) => extinction(non_negative(&arg, v)?),
         },
     };
@@ -262,23 +295,39 @@ fn heterogeneous(p: &Plugin<'_>) -> Result<(DensityDesc, AlbedoDesc), SceneError
             AlbedoDesc::Constant([default_for(p, DEFAULT_ALBEDO, "<volume name=\"albedo\">")?; 3])
         }
         Some(arg) => match volume(&arg, p.ctx, Role::Albedo)? {
-            VolumeValue::Grid(grid) => AlbedoDesc::Grid(grid),
+            VolumeValue::Grid(grid, filter) => {
+                filters.push(filter);
+                AlbedoDesc::Grid(grid)
+            }
             VolumeValue::Constant(v) => AlbedoDesc::Constant(in_unit_range(&arg, v)?),
         },
+    };
+    let lookup = match filters[..] {
+        [Filter::Nearest] | [Filter::Nearest, Filter::Nearest] => GridLookup::Nearest,
+        [Filter::Trilinear, Filter::Nearest] | [Filter::Nearest, Filter::Trilinear] => {
+            tracing::warn!(
+                "{}:{}: the medium's grids have different filter_type values: volpt reads both \
+                 trilinearly",
+                p.el.file.display(),
+                p.el.line
+            );
+            GridLookup::Trilinear
+        }
+        _ => GridLookup::Trilinear,
     };
     p.warn_unless(
         &["method"],
         "woodcock",
         "delta (Woodcock) tracking, which is unbiased",
     )?;
-    Ok((density, albedo))
+    Ok((density, albedo, lookup))
 }
 
 /// A constant parameter of a homogeneous medium (a grid would need a heterogeneous one).
 fn constant(p: &Plugin<'_>, arg: &Arg<'_>) -> Result<[f32; 3], SceneError> {
     match volume(arg, p.ctx, Role::Density)? {
         VolumeValue::Constant(v) => Ok(v),
-        VolumeValue::Grid(_) => Err(SceneError::Unsupported {
+        VolumeValue::Grid(..) => Err(SceneError::Unsupported {
             path: arg.target.file.to_path_buf(),
             line: arg.target.line,
             what: arg.target.describe(),
@@ -456,12 +505,17 @@ impl MediumDesc {
         let sparse = self.grids().any(|(_, g)| g.layout == SampleLayout::Sparse);
         let plain_reads =
             self.lookup == GridLookup::Trilinear && self.storage == GridStorage::Dense;
-        let chromatic_grids =
-            matches!(self.density, DensityDesc::Rgb(_)) && self.grids().next().is_some();
-        if chromatic_grids && (sparse || !plain_reads) {
+        let chromatic_grids = match &self.density {
+            DensityDesc::Rgb(_) => self.grids().next().is_some(),
+            DensityDesc::Grid(g) => g.channels == 3,
+            DensityDesc::Constant(_) | DensityDesc::Indexed(_) => false,
+        };
+        let chromatic_reads = plain_reads
+            || (self.lookup == GridLookup::Nearest && self.storage == GridStorage::Dense);
+        if chromatic_grids && (sparse || !chromatic_reads) {
             return Err(invalid(
                 "grid lookup",
-                "trilinear lookups of dense grids beside a chromatic extinction",
+                "trilinear or nearest lookups of dense grids beside a chromatic extinction",
                 format!("{:?} lookups, {:?} storage", self.lookup, self.storage),
             ));
         }
@@ -563,7 +617,8 @@ impl MediumDesc {
         match &self.density {
             DensityDesc::Rgb(rgb) => !rgb.iter().all(|&c| c == rgb[0]),
             DensityDesc::Indexed(_) => true,
-            DensityDesc::Constant(_) | DensityDesc::Grid(_) => false,
+            DensityDesc::Grid(g) => g.channels == 3,
+            DensityDesc::Constant(_) => false,
         }
     }
 
@@ -574,6 +629,11 @@ impl MediumDesc {
         &self,
         grid: &mut GridWriter<'_>,
     ) -> Result<(&'static str, String, String), SceneError> {
+        // Nearest lookups are Mitsuba 3's `nearest` filter; the others are written trilinear.
+        let filter = match self.lookup {
+            GridLookup::Nearest => "nearest",
+            _ => "trilinear",
+        };
         let (medium_type, sigma_t) = match &self.density {
             DensityDesc::Constant(d) => (
                 "homogeneous",
@@ -590,7 +650,7 @@ impl MediumDesc {
                 };
                 ("homogeneous", rgb_element("sigma_t", &unit))
             }
-            DensityDesc::Grid(g) => ("heterogeneous", grid(g, "density", "sigma_t", "trilinear")?),
+            DensityDesc::Grid(g) => ("heterogeneous", grid(g, "density", "sigma_t", filter)?),
             // Mitsuba 3 reads no material table: the table expanded per voxel, read nearest.
             DensityDesc::Indexed(indexed) => {
                 let g = indexed.materials().first().map_or(0.0, |m| m.g);
@@ -612,7 +672,7 @@ impl MediumDesc {
         };
         let albedo = match &self.albedo {
             AlbedoDesc::Constant(rgb) => rgb_element("albedo", rgb),
-            AlbedoDesc::Grid(g) => grid(g, "albedo", "albedo", "trilinear")?,
+            AlbedoDesc::Grid(g) => grid(g, "albedo", "albedo", filter)?,
         };
         Ok((medium_type, sigma_t, albedo))
     }
@@ -815,7 +875,7 @@ impl MediumDesc {
             g,
             colour: None,
         });
-        let indices = [0, 1, 2, 1, 2, 0, 2, 0, 1, 0, 2, 1];
+        let indices: [u8; 12] = [0, 1, 2, 1, 2, 0, 2, 0, 1, 0, 2, 1];
         let indexed = IndexedDesc::new(
             std::path::Path::new("example"),
             materials.to_vec(),
@@ -939,6 +999,9 @@ impl fmt::Display for DensityDesc {
             DensityDesc::Constant(d) => write!(f, "constant {d}"),
             DensityDesc::Rgb(rgb) => write!(f, "constant RGB {rgb:?} (chromatic)"),
             DensityDesc::Indexed(indexed) => write!(f, "{}", InfoTable(indexed)),
+            DensityDesc::Grid(g) if g.channels == 3 => {
+                write!(f, "{} (a density per channel: chromatic)", InfoGrid(g))
+            }
             DensityDesc::Grid(g) => write!(f, "{}", InfoGrid(g)),
         }
     }
@@ -1020,6 +1083,17 @@ enum Density<'a> {
     Indexed(&'a IndexedDesc),
 }
 
+impl Density<'_> {
+    /// Whether the extinction differs between channels: only [`ChromaticMedium`] renders it.
+    fn is_chromatic(&self) -> bool {
+        match self {
+            Density::Rgb(_) | Density::Indexed(_) => true,
+            Density::Grid(g) => g.channels == 3,
+            Density::Constant(_) => false,
+        }
+    }
+}
+
 enum Albedo<'a> {
     /// Three channels.
     Constant(&'a [f32]),
@@ -1043,7 +1117,11 @@ impl<'a> MediumInput<'a> {
             DensityDesc::Grid(grid) => match uniform(grid) {
                 Some(value) => {
                     fired(Simplification::ConstantDensityGrid);
-                    Density::Constant(&value[0])
+                    // A density per channel of one value each: an RGB constant.
+                    match <&[f32; 3]>::try_from(value) {
+                        Ok(rgb) if rgb.iter().any(|&c| c != rgb[0]) => Density::Rgb(rgb),
+                        _ => Density::Constant(&value[0]),
+                    }
                 }
                 None => Density::Grid(grid),
             },
@@ -1112,7 +1190,7 @@ impl<'a, R: ReadsRule> FromDescription<'a> for GridMedium<'a, ConstantAlbedo, R>
     type Input = MediumInput<'a>;
 
     fn specialised(input: &MediumInput<'a>, _: &mut dyn FnMut(Simplification)) -> Option<Self> {
-        if matches!(input.density, Density::Rgb(_) | Density::Indexed(_)) {
+        if input.density.is_chromatic() {
             return None;
         }
         match input.albedo {
@@ -1139,9 +1217,7 @@ impl<'a, R: ReadsRule> FromDescription<'a> for GridMedium<'a, GridAlbedo<'a, R>,
     }
 
     fn general(input: &MediumInput<'a>) -> Option<Self> {
-        if !R::asked_by(input.medium)
-            || matches!(input.density, Density::Rgb(_) | Density::Indexed(_))
-        {
+        if !R::asked_by(input.medium) || input.density.is_chromatic() {
             return None;
         }
         let albedo = match input.albedo {
@@ -1152,8 +1228,8 @@ impl<'a, R: ReadsRule> FromDescription<'a> for GridMedium<'a, GridAlbedo<'a, R>,
     }
 }
 
-/// A chromatic extinction, which only this part renders (read trilinearly from dense grids: an
-/// albedo grid of other lookups or storage is refused when the scene is checked).
+/// A chromatic extinction, which only this part renders (read trilinearly from dense grids: a
+/// density or albedo grid of other lookups or storage is refused when the scene is checked).
 impl<'a> FromDescription<'a> for ChromaticMedium<'a> {
     type Input = MediumInput<'a>;
 
@@ -1162,8 +1238,20 @@ impl<'a> FromDescription<'a> for ChromaticMedium<'a> {
     }
 
     fn general(input: &MediumInput<'a>) -> Option<Self> {
+        let (albedo, albedo_grid) = match input.albedo {
+            Albedo::Constant(a) => (Spectrum::new(a[0], a[1], a[2]), None),
+            Albedo::Grid(g) => (Spectrum::ZERO, Some(grid::<3>(g, input.medium.lookup))),
+        };
         let rgb = match input.density {
             Density::Rgb(rgb) => rgb,
+            Density::Grid(g) if g.channels == 3 => {
+                return Some(ChromaticMedium::per_channel(
+                    Spectrum::splat(input.medium.scale),
+                    grid::<3>(g, input.medium.lookup),
+                    albedo,
+                    albedo_grid,
+                ))
+            }
             Density::Indexed(indexed) => {
                 return Some(ChromaticMedium::indexed(MaterialGrid::new(
                     indexed.packed_indices(),
@@ -1174,10 +1262,6 @@ impl<'a> FromDescription<'a> for ChromaticMedium<'a> {
                 )))
             }
             Density::Constant(_) | Density::Grid(_) => return None,
-        };
-        let (albedo, albedo_grid) = match input.albedo {
-            Albedo::Constant(a) => (Spectrum::new(a[0], a[1], a[2]), None),
-            Albedo::Grid(g) => (Spectrum::ZERO, Some(grid::<3>(g, input.medium.lookup))),
         };
         let extinction = input.medium.scale * Spectrum::from_array(*rgb);
         Some(ChromaticMedium::new(extinction, None, albedo, albedo_grid))

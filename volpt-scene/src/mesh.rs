@@ -11,6 +11,9 @@
 use std::collections::HashMap;
 use std::fmt;
 use std::path::Path;
+use std::sync::Arc;
+
+use serde::{Serialize, Serializer};
 
 use volpt_core::mesh::build::{build, BuildError, MeshBuffers};
 
@@ -93,6 +96,106 @@ fn parse_error(line: Option<usize>, field: &str, expected: &str, found: &str) ->
         field: field.into(),
         expected: expected.into(),
         found: format!("\"{found}\""),
+    }
+}
+
+/// A closed triangle mesh that bounds the medium, placed in world space, with its BVH. The
+/// boundary's box ([`crate::BoundaryDesc::bounds`]) is then the mesh's bounding box.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshDesc {
+    /// What it was made from (a file, or Mitsuba's `sphere`), for `volpt info`.
+    pub source: String,
+    pub buffers: MeshBuffers,
+    /// FNV-1a of the triangles' bytes: what a scene's fingerprint takes in for them.
+    pub content: u64,
+}
+
+impl MeshDesc {
+    /// Checks `soup`, places it by `to_world` (a row-major affine transform, applied in f64, each
+    /// coordinate then rounded once to f32) and builds its BVH; `source` names it in errors and
+    /// in `volpt info`. A mirroring transform reverses every triangle, so that they still face
+    /// outwards.
+    pub fn placed(
+        source: &Path,
+        soup: &TriangleSoup,
+        to_world: &[[f64; 4]; 4],
+    ) -> Result<Arc<Self>, SceneError> {
+        let m = to_world;
+        let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+        let vertices: Vec<[f32; 3]> = soup
+            .vertices
+            .iter()
+            .map(|v| {
+                let p = v.map(f64::from);
+                core::array::from_fn(|r| {
+                    (m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3]) as f32
+                })
+            })
+            .collect();
+        let triangles: Vec<[u32; 3]> = if det < 0.0 {
+            soup.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect()
+        } else {
+            soup.triangles.clone()
+        };
+        let placed = TriangleSoup {
+            vertices,
+            triangles,
+        };
+        let buffers = with_distances(build_mesh(source, &placed)?);
+        let mut hash = FNV_OFFSET;
+        for t in &buffers.triangles {
+            for byte in bytemuck::bytes_of(t) {
+                hash = (hash ^ u64::from(*byte)).wrapping_mul(FNV_PRIME);
+            }
+        }
+        Ok(Arc::new(Self {
+            source: source.display().to_string(),
+            buffers,
+            content: hash,
+        }))
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.buffers.triangles.len()
+    }
+}
+
+/// `buffers` with their distance grid ([`volpt_core::mesh::distance`]), its slabs computed on
+/// every core.
+fn with_distances(mut buffers: MeshBuffers) -> MeshBuffers {
+    use volpt_core::mesh::distance::{distance_slab, resolution_for, DISTANCE_RESOLUTION};
+    let res = resolution_for(buffers.bounds, DISTANCE_RESOLUTION);
+    let slab = (res[0] * res[1]) as usize;
+    let mut values = vec![0.0; slab * res[2] as usize];
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let slabs_per_thread = (res[2] as usize).div_ceil(threads);
+    let mesh = buffers.mesh();
+    std::thread::scope(|scope| {
+        for (chunk, out) in values.chunks_mut(slab * slabs_per_thread).enumerate() {
+            let mesh = &mesh;
+            scope.spawn(move || {
+                for (i, out) in out.chunks_mut(slab).enumerate() {
+                    let z = chunk * slabs_per_thread + i;
+                    distance_slab(mesh, res, z as u32, out);
+                }
+            });
+        }
+    });
+    buffers.distances = values;
+    buffers.distance_res = res;
+    buffers
+}
+
+const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+const FNV_PRIME: u64 = 0x0000_0100_0000_01b3;
+
+/// The source, the triangle count and the triangles' hash: not the triangles themselves, which
+/// may be millions (a fingerprint serialises the description at every render).
+impl Serialize for MeshDesc {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        (&self.source, self.triangle_count() as u64, self.content).serialize(serializer)
     }
 }
 

@@ -14,7 +14,8 @@ use std::path::{Path, PathBuf};
 
 use crate::error::{MaterialProblem, SceneError};
 use crate::limits::{bytes_of, check_memory, open_regular};
-use crate::material::MaterialDesc;
+use crate::material::{MaterialDesc, MaterialIndex};
+use volpt_core::material::wide_indices;
 
 /// The PNG files of a folder, in the natural order of their names (hidden files skipped).
 pub fn slice_files(dir: &Path) -> Result<Vec<PathBuf>, SceneError> {
@@ -27,13 +28,35 @@ pub fn slice_files(dir: &Path) -> Result<Vec<PathBuf>, SceneError> {
     Ok(files)
 }
 
-/// The material indices of the slice stack in `dir` (one byte per voxel, x fastest) and its
-/// resolution; `layers`, if given, is the slice count the scene expects.
+/// A slice stack's material indices, one per voxel, x fastest.
+pub enum SliceIndices {
+    /// For a table of at most 256 materials.
+    Bytes(Vec<u8>),
+    /// For a larger table.
+    Wide(Vec<u16>),
+}
+
+/// The material indices of the slice stack in `dir` (bytes, or `u16`s for a table of more than
+/// 256 materials) and its resolution; `layers`, if given, is the slice count the scene expects.
 pub fn read_slices(
     dir: &Path,
     materials: &[MaterialDesc],
     layers: Option<u32>,
-) -> Result<(Vec<u8>, [u32; 3]), SceneError> {
+) -> Result<(SliceIndices, [u32; 3]), SceneError> {
+    Ok(if wide_indices(materials.len()) {
+        let (indices, res) = read_slices_as(dir, materials, layers)?;
+        (SliceIndices::Wide(indices), res)
+    } else {
+        let (indices, res) = read_slices_as(dir, materials, layers)?;
+        (SliceIndices::Bytes(indices), res)
+    })
+}
+
+fn read_slices_as<I: MaterialIndex>(
+    dir: &Path,
+    materials: &[MaterialDesc],
+    layers: Option<u32>,
+) -> Result<(Vec<I>, [u32; 3]), SceneError> {
     let error = |problem| SceneError::Material {
         path: dir.to_owned(),
         problem,
@@ -72,7 +95,7 @@ pub fn read_slices(
     check_memory(
         dir,
         &format!("the index grid of {w} x {h} x {found} voxels"),
-        bytes_of(voxels, 1),
+        bytes_of(voxels, std::mem::size_of::<I>() as u64),
     )?;
     let mut indices = Vec::with_capacity(voxels as usize);
     for file in &files {
@@ -82,7 +105,10 @@ pub fn read_slices(
 }
 
 /// Colour to material index; every material of a slice stack's table needs a distinct colour.
-fn palette(dir: &Path, materials: &[MaterialDesc]) -> Result<HashMap<[u8; 3], u8>, SceneError> {
+fn palette<I: MaterialIndex>(
+    dir: &Path,
+    materials: &[MaterialDesc],
+) -> Result<HashMap<[u8; 3], I>, SceneError> {
     let mut palette = HashMap::new();
     for (k, m) in materials.iter().enumerate() {
         let invalid = |expected: &str, found: String| SceneError::InvalidScene {
@@ -97,7 +123,7 @@ fn palette(dir: &Path, materials: &[MaterialDesc]) -> Result<HashMap<[u8; 3], u8
                 "none".into(),
             ));
         };
-        if palette.insert(colour, k as u8).is_some() {
+        if palette.insert(colour, I::narrow(k)).is_some() {
             return Err(invalid(
                 "a colour no other material has",
                 format!("{colour:?} twice"),
@@ -128,11 +154,11 @@ fn header(file: &Path, slice: &str) -> Result<(u32, u32), SceneError> {
 }
 
 /// Appends a slice's material indices to `out`.
-fn decode(
+fn decode<I: MaterialIndex>(
     file: &Path,
     slice: &str,
-    palette: &HashMap<[u8; 3], u8>,
-    out: &mut Vec<u8>,
+    palette: &HashMap<[u8; 3], I>,
+    out: &mut Vec<I>,
 ) -> Result<(), SceneError> {
     let error = |problem| SceneError::Material {
         path: file.to_owned(),

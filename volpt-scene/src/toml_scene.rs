@@ -8,6 +8,7 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use serde::Deserialize;
 
@@ -409,7 +410,7 @@ fn assemble(
 
     let volume_path = resolve(&v.file, "volume.file")?;
     if !file.materials.is_empty() {
-        return assemble_indexed(cx, &file, &volume_path);
+        return assemble_indexed(cx, &file, &volume_path, dir, params);
     }
     if v.format == Some(VolumeFormat::Png) {
         return Err(cx.invalid(
@@ -418,12 +419,33 @@ fn assemble(
             "no [[materials]]",
         ));
     }
+    let mesh_path = match &file.boundary.mesh {
+        Some(m) => Some(resolve(m, "boundary.mesh")?),
+        None => None,
+    };
+    let mesh = file.boundary.mesh(cx, mesh_path.as_deref())?;
+    // The grids lie over the mesh's bounding box unless `volume.bounds` places them.
+    let mesh_box = match (&mesh, v.bounds) {
+        (Some(m), None) => Some(crate::BoundaryDesc::mesh(m.clone(), BsdfDesc::Null).bounds),
+        _ => None,
+    };
     let (mut grid, file_box) = read_volume(cx, &volume_path, v)?;
+    if let Some(b) = mesh_box {
+        grid.bounds = b;
+    }
     if let Some(target) = v.normalise {
         if !(target.is_finite() && target > 0.0) {
             return Err(cx.invalid("volume.normalise", "a positive density", target));
         }
         grid = normalise(grid, target);
+    }
+    let grid = crate::medium::grey_if_equal(grid);
+    if grid.channels == 3 && file.albedo.transfer_function.is_some() {
+        return Err(cx.invalid(
+            "albedo.transfer_function",
+            "a one-channel density to apply it to (or an albedo value)",
+            "a density grid of three channels",
+        ));
     }
     if !(v.scale.is_finite() && v.scale >= 0.0) {
         return Err(cx.invalid("volume.scale", "a finite scale >= 0", v.scale));
@@ -444,13 +466,13 @@ fn assemble(
                 sparsity: sparsity(cx, v)?,
             };
             let mut albedo = crate::vdb::read_vdb(&volume_path, &options)?;
-            if let Some(b) = v.bounds {
+            let placed = match (v.bounds, mesh_box) {
+                (Some(b), _) => Some(checked_box(cx, "volume.bounds", b)?),
+                (None, mesh_box) => mesh_box,
+            };
+            if let Some(b) = placed {
                 // The albedo moves with the density's box.
-                albedo.bounds = remap(
-                    albedo.bounds,
-                    file_box,
-                    checked_box(cx, "volume.bounds", b)?,
-                );
+                albedo.bounds = remap(albedo.bounds, file_box, b);
             }
             Some(albedo)
         }
@@ -474,7 +496,7 @@ fn assemble(
         lookup: Default::default(),
         storage: Default::default(),
     };
-    finish(cx, &file, grid_bounds, medium)
+    finish(cx, &file, grid_bounds, medium, mesh)
 }
 
 /// A material-indexed volume's scene: `[[materials]]` and `[volume]`'s index grid or slices;
@@ -483,6 +505,8 @@ fn assemble_indexed(
     cx: &Cx<'_>,
     file: &SceneFile,
     volume_path: &Path,
+    dir: &Path,
+    params: &[(String, String)],
 ) -> Result<SceneDescription, SceneError> {
     let v = &file.volume;
     if file.albedo.value.is_some()
@@ -533,6 +557,7 @@ fn assemble_indexed(
             !files.is_empty()
         });
     let indexed = if slices {
+        use crate::slices::SliceIndices;
         let (indices, resolution) =
             crate::slices::read_slices(volume_path, &materials, v.resolution.map(|r| r[2]))?;
         if let Some(r) = v.resolution {
@@ -568,7 +593,14 @@ fn assemble_indexed(
                 ))
             }
         };
-        IndexedDesc::new(volume_path, materials, resolution, bounds, &indices)?
+        match indices {
+            SliceIndices::Bytes(i) => {
+                IndexedDesc::new(volume_path, materials, resolution, bounds, &i)?
+            }
+            SliceIndices::Wide(i) => {
+                IndexedDesc::new(volume_path, materials, resolution, bounds, &i)?
+            }
+        }
     } else {
         let (grid, _) = read_volume(cx, volume_path, v)?;
         IndexedDesc::from_grid(volume_path, materials, &grid)?
@@ -583,7 +615,15 @@ fn assemble_indexed(
         lookup: Default::default(),
         storage: Default::default(),
     };
-    finish(cx, file, bounds, medium)
+    // An indexed volume keeps its own placement (its slices' or its file's voxel size).
+    let mesh = match &file.boundary.mesh {
+        Some(m) => {
+            let path = resolve_path(cx, dir, m, "boundary.mesh", file, params)?;
+            file.boundary.mesh(cx, Some(&path))?
+        }
+        None => file.boundary.mesh(cx, None)?,
+    };
+    finish(cx, file, bounds, medium, mesh)
 }
 
 /// The scene around `medium`, whose grid's box is `grid_bounds`: boundary, camera, film,
@@ -593,11 +633,13 @@ fn finish(
     file: &SceneFile,
     grid_bounds: Bounds,
     medium: MediumDesc,
+    mesh: Option<Arc<MeshDesc>>,
 ) -> Result<SceneDescription, SceneError> {
     let bsdf = file.boundary.bsdf(cx)?;
-    let bounds = match file.boundary.bounds {
-        Some(box_) => checked_box(cx, "boundary.bounds", box_)?,
-        None => grid_bounds,
+    let boundary = match (mesh, file.boundary.bounds) {
+        (Some(mesh), _) => BoundaryDesc::mesh(mesh, bsdf),
+        (None, Some(box_)) => BoundaryDesc::box_(checked_box(cx, "boundary.bounds", box_)?, bsdf),
+        (None, None) => BoundaryDesc::box_(grid_bounds, bsdf),
     };
 
     let c = &file.camera;
@@ -700,7 +742,7 @@ fn finish(
             max_depth: depth(file.integrator.max_depth, "integrator.max_depth")?,
             rr_depth: depth(file.integrator.rr_depth, "integrator.rr_depth")?,
         },
-        boundary: BoundaryDesc { bounds, bsdf },
+        boundary,
         medium,
         environment,
         lights: LightSpec::lights(&file.lights, cx)?,
@@ -861,10 +903,10 @@ fn read_volume(cx: &Cx<'_>, file: &Path, v: &VolumeSpec) -> Result<(GridDesc, Bo
             }
         }
     };
-    if grid.channels != 1 {
+    if grid.channels != 1 && grid.channels != 3 {
         return Err(cx.invalid(
             "volume.file",
-            "a one-channel density grid",
+            "a density grid of one channel (grey) or three (a density per channel)",
             format!("{} channels in {}", grid.channels, file.display()),
         ));
     }

@@ -45,15 +45,16 @@ impl VolGrid {
         voxel_of(self.resolution, self.channels, index)
     }
 
-    /// Checks the grid can serve as a density (extinction) grid: one channel, values >= 0
+    /// Checks the grid can serve as a density (extinction) grid: one channel or three (a density
+    /// per channel), values >= 0
     /// (finiteness is already guaranteed by [`read_vol`]). `path` is the file, for the message.
     pub fn check_density(&self, path: &Path) -> Result<(), SceneError> {
-        if self.channels != 1 {
+        if self.channels != 1 && self.channels != 3 {
             return Err(vol_error(
                 path,
                 VolProblem::WrongChannels {
                     role: "density",
-                    expected: "1 channel (volpt supports grey extinction only)",
+                    expected: "1 channel (grey) or 3 (a density per channel)",
                     found: self.channels,
                 },
             ));

@@ -226,11 +226,18 @@ fn density_and_albedo_checks() {
         data: vec![0.5; 24],
         ..grid.clone()
     };
-    message_of(
-        &rgb.check_density(path).unwrap_err(),
-        &["density grid", "1 channel", "found 3"],
-    );
+    // A density per channel.
+    rgb.check_density(path).unwrap();
     rgb.check_albedo(path).unwrap();
+    let two = VolGrid {
+        channels: 2,
+        data: vec![0.5; 16],
+        ..grid.clone()
+    };
+    message_of(
+        &two.check_density(path).unwrap_err(),
+        &["density grid", "1 channel (grey) or 3", "found 2"],
+    );
     let bright = VolGrid {
         data: vec![1.5; 8],
         ..grid

@@ -5,7 +5,9 @@
 //! - `{"type":"camera","origin":[x,y,z],"target":[x,y,z],"fov":deg?,"interactive":bool}`: look
 //!   from `origin` at `target` (the orbit centre), keeping the world up of `hello`. `interactive`
 //!   while the user drags: reduced resolution, one sample per frame.
-//! - `{"type":"set","key":K,"value":V}`: a scene parameter, `K` one of [`SETTABLE`].
+//! - `{"type":"set","key":K,"value":V}`: a scene parameter, `K` one of [`SETTABLE`] or a
+//!   material's coefficient, `materials.<m>.sigma_s`, `.sigma_a` (`[r, g, b]`) or `.g` (a number)
+//!   (`<m>` the material's name or index, [`MaterialParams::id`]).
 //! - `{"type":"exposure","value":stops}`: the tone mapping's exposure (no new accumulation).
 //! - `{"type":"format","format":"jpeg"|"png"}`: how this client's frames are encoded.
 //! - `{"type":"ack","frame":id}`: frame `id` arrived; at most [`MAX_IN_FLIGHT`] are unacknowledged.
@@ -26,7 +28,8 @@ pub const MAX_MESSAGE_BYTES: usize = 4096;
 /// Frames sent to a client and not yet acknowledged, at most.
 pub const MAX_IN_FLIGHT: usize = 2;
 
-/// The parameters a `set` message may change (the camera moves by `camera` messages).
+/// The parameters a `set` message may change (the camera moves by `camera` messages), besides
+/// the materials' ([`MATERIAL_FIELDS`]).
 pub const SETTABLE: &[&str] = &[
     "spp",
     "seed",
@@ -43,6 +46,9 @@ pub const SETTABLE: &[&str] = &[
     "light.intensity",
     "light.direction",
 ];
+
+/// What `materials.<m>.` may be followed by in a `set` message: RGB, RGB, a number.
+pub const MATERIAL_FIELDS: [&str; 3] = ["sigma_s", "sigma_a", "g"];
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -122,6 +128,32 @@ pub fn param_value(key: &str, value: &serde_json::Value) -> Result<ParamValue, P
         ProtocolError::Invalid(format!("{key}: expected {expected}, found {value}"))
     };
     let number = || value.as_f64().filter(|v| v.is_finite());
+    let rgb = || {
+        let rgb: Option<Vec<f32>> = value.as_array().and_then(|a| {
+            a.iter()
+                .map(|c| c.as_f64().filter(|v| v.is_finite()).map(|v| v as f32))
+                .collect()
+        });
+        match rgb.as_deref() {
+            Some(&[r, g, b]) => Ok(ParamValue::Rgb([r, g, b])),
+            _ => Err(wrong("three numbers ([r, g, b] or [x, y, z])")),
+        }
+    };
+    let field = key
+        .strip_prefix("materials.")
+        .and_then(|rest| rest.rsplit_once('.'))
+        .filter(|(id, _)| !id.is_empty())
+        .map(|(_, field)| field);
+    match (key, field) {
+        (_, Some("sigma_s" | "sigma_a")) => return rgb(),
+        (_, Some("g")) => {
+            return number()
+                .filter(|v| v.abs() <= f64::from(f32::MAX))
+                .map(|v| ParamValue::Float(v as f32))
+                .ok_or_else(|| wrong("a number"))
+        }
+        _ => {}
+    }
     match key {
         "spp" | "seed" | "max_depth" | "rr_depth" => value
             .as_i64()
@@ -132,20 +164,11 @@ pub fn param_value(key: &str, value: &serde_json::Value) -> Result<ParamValue, P
             .map(|v| ParamValue::Float(v as f32))
             .ok_or_else(|| wrong("a number")),
         "medium.albedo" | "sun.direction" | "sun.irradiance" | "light.position"
-        | "light.intensity" | "light.direction" => {
-            let rgb: Option<Vec<f32>> = value.as_array().and_then(|a| {
-                a.iter()
-                    .map(|c| c.as_f64().filter(|v| v.is_finite()).map(|v| v as f32))
-                    .collect()
-            });
-            match rgb.as_deref() {
-                Some(&[r, g, b]) => Ok(ParamValue::Rgb([r, g, b])),
-                _ => Err(wrong("three numbers ([r, g, b] or [x, y, z])")),
-            }
-        }
+        | "light.intensity" | "light.direction" => rgb(),
         _ => Err(ProtocolError::Invalid(format!(
-            "set: unknown parameter {key:?} (expected one of {})",
-            SETTABLE.join(", ")
+            "set: unknown parameter {key:?} (expected one of {}, or materials.<name>.{})",
+            SETTABLE.join(", "),
+            MATERIAL_FIELDS.join("|")
         ))),
     }
 }
@@ -168,6 +191,19 @@ pub struct Params {
     /// `None` for an albedo grid.
     pub medium_albedo: Option<[f32; 3]>,
     pub phase_g: f32,
+    /// A material-indexed volume's materials, in table order (none for another medium).
+    pub materials: Vec<MaterialParams>,
+}
+
+/// A material's coefficients as the page shows and edits them.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct MaterialParams {
+    /// What names it in a key, `materials.<id>.sigma_s`: its name, or its index where the name
+    /// is empty or not unique.
+    pub id: String,
+    pub sigma_s: [f32; 3],
+    pub sigma_a: [f32; 3],
+    pub g: f32,
 }
 
 /// Sent once on connection: what is rendered where, and the view to reset to.
@@ -286,6 +322,19 @@ mod tests {
         assert!(param_value("medium.albedo", &v("[1, 2]")).is_err());
         assert!(param_value("camera.origin", &v("[1, 2, 3]")).is_err());
         assert!(param_value("phase.g", &v("\"0.5\"")).is_err());
+        // A material's keys, by name or index (the facade knows which materials there are).
+        assert_eq!(
+            param_value("materials.cyan.sigma_a", &v("[6, 0.8, 0.2]")),
+            Ok(ParamValue::Rgb([6.0, 0.8, 0.2]))
+        );
+        assert_eq!(
+            param_value("materials.0.g", &v("0.3")),
+            Ok(ParamValue::Float(0.3))
+        );
+        assert!(param_value("materials.cyan.sigma_s", &v("1")).is_err());
+        assert!(param_value("materials.cyan.g", &v("[1, 2, 3]")).is_err());
+        assert!(param_value("materials.cyan.colour", &v("[1, 2, 3]")).is_err());
+        assert!(param_value("materials..g", &v("0.3")).is_err());
     }
 
     #[test]

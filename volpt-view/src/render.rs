@@ -15,7 +15,9 @@ use tokio::sync::{broadcast, mpsc, oneshot, watch};
 use volpt::{Backend, BackendOptions, Film, Image, ParamValue, Scene};
 
 use crate::encode;
-use crate::protocol::{FrameHeader, Hello, ImageFormat, Params, ServerMessage, View};
+use crate::protocol::{
+    FrameHeader, Hello, ImageFormat, MaterialParams, Params, ServerMessage, View,
+};
 use crate::ViewError;
 
 /// A client's queue of text messages (error replies), bounded: a reply that does not fit is
@@ -489,7 +491,31 @@ impl Renderer {
                 _ => None,
             },
             phase_g: float("phase.g"),
+            materials: self.materials(),
         }
+    }
+
+    /// The materials of a material-indexed volume, each named as its keys name it (the keys of
+    /// [`Scene::params`], three a material, in table order).
+    fn materials(&self) -> Vec<MaterialParams> {
+        let rgb = |key: &str| match self.scene.get(key) {
+            Ok(ParamValue::Rgb(v)) => v,
+            _ => [0.0; 3],
+        };
+        self.scene
+            .params()
+            .iter()
+            .filter_map(|(key, _)| key.strip_prefix("materials.")?.strip_suffix(".g"))
+            .map(|id| MaterialParams {
+                id: id.to_owned(),
+                sigma_s: rgb(&format!("materials.{id}.sigma_s")),
+                sigma_a: rgb(&format!("materials.{id}.sigma_a")),
+                g: match self.scene.get(&format!("materials.{id}.g")) {
+                    Ok(ParamValue::Float(g)) => g,
+                    _ => 0.0,
+                },
+            })
+            .collect()
     }
 }
 

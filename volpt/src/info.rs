@@ -11,7 +11,7 @@ use volpt_render::factory::{
 use volpt_scene::{GridDesc, SampleLayout, SceneDescription};
 
 /// A scene described field by field, in `volpt info`'s order: `scene`, `variant`, `film`,
-/// `camera`, `integrator`, `bounds`, `boundary`, `density`, `majorant`, `tracking`, `estimator`,
+/// `camera`, `integrator`, `bounds`, `shape`, `boundary`, `density`, `majorant`, `tracking`, `estimator`,
 /// `albedo`, `memory` (only with grids), `lookup` (only with grids), `math`, `phase`, `light`. A
 /// value of several lines (the variant's specialisations, the
 /// tracking's default rule) has them separated by `\n`. [`fmt::Display`] writes `volpt info`'s
@@ -96,6 +96,20 @@ pub fn describe(
         ),
     );
     field("bounds", format!("{:?} .. {:?}", b.min, b.max));
+    field(
+        "shape",
+        match &desc.boundary.mesh {
+            None => "box: one slab test per crossing".to_owned(),
+            Some(mesh) => format!(
+                "closed triangle mesh from {}: {} triangles, BVH of {} nodes (bounds: its \
+                 bounding box); one ray cast per crossing; renders on the CPU (the GPU kernels \
+                 trace boxes)",
+                mesh.source,
+                mesh.triangle_count(),
+                mesh.buffers.nodes.len()
+            ),
+        },
+    );
     field("boundary", desc.boundary.bsdf.to_string());
     field("density", format!("{}, scale {}", m.density, m.scale));
     field(
@@ -160,6 +174,7 @@ fn tracking(desc: &SceneDescription, parts: &Parts<'_>, settings: &PathSettings)
         return "homogeneous: every tentative collision is real".to_owned();
     }
     let bounds = &desc.boundary.bounds;
+    // The majorant grid covers the boundary's box, a mesh's bounding box.
     let derived = Derived::of(
         parts,
         volpt_core::Aabb::new(bounds.min.into(), bounds.max.into()),

@@ -691,11 +691,15 @@ impl Scene {
     }
 
     /// Replaces the material index of every voxel of the medium's material-indexed volume
-    /// ([`volpt_scene::material::IndexedDesc::set_indices`]: one byte per voxel, x fastest, each below the
-    /// table's length) — a printing application's next iteration. New indices are new data, as
-    /// [`Scene::set_grid`]'s new values are; the same indices change nothing; a refusal (a medium
-    /// without indices, the wrong count, an index past the table) leaves the scene as it was.
-    pub fn set_indices(&mut self, indices: &[u8]) -> Result<(), Error> {
+    /// ([`volpt_scene::material::IndexedDesc::set_indices`]: one per voxel, x fastest, bytes or
+    /// `u16`s, each below the table's length) — a printing application's next iteration. New
+    /// indices are new data, as [`Scene::set_grid`]'s new values are; the same indices change
+    /// nothing; a refusal (a medium without indices, the wrong count, an index past the table)
+    /// leaves the scene as it was.
+    pub fn set_indices<I: volpt_scene::material::MaterialIndex>(
+        &mut self,
+        indices: &[I],
+    ) -> Result<(), Error> {
         let DensityDesc::Indexed(volume) = &mut self.desc.medium.density else {
             return Err(Error::Grid {
                 grid: "indices".to_owned(),

@@ -23,15 +23,42 @@ pub struct MeshBuffers {
     /// `order[i]`: the input index of triangle `i`.
     pub order: Vec<u32>,
     pub bounds: Aabb,
+    /// The distance grid's values ([`super::SurfaceDistance`]), empty until
+    /// [`MeshBuffers::with_distances`], and its resolution.
+    pub distances: Vec<f32>,
+    pub distance_res: [u32; 3],
 }
 
 impl MeshBuffers {
     pub fn mesh(&self) -> super::TriangleMesh<'_> {
+        let distance = if self.distances.is_empty() {
+            super::SurfaceDistance::NONE
+        } else {
+            super::SurfaceDistance {
+                values: &self.distances,
+                ..super::distance::layout(self.bounds, self.distance_res)
+            }
+        };
         super::TriangleMesh {
             nodes: &self.nodes,
             triangles: &self.triangles,
             bounds: self.bounds,
+            distance,
         }
+    }
+
+    /// These buffers with a distance grid of `res` cells over the mesh's box, computed here one
+    /// slab after another (a host with threads may compute the slabs,
+    /// [`super::distance::distance_slab`], in parallel and set `distances` itself).
+    pub fn with_distances(mut self, res: [u32; 3]) -> Self {
+        let slab = (res[0] * res[1]) as usize;
+        let mut values = alloc::vec![0.0; slab * res[2] as usize];
+        for (z, out) in values.chunks_mut(slab).enumerate() {
+            super::distance::distance_slab(&self.mesh(), res, z as u32, out);
+        }
+        self.distances = values;
+        self.distance_res = res;
+        self
     }
 }
 
@@ -76,6 +103,11 @@ pub enum BuildError {
         to: u32,
         triangles: usize,
     },
+    /// Every triangle faces inwards: the signed volume the mesh encloses, `volume`, is not
+    /// positive (a closed mesh that faces outwards encloses a positive one, cavities included).
+    InsideOut {
+        volume: f64,
+    },
 }
 
 impl fmt::Display for BuildError {
@@ -104,6 +136,12 @@ impl fmt::Display for BuildError {
             Self::NonManifoldEdge { from, to, triangles } => write!(
                 f,
                 "the mesh is not manifold: edge {from}-{to} borders {triangles} triangles, expected 2"
+            ),
+            Self::InsideOut { volume } => write!(
+                f,
+                "the mesh faces inwards: it encloses a signed volume of {volume:e}, expected a \
+                 positive one (each triangle's vertices counter-clockwise seen from outside); \
+                 reverse every triangle"
             ),
         }
     }
@@ -148,6 +186,7 @@ pub fn build(vertices: &[[f32; 3]], indices: &[[u32; 3]]) -> Result<MeshBuffers,
         let (normal, offset) = plane(&v).ok_or(BuildError::Degenerate { triangle })?;
         triangles.push(MeshTriangle { v, normal, offset });
     }
+    check_outward(vertices, indices)?;
     let mut prims: Vec<Prim> = triangles
         .iter()
         .enumerate()
@@ -171,7 +210,35 @@ pub fn build(vertices: &[[f32; 3]], indices: &[[u32; 3]]) -> Result<MeshBuffers,
         triangles: order.iter().map(|&i| triangles[i as usize]).collect(),
         order,
         bounds,
+        distances: Vec::new(),
+        distance_res: [0; 3],
     })
+}
+
+/// The divergence theorem: a closed mesh whose triangles face outwards encloses the positive
+/// volume `sum(a . (b x c)) / 6`, in f64 (relative to the first vertex, so that a mesh far from
+/// the origin keeps its digits). Inside-out meshes (an STL exported with inverted normals) are
+/// closed and consistent, so only this catches them.
+fn check_outward(vertices: &[[f32; 3]], indices: &[[u32; 3]]) -> Result<(), BuildError> {
+    let origin = vertices[indices[0][0] as usize].map(f64::from);
+    let at = |i: u32| {
+        let v = vertices[i as usize];
+        [0, 1, 2].map(|k| f64::from(v[k]) - origin[k])
+    };
+    let volume: f64 = indices
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(at);
+            a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                + a[2] * (b[0] * c[1] - b[1] * c[0])
+        })
+        .sum::<f64>()
+        / 6.0;
+    if volume > 0.0 {
+        Ok(())
+    } else {
+        Err(BuildError::InsideOut { volume })
+    }
 }
 
 fn check_indices(vertices: usize, indices: &[[u32; 3]]) -> Result<(), BuildError> {

@@ -21,6 +21,7 @@
 
 #[cfg(feature = "alloc")]
 pub mod build;
+pub mod distance;
 #[cfg(feature = "alloc")]
 pub mod primitives;
 
@@ -66,12 +67,17 @@ pub enum Crossing {
     Any,
 }
 
-/// A closed triangle mesh and its BVH, borrowed from memory the caller keeps (host or device).
+pub use distance::SurfaceDistance;
+
+/// A closed triangle mesh, its BVH and its distance grid, borrowed from memory the caller keeps
+/// (host or device).
 #[derive(Clone, Copy, Debug)]
 pub struct TriangleMesh<'a> {
     pub nodes: &'a [BvhNode],
     pub triangles: &'a [MeshTriangle],
     pub bounds: Aabb,
+    /// Lets a free flight that cannot reach the surface skip the ray cast.
+    pub distance: SurfaceDistance<'a>,
 }
 
 impl<'a> TriangleMesh<'a> {
@@ -304,6 +310,16 @@ fn intersect(
 
 impl Shape for TriangleMesh<'_> {
     const CONVEX: bool = false;
+
+    type Exit<'e>
+        = crate::flight::LazyExit<'e>
+    where
+        Self: 'e;
+
+    #[inline(always)]
+    fn flight_exit<'e>(&'e self, ray: &'e Ray) -> Self::Exit<'e> {
+        crate::flight::LazyExit::cast_later(self, ray, self.distance.at(ray.origin))
+    }
 
     #[inline(always)]
     fn bounds(&self) -> Aabb {

@@ -27,11 +27,17 @@ use std::sync::Mutex;
 /// The first bytes of every pack (the last one is the layout's version).
 pub const MAGIC: &[u8; 8] = b"volptPK1";
 
-/// The zstd level of every frame. Measured on the fast build's 86 MB of PTX (2026-11-26,
-/// `bench/results/2026-11-26-h100-ptx-size/compression.txt`): 10.2 MB at 12 against 10.5 at 9 and
-/// 7.9 at 19, which takes about 15 times as long to write (minutes per build on two cores); both
-/// builds at 12 keep the release binary well under its 40 MB.
-pub const LEVEL: i32 = 12;
+/// The zstd level of a release build's frames: what the binary carries. At 19 zstd's optimal
+/// parser finds the repeats between a strategy's kernels that 12's lazy one misses: on the fast
+/// build's 123 MB of PTX (2026-11-29) the frames take 22% less than at 12 (13 and 14 are no
+/// smaller, 16 18% less, and `--long` windows do not help), for about 15 times the time to
+/// write, which a release build pays once per kernel build. Reading a frame back stays tens
+/// of milliseconds.
+pub const RELEASE_LEVEL: i32 = 19;
+
+/// The zstd level of other builds' frames (debug builds, tests without `--release`): seconds
+/// to write where [`RELEASE_LEVEL`] takes minutes on two cores.
+pub const DEV_LEVEL: i32 = 12;
 
 /// The index's record kinds, its first field.
 pub const FRAME_RECORD: &str = "frame";
@@ -150,9 +156,9 @@ pub fn group_of(name: &str) -> &str {
     name.split_once("__").map_or(name, |(group, _)| group)
 }
 
-/// `text` as one zstd frame at [`LEVEL`], with its content checksum.
-fn compress(text: &str) -> io::Result<Vec<u8>> {
-    let mut encoder = zstd::stream::Encoder::new(Vec::new(), LEVEL)?;
+/// `text` as one zstd frame at `level`, with its content checksum.
+fn compress(text: &str, level: i32) -> io::Result<Vec<u8>> {
+    let mut encoder = zstd::stream::Encoder::new(Vec::new(), level)?;
     encoder.include_checksum(true)?;
     encoder.write_all(text.as_bytes())?;
     encoder.finish()
@@ -160,7 +166,7 @@ fn compress(text: &str) -> io::Result<Vec<u8>> {
 
 /// `texts`, each compressed, on as many threads as this machine has cores: the build script packs
 /// some 180 MB of PTX at every kernel build.
-fn compress_all(texts: &[String]) -> io::Result<Vec<Vec<u8>>> {
+fn compress_all(texts: &[String], level: i32) -> io::Result<Vec<Vec<u8>>> {
     let next = AtomicUsize::new(0);
     let done: Mutex<Vec<Option<io::Result<Vec<u8>>>>> =
         Mutex::new(texts.iter().map(|_| None).collect());
@@ -172,7 +178,7 @@ fn compress_all(texts: &[String]) -> io::Result<Vec<Vec<u8>>> {
             scope.spawn(|| loop {
                 let i = next.fetch_add(1, Ordering::Relaxed);
                 let Some(text) = texts.get(i) else { break };
-                let frame = compress(text);
+                let frame = compress(text, level);
                 done.lock().unwrap_or_else(|e| e.into_inner())[i] = Some(frame);
             });
         }
@@ -184,8 +190,9 @@ fn compress_all(texts: &[String]) -> io::Result<Vec<Vec<u8>>> {
         .collect()
 }
 
-/// The pack of the PTX module `ptx` (the layout above).
-pub fn pack(ptx: &str) -> io::Result<Vec<u8>> {
+/// The pack of the PTX module `ptx` (the layout above), its frames at zstd level `level`
+/// ([`RELEASE_LEVEL`], [`DEV_LEVEL`]).
+pub fn pack(ptx: &str, level: i32) -> io::Result<Vec<u8>> {
     let split = split(ptx);
     let mut names = vec![COMMON_FRAME];
     let mut texts = vec![split.common.clone()];
@@ -211,7 +218,7 @@ pub fn pack(ptx: &str) -> io::Result<Vec<u8>> {
         ));
         text.push_str(entry.text);
     }
-    let frames = compress_all(&texts)?;
+    let frames = compress_all(&texts, level)?;
     let mut index = String::new();
     for ((name, text), frame) in names.iter().zip(&texts).zip(&frames) {
         index.push_str(&format!(
@@ -221,7 +228,7 @@ pub fn pack(ptx: &str) -> io::Result<Vec<u8>> {
         ));
     }
     index.push_str(&entries);
-    let index = compress(&index)?;
+    let index = compress(&index, level)?;
     let mut out = Vec::with_capacity(16 + index.len() + frames.iter().map(Vec::len).sum::<usize>());
     out.extend_from_slice(MAGIC);
     out.extend_from_slice(&(index.len() as u64).to_le_bytes());

@@ -44,11 +44,14 @@ use std::sync::Arc;
 use volpt_core::abi::SceneAbi;
 use volpt_core::grid::Grid;
 
+use volpt_core::chromatic::build_channel_majorants;
 use volpt_core::majorant::MajorantGrid;
 use volpt_core::material::build_material_channel_majorants;
 use volpt_core::math::tan;
 use volpt_core::path::Estimator;
-use volpt_core::{Aabb, PathSettings, PerspectiveCamera, Scene, Vec2, Vec3, VolumeScene};
+use volpt_core::{
+    Aabb, BoundaryShape, PathSettings, PerspectiveCamera, Scene, Shape, Vec2, Vec3, VolumeScene,
+};
 use volpt_scene::description::{
     Bounds, BsdfDesc, CameraDesc, EnvironmentDesc, FilmDesc, FovAxis, PhaseDesc, Projection,
     SceneDescription,
@@ -74,6 +77,9 @@ macro_rules! axis {
     ($(#[$doc:meta])* $part:ident $(<$lt:lifetime>)?, $kind:ident, $input:ty, $rule:ident,
      [$(($camel:ident, $snake:ident, $ty:ty))*]) => {
         $(#[$doc])*
+        // One built part per render, moved into the scene it renders: the chromatic medium's
+        // grids and tables make its variant the largest, which costs nothing here.
+        #[allow(clippy::large_enum_variant)]
         pub enum $part $(<$lt>)? {
             $($camel($ty),)*
         }
@@ -161,6 +167,12 @@ macro_rules! factory {
                 }
             }
 
+            fn channel_densities(&self) -> Option<(Grid<'a, 3>, volpt_core::Spectrum)> {
+                match self {
+                    $(MediumPart::$Mv(m) => m.channel_densities(),)*
+                }
+            }
+
             fn track_with(&mut self, grid: Option<MajorantGrid<'a>>) {
                 match self {
                     $(MediumPart::$Mv(m) => m.track_with(grid),)*
@@ -228,7 +240,7 @@ macro_rules! factory {
         }
 
         /// Hands the scene made of `shared` and `parts` to `visitor`, monomorphised for its variant.
-        fn dispatch<V: SceneVisitor>(shared: Shared, parts: Parts<'_>, visitor: V) -> V::Output {
+        fn dispatch<V: SceneVisitor>(shared: Shared<'_>, parts: Parts<'_>, visitor: V) -> V::Output {
             match (parts.medium, parts.boundary, parts.phase, parts.environment) {
                 $((
                     MediumPart::$M(medium),
@@ -237,7 +249,7 @@ macro_rules! factory {
                     EnvironmentPart::$E(environment),
                 ) => visitor.visit(&VolumeScene {
                     camera: shared.camera,
-                    bounds: shared.bounds,
+                    bounds: shared.shape,
                     settings: shared.settings,
                     medium,
                     boundary,
@@ -334,13 +346,22 @@ impl<'a> Parts<'a> {
     }
 }
 
-/// The parts every variant shares.
-struct Shared {
+/// The parts every variant shares. The boundary's geometry is chosen at run time, box or mesh
+/// ([`BoundaryShape`]): a second scene type per variant would double every backend's code.
+struct Shared<'a> {
     camera: PerspectiveCamera,
-    bounds: Aabb,
+    shape: BoundaryShape<'a>,
     settings: PathSettings,
     /// The lights besides the environment: a run-time part of every variant.
     lights: volpt_core::Lights,
+}
+
+/// The boundary's geometry `desc` describes, borrowing its mesh.
+pub fn boundary_shape(desc: &SceneDescription) -> BoundaryShape<'_> {
+    match &desc.boundary.mesh {
+        Some(mesh) => BoundaryShape::Mesh(mesh.buffers.mesh()),
+        None => BoundaryShape::Box(aabb(&desc.boundary.bounds)),
+    }
 }
 
 /// Builds the scene that `desc` describes, with `settings` for the integrator, specialised to its
@@ -374,12 +395,12 @@ pub fn with_scene_cached<V: SceneVisitor>(
 ) -> V::Output {
     let shared = Shared {
         camera: camera(&desc.camera, &desc.film),
-        bounds: aabb(&desc.boundary.bounds),
+        shape: boundary_shape(desc),
         settings,
         lights: desc.lights.lights(),
     };
     let parts = Parts::of_cached(desc, effects, cache);
-    let derived = Derived::of_cached(&parts, shared.bounds, &settings, cache);
+    let derived = Derived::of_cached(&parts, shared.shape.bounds(), &settings, cache);
     dispatch(shared, parts.with(&derived), visitor)
 }
 
@@ -390,7 +411,7 @@ pub struct Derived {
     /// Per-cell majorants and the grid's resolution, if the medium tracks with a grid.
     majorants: Option<Arc<Majorants>>,
     /// Each channel's bound per cell of `majorants` (three a cell), for a medium whose channels'
-    /// bounds are not in proportion (a material-indexed volume's).
+    /// bounds are not in proportion (a material-indexed volume's, a density per channel's).
     channel_majorants: Option<Vec<f32>>,
     bounds: Aabb,
     /// The environment's sampling distribution, for next-event estimation.
@@ -424,13 +445,35 @@ impl Derived {
                 (Arc::new(Majorants { data, res }), Some(channels))
             })
         };
+        // A density per channel: each channel's bounds from its own samples (built anew each
+        // time, as an indexed volume's).
+        let per_channel = |res: [u32; 3]| {
+            parts
+                .medium
+                .channel_densities()
+                .map(|(density, extinction)| {
+                    let cells = res.iter().map(|&r| r as usize).product::<usize>();
+                    let (mut channels, mut data) = (vec![0.0; 3 * cells], vec![0.0; cells]);
+                    let mut plane = vec![0.0; density.data.len() / 3];
+                    build_channel_majorants(
+                        &density,
+                        extinction,
+                        bounds,
+                        res,
+                        &mut plane,
+                        &mut channels,
+                        &mut data,
+                    );
+                    (Arc::new(Majorants { data, res }), Some(channels))
+                })
+        };
         let majorants = (settings.majorant_resolution > 1)
             .then(|| MajorantGrid::resolution_for(bounds, settings.majorant_resolution))
             .and_then(|res| match parts.medium.density() {
                 Some((density, scale)) => {
                     Some((cache.majorants(&density, scale, bounds, res), None))
                 }
-                None => indexed(res),
+                None => per_channel(res).or_else(|| indexed(res)),
             })
             // A grid whose every cell has the global bound (a uniform density, as ad's) saves no
             // step and costs the walk: track with the global majorant.

@@ -15,15 +15,20 @@
 //!   table expanded per voxel: RGB grids of the extinction and the albedo, read `nearest` as the
 //!   table is. Mitsuba 3 has one phase function per medium: a table whose materials' `g` differ
 //!   is refused.
+//! - **Mesh boundaries** are written as a binary PLY of their world-space triangles
+//!   (`<name>-boundary.ply`, vertices shared where their positions are equal, so that volpt reads
+//!   it back as the same closed mesh) read with `face_normals`: volpt refracts at the geometric
+//!   normal, and Mitsuba would otherwise interpolate vertex normals it computes itself.
 //! - **Environment maps** are written with Mitsuba 3's row convention (rows from pole to pole). A
 //!   Mitsuba 0.6 map (cell-centred rows) would move by half a row, so it is refused rather than
 //!   silently changed.
 
+use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use crate::description::{
-    Bounds, FovAxis, GridConvention, GridDesc, Matrix4, Projection, SceneDescription,
+    Bounds, FovAxis, GridConvention, GridDesc, Matrix4, MeshDesc, Projection, SceneDescription,
 };
 use crate::error::SceneError;
 use crate::output::create_dir;
@@ -104,13 +109,30 @@ pub fn write_mitsuba3(
         FovAxis::Larger => "larger",
         FovAxis::Diagonal => "diagonal",
     };
-    let b = desc.boundary.bounds;
-    // Mitsuba's `cube` is [-1,1]^3.
-    let cube = Bounds {
-        min: [-1.0; 3],
-        max: [1.0; 3],
+    let shape = match &desc.boundary.mesh {
+        None => {
+            // Mitsuba's `cube` is [-1,1]^3.
+            let cube = Bounds {
+                min: [-1.0; 3],
+                max: [1.0; 3],
+            };
+            let cube_to_world = box_transform(&cube, &desc.boundary.bounds);
+            format!(
+                "<shape type=\"cube\">\n        {}",
+                matrix_transform(&cube_to_world, "        ")
+            )
+        }
+        Some(mesh) => {
+            let file = format!("{name}-boundary.ply");
+            let path = dir.join(&file);
+            write_ply(&path, mesh)?;
+            written.push(path);
+            format!(
+                "<shape type=\"ply\">\n        <string name=\"filename\" value=\"{file}\"/>\n        \
+                 <boolean name=\"face_normals\" value=\"true\"/>"
+            )
+        }
     };
-    let cube_to_world = box_transform(&cube, &b);
 
     let mut xml = String::new();
     let _ = write!(
@@ -137,8 +159,7 @@ pub fn write_mitsuba3(
 
     {emitter}
 
-    <shape type="cube">
-        {cube}
+    {shape}
         {bsdf}
         <medium type="{medium_type}" name="interior">
             {sigma_t}
@@ -168,7 +189,6 @@ pub fn write_mitsuba3(
         spp = desc.spp,
         width = desc.film.width,
         height = desc.film.height,
-        cube = matrix_transform(&cube_to_world, "        "),
         scale = medium.mitsuba3_scale(),
         // Mitsuba 3's `volpath` samples one channel without MIS: very noisy on chromatic media.
         integrator = if medium.is_chromatic() {
@@ -182,6 +202,44 @@ pub fn write_mitsuba3(
         error,
     })?;
     Ok(written)
+}
+
+/// Writes `mesh`'s triangles as a binary little-endian PLY, each position once.
+fn write_ply(path: &Path, mesh: &MeshDesc) -> Result<(), SceneError> {
+    let mut index: HashMap<[u32; 3], u32> = HashMap::new();
+    let mut vertices: Vec<[f32; 3]> = Vec::new();
+    let mut faces: Vec<[u32; 3]> = Vec::with_capacity(mesh.triangle_count());
+    for t in &mesh.buffers.triangles {
+        faces.push(t.v.map(|v| {
+            *index.entry(v.map(f32::to_bits)).or_insert_with(|| {
+                vertices.push(v);
+                (vertices.len() - 1) as u32
+            })
+        }));
+    }
+    let mut bytes = format!(
+        "ply\nformat binary_little_endian 1.0\ncomment written by volpt: a closed mesh boundary\n\
+         element vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
+         element face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        vertices.len(),
+        faces.len()
+    )
+    .into_bytes();
+    for v in &vertices {
+        for c in v {
+            bytes.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    for f in &faces {
+        bytes.push(3);
+        for i in f {
+            bytes.extend_from_slice(&i.to_le_bytes());
+        }
+    }
+    std::fs::write(path, bytes).map_err(|error| SceneError::Io {
+        path: path.to_path_buf(),
+        error,
+    })
 }
 
 /// The box whose cells' centres are the grid's samples, and the transform that takes `[0,1]^3` to it.

@@ -15,7 +15,6 @@ pub(crate) mod emitter;
 pub(crate) mod export;
 mod integrator;
 pub(crate) mod ior;
-mod obj;
 pub(crate) mod plugin;
 pub(crate) mod preprocess;
 pub mod presets;
@@ -89,7 +88,7 @@ fn scene(root: &Element, ctx: &Ctx<'_>) -> Result<SceneDescription, SceneError> 
     };
     one(&sensors, "sensor")?;
     one(&integrators, "integrator")?;
-    one(&shapes, "shape: the box that bounds the medium")?;
+    one(&shapes, "shape: the closed surface that bounds the medium")?;
 
     let sensor_el = sensors.first().ok_or_else(|| SceneError::Missing {
         path: root.file.to_path_buf(),
@@ -101,7 +100,7 @@ fn scene(root: &Element, ctx: &Ctx<'_>) -> Result<SceneDescription, SceneError> 
         path: root.file.to_path_buf(),
         line: root.line,
         element: "<scene>".into(),
-        what: "a <shape> (a cube or box obj) holding the medium".into(),
+        what: "a <shape> (a cube, a sphere, or an obj or ply mesh) holding the medium".into(),
     })?;
     let sensor = sensor(sensor_el, ctx)?;
     let integrator = match integrators.first() {

@@ -22,7 +22,7 @@ use crate::vol::{read_vol, VolGrid};
 /// What a volume is used for, which decides the values and channel counts it may hold.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Role {
-    /// Extinction: one channel, values >= 0.
+    /// Extinction: one channel, or three (a density per channel), values >= 0.
     Density,
     /// Single-scattering albedo: one (grey) or three channels, values in [0, 1]. A one-channel
     /// grid is expanded to three.
@@ -31,7 +31,15 @@ pub(crate) enum Role {
 
 pub(crate) enum VolumeValue {
     Constant([f32; 3]),
-    Grid(GridDesc),
+    /// A grid and how its `filter_type` reads it between samples.
+    Grid(GridDesc, Filter),
+}
+
+/// A `gridvolume`'s `filter_type`: Mitsuba 3's `trilinear` (its default) or `nearest`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Filter {
+    Trilinear,
+    Nearest,
 }
 
 /// Reads a volume-valued parameter. Constants are returned unchecked (the caller knows its
@@ -49,7 +57,10 @@ pub(crate) fn volume(arg: &Arg<'_>, ctx: &Ctx<'_>, role: Role) -> Result<VolumeV
             p.ignore(&["toWorld", "to_world"]); // a constant does not move
             VolumeValue::Constant(rgb(&value)?)
         }
-        "gridvolume" => VolumeValue::Grid(grid(&p, role)?),
+        "gridvolume" => {
+            let (grid, filter) = grid(&p, role)?;
+            VolumeValue::Grid(grid, filter)
+        }
         _ => return Err(p.unsupported("volpt's volumes are gridvolume and constvolume")),
     };
     p.finish()?;
@@ -59,7 +70,7 @@ pub(crate) fn volume(arg: &Arg<'_>, ctx: &Ctx<'_>, role: Role) -> Result<VolumeV
 /// A `gridvolume` whose file is a `.vdb`: the grid named by `<string name="grid">` (default: the
 /// density, or for an albedo the file's vec3 grid), over the box its own transform gives
 /// (voxel centres: cell-centred), mapped by `toWorld`/`to_world`, in either dialect.
-fn vdb_grid(p: &Plugin<'_>, role: Role, path: &Path) -> Result<GridDesc, SceneError> {
+fn vdb_grid(p: &Plugin<'_>, role: Role, path: &Path) -> Result<(GridDesc, Filter), SceneError> {
     let name = match p.find(&["grid"])? {
         Some(arg) => Some(arg.string()?.to_owned()),
         None => None,
@@ -73,7 +84,7 @@ fn vdb_grid(p: &Plugin<'_>, role: Role, path: &Path) -> Result<GridDesc, SceneEr
 }
 
 /// A grid read with its own box (a VDB file's, a scanner file's), mapped by `toWorld`/`to_world`.
-fn own_box(p: &Plugin<'_>, mut grid: GridDesc) -> Result<GridDesc, SceneError> {
+fn own_box(p: &Plugin<'_>, mut grid: GridDesc) -> Result<(GridDesc, Filter), SceneError> {
     let to_world = match p.find(&["toWorld", "to_world"])? {
         Some(arg) => transform(&arg)?,
         None => IDENTITY_F64,
@@ -95,11 +106,10 @@ fn own_box(p: &Plugin<'_>, mut grid: GridDesc) -> Result<GridDesc, SceneError> {
         "raw",
         "accel",
     ]);
-    warn_on_lookup_settings(p)?;
-    Ok(grid)
+    Ok((grid, lookup_settings(p)?))
 }
 
-fn grid(p: &Plugin<'_>, role: Role) -> Result<GridDesc, SceneError> {
+fn grid(p: &Plugin<'_>, role: Role) -> Result<(GridDesc, Filter), SceneError> {
     let el = p.el;
     let filename = p
         .find(&["filename"])?
@@ -171,7 +181,7 @@ fn grid(p: &Plugin<'_>, role: Role) -> Result<GridDesc, SceneError> {
              axis-aligned, so only positive scales and translations are allowed",
         )
     })?;
-    warn_on_lookup_settings(p)?;
+    let filter = lookup_settings(p)?;
     // Settings of Mitsuba's own storage and acceleration.
     p.ignore(&["sendData", "customStepSize", "raw", "accel"]);
 
@@ -179,14 +189,17 @@ fn grid(p: &Plugin<'_>, role: Role) -> Result<GridDesc, SceneError> {
         (Role::Albedo, 1) => (3, expand_grey(&vol.data, &path)?),
         _ => (vol.channels, vol.data),
     };
-    Ok(GridDesc {
-        layout: crate::description::SampleLayout::Dense,
-        resolution: vol.resolution,
-        channels,
-        bounds,
-        convention,
-        data,
-    })
+    Ok((
+        GridDesc {
+            layout: crate::description::SampleLayout::Dense,
+            resolution: vol.resolution,
+            channels,
+            bounds,
+            convention,
+            data,
+        },
+        filter,
+    ))
 }
 
 /// Mitsuba 0.6: the file's box, unless both `min` and `max` points override it.
@@ -205,10 +218,17 @@ fn file_box(vol: &VolGrid) -> ([f64; 3], [f64; 3]) {
     (vol.bbox.min.map(f64::from), vol.bbox.max.map(f64::from))
 }
 
-/// volpt always interpolates trilinearly and clamps at the edges (Mitsuba 3's defaults).
-fn warn_on_lookup_settings(p: &Plugin<'_>) -> Result<(), SceneError> {
-    p.warn_unless(&["filter_type"], "trilinear", "trilinear")?;
-    p.warn_unless(&["wrap_mode"], "clamp", "clamp")
+/// The grid's `filter_type`, `trilinear` (Mitsuba 3's default) or `nearest`; another is warned
+/// about and read trilinearly. volpt clamps at the edges (Mitsuba 3's default `wrap_mode`).
+fn lookup_settings(p: &Plugin<'_>) -> Result<Filter, SceneError> {
+    p.warn_unless(&["wrap_mode"], "clamp", "clamp")?;
+    if let Some(arg) = p.find(&["filter_type"])? {
+        if arg.string()?.trim().eq_ignore_ascii_case("nearest") {
+            return Ok(Filter::Nearest);
+        }
+    }
+    p.warn_unless(&["filter_type"], "trilinear", "trilinear (or nearest)")?;
+    Ok(Filter::Trilinear)
 }
 
 /// One grey channel to three equal ones, allocating fallibly (the grid may be large).
