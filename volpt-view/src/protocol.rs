@@ -39,6 +39,12 @@ pub const SETTABLE: &[&str] = &[
     "medium.albedo",
     "phase.g",
     "camera.fov",
+    "sun.direction",
+    "sun.irradiance",
+    "sun.angular_radius",
+    "light.position",
+    "light.intensity",
+    "light.direction",
 ];
 
 /// What `materials.<m>.` may be followed by in a `set` message: RGB, RGB, a number.
@@ -130,7 +136,7 @@ pub fn param_value(key: &str, value: &serde_json::Value) -> Result<ParamValue, P
         });
         match rgb.as_deref() {
             Some(&[r, g, b]) => Ok(ParamValue::Rgb([r, g, b])),
-            _ => Err(wrong("[r, g, b]")),
+            _ => Err(wrong("three numbers ([r, g, b] or [x, y, z])")),
         }
     };
     let field = key
@@ -153,11 +159,12 @@ pub fn param_value(key: &str, value: &serde_json::Value) -> Result<ParamValue, P
             .as_i64()
             .map(ParamValue::Int)
             .ok_or_else(|| wrong("an integer")),
-        "medium.scale" | "phase.g" | "camera.fov" => number()
+        "medium.scale" | "phase.g" | "camera.fov" | "sun.angular_radius" => number()
             .filter(|v| v.abs() <= f64::from(f32::MAX))
             .map(|v| ParamValue::Float(v as f32))
             .ok_or_else(|| wrong("a number")),
-        "medium.albedo" => rgb(),
+        "medium.albedo" | "sun.direction" | "sun.irradiance" | "light.position"
+        | "light.intensity" | "light.direction" => rgb(),
         _ => Err(ProtocolError::Invalid(format!(
             "set: unknown parameter {key:?} (expected one of {}, or materials.<name>.{})",
             SETTABLE.join(", "),
