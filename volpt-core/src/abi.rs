@@ -22,6 +22,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::camera::PerspectiveCamera;
 use crate::grid::{Grid, GridLayout, GridLookup, GridMapping, GridPlacement, TexelFormat};
+use crate::light::{Lights, LightsParams};
 use crate::path::{Estimator, PathSettings, Roulette};
 use crate::scene::{Scene, VolumeScene};
 use crate::{Aabb, Vec2, Vec3};
@@ -337,6 +338,7 @@ pub struct SceneParams<M, B, P, E> {
     pub bounds_min: [f32; 3],
     pub bounds_max: [f32; 3],
     pub settings: SettingsParams,
+    pub lights: LightsParams,
     pub medium: M,
     pub boundary: B,
     pub phase: P,
@@ -347,8 +349,10 @@ impl<M: Pod, B: Pod, P: Pod, E: Pod> SceneParams<M, B, P, E> {
     /// Evaluated for every composition the host builds: the fixed part is a multiple of 8 bytes
     /// and so is every variant part, so `repr(C)` inserts no padding and the struct is plain bytes.
     pub const LAYOUT: () = {
-        let fixed =
-            core::mem::size_of::<CameraParams>() + 24 + core::mem::size_of::<SettingsParams>();
+        let fixed = core::mem::size_of::<CameraParams>()
+            + 24
+            + core::mem::size_of::<SettingsParams>()
+            + core::mem::size_of::<LightsParams>();
         let parts = [
             core::mem::size_of::<M>(),
             core::mem::size_of::<B>(),
@@ -466,6 +470,7 @@ where
             bounds_min: self.bounds.device_box().min.to_array(),
             bounds_max: self.bounds.device_box().max.to_array(),
             settings: SettingsParams::from(&self.settings),
+            lights: LightsParams::from(&self.lights),
             medium: self.medium.to_params(upload),
             boundary: self.boundary.to_params(upload),
             phase: self.phase.to_params(upload),
@@ -487,6 +492,7 @@ where
                 boundary: B::from_params(&p.boundary),
                 phase: P::from_params(&p.phase),
                 environment: E::from_params(&p.environment),
+                lights: Lights::from(&p.lights),
                 settings: PathSettings::from(&p.settings),
             }
         }

@@ -345,6 +345,7 @@ fn an_absorber_in_a_sphere_and_a_torus_transmits_exp_minus_sigma_chord() {
             boundary: NullBoundary,
             phase: HenyeyGreenstein { g: 0.0 },
             environment: ConstantEnvironment(Spectrum::ONE),
+            lights: volpt_core::Lights::NONE,
             settings: PathSettings::default(),
         };
         let mut worst: f64 = 0.0;
@@ -426,6 +427,7 @@ fn box_and_mesh<B: volpt_core::Bsdf + Copy>(boundary: B, estimator: Estimator, s
         boundary,
         phase: HenyeyGreenstein { g: 0.3 },
         environment: ConstantEnvironment(Spectrum::ONE),
+        lights: volpt_core::Lights::NONE,
         settings,
     };
     let meshed = VolumeScene {
@@ -435,6 +437,7 @@ fn box_and_mesh<B: volpt_core::Bsdf + Copy>(boundary: B, estimator: Estimator, s
         boundary,
         phase: boxed.phase,
         environment: boxed.environment,
+        lights: volpt_core::Lights::NONE,
         settings,
     };
     // The factory's scene: either held as a run-time `BoundaryShape`.
@@ -445,6 +448,7 @@ fn box_and_mesh<B: volpt_core::Bsdf + Copy>(boundary: B, estimator: Estimator, s
         boundary,
         phase: boxed.phase,
         environment: boxed.environment,
+        lights: volpt_core::Lights::NONE,
         settings,
     };
     let (want, want_counters) = image(&boxed, 8);
@@ -555,6 +559,7 @@ fn the_furnace_in_a_torus_returns_the_light_with_and_without_next_event_estimati
             boundary: NullBoundary,
             phase: HenyeyGreenstein { g: 0.3 },
             environment: ConstantEnvironment(Spectrum::ONE),
+            lights: volpt_core::Lights::NONE,
             settings: PathSettings {
                 estimator,
                 ..PathSettings::default()
