@@ -461,7 +461,10 @@ fn emitter_volpt_does_not_have_is_unsupported() {
         "<emitter type=\"projector\"><float name=\"fov\" value=\"30\"/></emitter>\n<shape",
     );
     let err = error_at(&text, "type=\"projector\"");
-    message_of(&err, &["<emitter type=\"projector\">", "constant", "envmap"]);
+    message_of(
+        &err,
+        &["<emitter type=\"projector\">", "constant", "envmap"],
+    );
 }
 
 #[test]
