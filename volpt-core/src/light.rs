@@ -74,7 +74,7 @@ impl DirectionalLight {
 
     #[inline(always)]
     pub fn is_on(&self) -> bool {
-        self.radiance.max_element() > 0.0
+        IN_KERNELS && self.radiance.max_element() > 0.0
     }
 
     /// Whether the light is a single direction (reached only by next-event estimation).
@@ -179,7 +179,7 @@ impl SpotLight {
 
     #[inline(always)]
     pub fn is_on(&self) -> bool {
-        self.intensity.max_element() > 0.0
+        IN_KERNELS && self.intensity.max_element() > 0.0
     }
 
     /// Whether the light shines in every direction (Mitsuba's `point`).
@@ -364,6 +364,15 @@ pub(crate) fn sample_spot(spot: &SpotLight, p: Vec3) -> Option<LightSample> {
         delta: true,
     })
 }
+
+/// Whether this build traces the lights besides the environment: the CPU's does, the GPU
+/// kernels' not yet. Sampled in the index-matched kernels, the lights raised those kernels'
+/// registers (smoke's from 80 to 128, 158 before each light was sampled in its turn) and cost
+/// grey scenes without lights up to 41% under regeneration-sk and 4-5% under the defaults
+/// (H200, 2026-11-29, `bench/results/2026-11-29-h200-session11`). Until that cost is gone the
+/// kernels compile without them, exactly as before the lights, and the GPU refuses a scene with a
+/// light on (`volpt_cuda::CudaError::Lights`).
+pub const IN_KERNELS: bool = !cfg!(target_arch = "nvptx64");
 
 /// Next-event estimation's light slots: the environment, the sun, the point or spot.
 pub(crate) const SLOTS: u32 = 3;

@@ -38,6 +38,11 @@ pub enum CudaError {
          (--backend cpu)"
     )]
     MeshBoundary,
+    #[error(
+        "the GPU kernels have no lights besides the environment yet: a scene with a sun, point or \
+         spot light renders on the CPU (--backend cpu)"
+    )]
+    Lights,
     #[error(transparent)]
     Volume(#[from] volpt_gpu_mem::GpuMemError),
     #[error("CUDA driver call failed while {doing}: {source}")]

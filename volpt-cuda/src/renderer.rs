@@ -307,6 +307,9 @@ impl CudaRenderer {
         if !scene.on_device() {
             return Err(CudaError::MeshBoundary);
         }
+        if scene.lights().any() {
+            return Err(CudaError::Lights);
+        }
         // SAFETY: the grids are `scene`'s, borrowed by the caller for as long as it holds the
         // placer.
         let mut volumes = unsafe { VolumePlacer::new(self.stream.clone(), self.volumes) }?;
