@@ -11,7 +11,7 @@
 #    other strategies to 1e-6 (another summation order), as bench/device/chromatic.sh;
 # 2. the analytic test on the GPU: sun-slab.xml (fast math, the default) against its closed-form
 #    single-scattering radiance (lights_analytic.py: |z| <= 5 and within 2%).
-# While the kernels have no lights (volpt_core::light::IN_KERNELS false on the GPU), 1 checks
+# While the kernels have no lights (volpt_core::light::ENABLED false on the GPU), 1 checks
 # instead that the GPU refuses each scene with its error, and 2 runs on the CPU.
 # Expected: every line of summary.txt PASS, "failures: 0"; about 40 s on an H200 with the lights in
 # the kernels (45 renders of 64x64 at 4 spp, most of it process start-up), seconds without.
@@ -40,7 +40,7 @@ for entry in "${SCENES[@]}"; do
     # shellcheck disable=SC2086
     "$VOLPT" render "$file" $extra "${COMMON[@]}" -o "$OUT/$name-cpu.exr" >"$OUT/$name-cpu.log" 2>&1 \
         || { log "FAIL $name cpu render: $(tail -n 2 "$OUT/$name-cpu.log" | tr '\n' ' ')"; failures=$((failures + 1)); continue; }
-    # While the kernels have no lights (volpt_core::light::IN_KERNELS), the GPU must refuse the
+    # While the kernels have no lights (volpt_core::light::ENABLED), the GPU must refuse the
     # scene with its error, and there is nothing to compare.
     # shellcheck disable=SC2086
     if ! "$VOLPT" render "$file" $extra "${COMMON[@]}" --backend cuda -o "$OUT/$name-probe.exr" >"$OUT/$name-probe.log" 2>&1; then

@@ -74,7 +74,7 @@ impl DirectionalLight {
 
     #[inline(always)]
     pub fn is_on(&self) -> bool {
-        IN_KERNELS && self.radiance.max_element() > 0.0
+        ENABLED && self.radiance.max_element() > 0.0
     }
 
     /// Whether the light is a single direction (reached only by next-event estimation).
@@ -179,7 +179,7 @@ impl SpotLight {
 
     #[inline(always)]
     pub fn is_on(&self) -> bool {
-        IN_KERNELS && self.intensity.max_element() > 0.0
+        ENABLED && self.intensity.max_element() > 0.0
     }
 
     /// Whether the light shines in every direction (Mitsuba's `point`).
@@ -372,10 +372,12 @@ pub(crate) fn sample_spot(spot: &SpotLight, p: Vec3) -> Option<LightSample> {
 /// (H200, 2026-11-29, `bench/results/2026-11-29-h200-session11`). Until that cost is gone the
 /// kernels compile without them, exactly as before the lights, and the GPU refuses a scene with a
 /// light on (`volpt_cuda::CudaError::Lights`).
-pub const IN_KERNELS: bool = !cfg!(target_arch = "nvptx64");
+pub const ENABLED: bool = !cfg!(target_arch = "nvptx64");
 
-/// Next-event estimation's light slots: the environment, the sun, the point or spot.
-pub(crate) const SLOTS: u32 = 3;
+/// Next-event estimation's light slots: the environment, the sun, the point or spot; the
+/// environment's alone where the build has no lights ([`ENABLED`]), so that the GPU's loop is
+/// the straight code of one sample.
+pub(crate) const SLOTS: u32 = if ENABLED { 3 } else { 1 };
 
 /// Slot `slot`'s sample for next-event estimation from a collision at `p` (0: the environment's,
 /// where `environment`; 1: the sun's; 2: the point or spot's; `None` for a light that is off or
