@@ -473,26 +473,37 @@ fn next_event_estimate<S: Scene>(
 /// chord through the medium: one for a convex shape (the box's code is the single call); a ray
 /// that leaves a non-convex one (a torus) may enter it again. `None` when tracking runs out of
 /// steps. Per channel for a chromatic medium ([`SpectralState::Transmittance`]).
+///
+/// One ratio tracking, in the loop: a shape convex only at run time (the kernels' boundary)
+/// then costs the box no second copy of it.
 #[inline(always)]
 fn shadow_transmittance<S: Scene>(
     scene: &S,
     path: &mut PathOf<S>,
     shadow: Ray,
 ) -> Option<Transmittance<S>> {
-    let mut transmittance = chord_transmittance(scene, path, &shadow)?;
-    if scene.shape().convex() {
-        return Some(transmittance);
-    }
     let mut shadow = shadow;
-    while SpectralOf::<S>::transmits(transmittance) {
+    // The product of the chords before this one.
+    let mut before: Option<Transmittance<S>> = None;
+    loop {
+        let chord = chord_transmittance(scene, path, &shadow)?;
+        let transmittance = match before {
+            Some(mut t) => {
+                t *= chord;
+                t
+            }
+            None => chord,
+        };
+        if scene.shape().convex() || !SpectralOf::<S>::transmits(transmittance) {
+            return Some(transmittance);
+        }
         let exit = scene.shape().exit(&shadow);
         match scene.shape().entry(&Ray::new(exit.point, shadow.dir)) {
             Some(entry) => shadow.origin = entry.point,
-            None => break,
+            None => return Some(transmittance),
         }
-        transmittance *= chord_transmittance(scene, path, &shadow)?;
+        before = Some(transmittance);
     }
-    Some(transmittance)
 }
 
 /// A transmittance estimate of scene `S`'s medium.
