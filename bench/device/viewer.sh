@@ -12,6 +12,22 @@
 # while orbiting at 60 moves/s; a view shown again must give its first image byte for byte), and
 # stops the server with Ctrl-C (SIGINT), which must end it.
 #
+# First, with BACKENDS including cuda, the frames' GPU checks (CHECKS=0 skips them, ~40 s):
+#   1. `volpt selftest` (exact and fast kernels): its "tone mapping" line must PASS: the GPU's
+#      tone-mapped frame equals the CPU's within one 8-bit level.
+#   2. the accumulation: a scene served, dragged away and moved back (bin/viewer-bench
+#      --snapshot), its linear image once the still view has all its samples, from the GPU and
+#      from the CPU: the example cube (64x48, 64 spp, regeneration-sk) and ad (128x128, 8 spp,
+#      streaming-mk: frames stopped at their deadline with paths in flight, continued by the next;
+#      the line says how many still frames had paths in flight). The GPU's exact kernels must
+#      give the CPU's seed-0 image up to rounding (`volpt compare --max-relative 1e-4`), and the
+#      GPU's exact and fast images must be independent estimates of the CPU's seed-1 image
+#      (`--independent`). The CPU's viewer image is `volpt render`'s bit for bit
+#      (volpt-view/tests/accumulation.rs).
+#
+# Quick look at the frames (checks, then ad and the cube on the GPU at both sizes; ~75 s):
+#   SCENES="example-cube ad" BACKENDS=cuda SECONDS_PER_PHASE=2 bash bundle/viewer.sh
+#
 # Environment:
 #   OUT                 outputs (default ./out)
 #   SCENES, BACKENDS, RESOLUTIONS   space-separated subsets of the lists below
@@ -60,41 +76,108 @@ say "volpt: $($VOLPT --version 2>/dev/null); GPU strategy $STRATEGY, math $MATH;
 say ""
 say "move->frame: a still camera move to its first frame (1 spp, full resolution), median of 10. still: frames/s of the refinement and the spp reached. orbit: 60 interactive moves/s; frames/s showing a move, move->frame median, the resolution the renderer chose, and the mean render / tone map / JPEG ms per frame."
 say ""
-say "| scene | backend | resolution | move->frame ms | still frames/s | still spp after | orbit frames/s | orbit move->frame ms | orbit at | orbit render / tone / jpeg ms |"
-say "|---|---|---|---|---|---|---|---|---|---|"
 "$VOLPT" scene generate scenes >"$OUT/viewer-generate.log" 2>&1 || echo "viewer.sh: volpt scene generate failed (see viewer-generate.log)"
 
-num() { python3 -c "import json,sys; v=json.loads(sys.argv[1]).get(sys.argv[2]); print('-' if v is None else (f'{v:.1f}' if isinstance(v,float) else v))" "$1" "$2"; }
+# serve NAME ARGS...: starts `volpt view ARGS --bind 127.0.0.1:0` logging to $OUT/viewer-NAME.log;
+# sets $server and $url (empty if it did not start).
+serve() {
+    local name=$1; shift
+    log=$OUT/viewer-$name.log
+    "$VOLPT" view "$@" --bind 127.0.0.1:0 >"$log" 2>&1 &
+    server=$!
+    url=
+    for _ in $(seq 600); do
+        url=$(sed -n 's/^volpt view: open http/ws/p' "$log")
+        [ -n "$url" ] && break
+        kill -0 "$server" 2>/dev/null || break
+        sleep 0.1
+    done
+}
+# stop: Ctrl-C the server, which must end it.
+stop() {
+    kill -INT "$server" 2>/dev/null
+    for _ in $(seq 100); do kill -0 "$server" 2>/dev/null || break; sleep 0.1; done
+    if kill -0 "$server" 2>/dev/null; then
+        echo "viewer.sh: $log: the server ignored SIGINT" | tee -a "$log"; kill -9 "$server"; failures=$((failures + 1))
+    fi
+    wait "$server" 2>/dev/null
+}
 failures=0
+check() { # check NAME COMMAND...: one line, PASS or FAIL, with the command's last line
+    local name=$1; shift
+    local out; out=$("$@" 2>&1); local rc=$?
+    if [ $rc -eq 0 ]; then say "- PASS $name: $(echo "$out" | tail -n 1)"; else
+        say "- FAIL $name: $(echo "$out" | tail -n 3 | tr '\n' ' ')"; failures=$((failures + 1)); fi
+}
+if [ "${CHECKS:-1}" = 1 ] && [[ " $BACKENDS " == *" cuda "* ]]; then
+    say "## The frames' GPU checks"
+    say ""
+    for math in exact fast; do
+        "$VOLPT" selftest --math $math >"$OUT/viewer-selftest-$math.log" 2>&1
+        check "tone mapping ($math kernels)" grep -E "^PASS tone mapping" "$OUT/viewer-selftest-$math.log"
+        say "  $(grep -A1 'tone mapping' "$OUT/viewer-selftest-$math.log" | tail -n 1 | xargs)"
+    done
+    # accumulate NAME SCENE-ARGS -- RUNS...: serves each run ("name flags...") of the scene,
+    # drags away and back, and keeps the still view's linear image as $OUT/accumulation-NAME-RUN.exr.
+    accumulate() {
+        local scene=$1; shift
+        local args=(); while [ "$1" != -- ]; do args+=("$1"); shift; done; shift
+        for run in "$@"; do
+            # shellcheck disable=SC2086 # the run's name and flags
+            set -- $run
+            local name=$1; shift
+            serve "accumulation-$scene-$name" "${args[@]}" "$@"
+            rm -f "$OUT/accumulation-$scene-$name.exr"
+            if [ -n "$url" ]; then
+                timeout 60 "$CLIENT" "${url}ws" --snapshot "$OUT/accumulation-$scene-$name.exr" \
+                    >"$OUT/accumulation-$scene-$name.json" 2>>"$log"
+                say "  $scene $name: $(python3 -c "import json,sys
+try:
+    r = json.load(sys.stdin); print(f\"{r['last']['spp']} spp, {r['last']['width']}x{r['last']['height']}, {r['still_frames_with_paths_in_flight']} still frames with paths in flight\")
+except Exception as e: print('no snapshot:', e)" <"$OUT/accumulation-$scene-$name.json")"
+            fi
+            stop
+        done
+    }
+    # The cube with the default strategy's kernels; ad (paths of ~140 segments, a few of
+    # thousands) with streaming-mk, whose frames stop at their deadline with paths in flight.
+    accumulate cube scenes/example/cube.xml --resolution 64x48 --spp 64 -- \
+        "gpu-exact --backend cuda --strategy regeneration-sk --math exact" \
+        "gpu-fast --backend cuda --strategy regeneration-sk --math fast" \
+        "cpu-0 --backend cpu" "cpu-1 --backend cpu --seed 1"
+    accumulate ad scenes/ad/scene.xml --resolution 128x128 --spp 8 -- \
+        "gpu-exact --backend cuda --strategy streaming-mk --math exact" \
+        "gpu-fast --backend cuda --strategy streaming-mk --math fast" \
+        "cpu-0 --backend cpu" "cpu-1 --backend cpu --seed 1"
+    for scene in cube ad; do
+        a=$OUT/accumulation-$scene
+        check "accumulation, $scene: the GPU's exact image is the CPU's (seed 0)" \
+            "$VOLPT" compare "$a-gpu-exact.exr" "$a-cpu-0.exr" --max-relative 1e-4
+        for math in exact fast; do
+            check "accumulation, $scene: the GPU's $math image estimates the CPU's seed-1 image" \
+                "$VOLPT" compare "$a-gpu-$math.exr" "$a-cpu-1.exr" --independent
+        done
+    done
+    say ""
+fi
+
+num() { python3 -c "import json,sys; v=json.loads(sys.argv[1]).get(sys.argv[2]); print('-' if v is None else (f'{v:.1f}' if isinstance(v,float) else v))" "$1" "$2"; }
+say "| scene | backend | resolution | move->frame ms | still frames/s | still spp after | orbit frames/s | orbit move->frame ms | orbit at | orbit render / tone / jpeg ms |"
+say "|---|---|---|---|---|---|---|---|---|---|"
 for scene in $SCENES; do
   for backend in $BACKENDS; do
     for res in $RESOLUTIONS; do
       gpu=()
       [ "$backend" = cuda ] && gpu=(--strategy "$STRATEGY" --math "$MATH")
-      log=$OUT/viewer-$scene-$backend-$res.log
       # shellcheck disable=SC2086 # FILES holds the scene file and its -D parameter
-      "$VOLPT" view ${FILES[$scene]} --backend "$backend" "${gpu[@]}" --resolution "$res" \
-          --bind 127.0.0.1:0 >"$log" 2>&1 &
-      server=$!
-      url=
-      for _ in $(seq 600); do
-          url=$(sed -n 's/^volpt view: open http/ws/p' "$log")
-          [ -n "$url" ] && break
-          kill -0 "$server" 2>/dev/null || break
-          sleep 0.1
-      done
+      serve "$scene-$backend-$res" ${FILES[$scene]} --backend "$backend" "${gpu[@]}" --resolution "$res"
       if [ -z "$url" ]; then
           say "| $scene | $backend | $res | FAIL: no server ($(tail -n 1 "$log")) |"
           failures=$((failures + 1)); kill "$server" 2>/dev/null; wait "$server" 2>/dev/null; continue
       fi
       json=$(timeout "$LIMIT" "$CLIENT" "${url}ws" "$SECONDS_PER_PHASE" 2>>"$log")
       rc=$?
-      kill -INT "$server"; 
-      for _ in $(seq 100); do kill -0 "$server" 2>/dev/null || break; sleep 0.1; done
-      if kill -0 "$server" 2>/dev/null; then
-          echo "viewer.sh: $scene $backend $res: the server ignored SIGINT" | tee -a "$log"; kill -9 "$server"; failures=$((failures + 1))
-      fi
-      wait "$server" 2>/dev/null
+      stop
       if [ $rc -ne 0 ] || [ -z "$json" ]; then
           say "| $scene | $backend | $res | FAIL: client rc $rc ($(tail -n 1 "$log")) |"
           failures=$((failures + 1)); continue

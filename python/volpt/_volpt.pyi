@@ -165,7 +165,10 @@ class SceneParameters:
     Keys (``volpt.PARAMS`` says each one's range): ``spp``, ``seed``, ``max_depth``,
     ``rr_depth`` (int; -1 unlimited / never), ``camera.origin``, ``camera.target``,
     ``camera.up`` (3 floats), ``camera.fov`` (degrees), ``medium.scale`` (float),
-    ``medium.albedo`` (RGB; scenes with a constant albedo), ``phase.g`` (float in (-1, 1)).
+    ``medium.albedo`` (RGB; scenes with a constant albedo), ``phase.g`` (float in (-1, 1));
+    where the scene has them, its lights': ``sun.direction`` (3 floats, where the light travels),
+    ``sun.irradiance`` (RGB), ``sun.angular_radius`` (degrees), ``light.position``,
+    ``light.intensity`` (RGB, W/sr) and ``light.direction`` (a spot's axis).
 
     Values are ints, floats and tuples of three floats; a set value is checked as a loaded scene
     is, and a refusal (``ParamError``, a ``ValueError``; ``UnknownParamError``, a ``KeyError``,

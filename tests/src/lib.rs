@@ -40,6 +40,7 @@ pub fn cube_scene(
     env: f32,
 ) -> SceneDescription {
     SceneDescription {
+        lights: Default::default(),
         camera: CameraDesc {
             to_world: look_at([2.0, 1.5, 2.5]),
             fov_degrees: 45.0,

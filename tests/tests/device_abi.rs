@@ -265,6 +265,7 @@ fn a_new_instantiation_needs_only_its_registry_line() {
         boundary: NullBoundary,
         phase: Isotropic,
         environment: volpt_core::ConstantEnvironment(rgb.into()),
+        lights: volpt_core::Lights::NONE,
     };
     let (new, decoded, kernel) = RoundTrip {
         layout: GridLayout::Bricked,

@@ -52,6 +52,7 @@ fn scene(
     environment: EnvironmentDesc,
 ) -> SceneDescription {
     SceneDescription {
+        lights: Default::default(),
         camera: CameraDesc {
             to_world: look_at(camera_at),
             fov_degrees: fov,

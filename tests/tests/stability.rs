@@ -446,6 +446,7 @@ fn rays_through_edges_corners_faces_and_from_the_boundary() {
         let (mean, _) = with_scene(&furnace, settings(&furnace), along());
         assert_eq!(mean, 1.0, "{case}: furnace");
         let rough_furnace = SceneDescription {
+            lights: Default::default(),
             boundary: BoundaryDesc {
                 bounds: unit_bounds(),
                 bsdf: rough(0.1, 1.05, 1.01),

@@ -60,8 +60,8 @@ enum Command {
     /// Error against time for each setting: progressive renders, CSV, SVG and PNG plots, a table.
     Converge(converge::ConvergeArgs),
     /// Test the GPU strategies' collective building blocks (block scan and sort, warp and block
-    /// index takers, texture lookups) and the kernels' math functions on the GPU against plain
-    /// CPU implementations.
+    /// index takers, texture lookups), the kernels' math functions and the viewer's tone mapping
+    /// on the GPU against plain CPU implementations.
     Selftest {
         /// Which kernels: `exact` must give the CPU's bits, `fast` the documented accuracy of
         /// its approximate instructions.

@@ -40,6 +40,7 @@ fn scene(g: f32, last: f32, last_green: f32, int_ior: f32) -> SceneDescription {
         }
     };
     SceneDescription {
+        lights: Default::default(),
         camera: CameraDesc {
             to_world: [
                 [-1.0, 0.0, 0.0, 0.0],

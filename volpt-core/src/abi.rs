@@ -23,6 +23,7 @@ use bytemuck::{Pod, Zeroable};
 use crate::camera::PerspectiveCamera;
 use crate::geometry::Aabb;
 use crate::grid::{Grid, GridLayout, GridLookup, GridMapping, GridPlacement, TexelFormat};
+use crate::light::{Lights, LightsParams};
 use crate::mesh::{BvhNode, MeshTriangle, SurfaceDistance, TriangleMesh};
 use crate::path::{Estimator, PathSettings, Roulette};
 use crate::scene::{Scene, VolumeScene};
@@ -343,6 +344,7 @@ pub struct SceneParams<M, B, P, E> {
     pub settings: SettingsParams,
     /// The boundary's BVH if it is a mesh (its box is `bounds_min`, `bounds_max`).
     pub mesh: MeshParams,
+    pub lights: LightsParams,
     pub medium: M,
     pub boundary: B,
     pub phase: P,
@@ -356,7 +358,8 @@ impl<M: Pod, B: Pod, P: Pod, E: Pod> SceneParams<M, B, P, E> {
         let fixed = core::mem::size_of::<CameraParams>()
             + 24
             + core::mem::size_of::<SettingsParams>()
-            + core::mem::size_of::<MeshParams>();
+            + core::mem::size_of::<MeshParams>()
+            + core::mem::size_of::<LightsParams>();
         let parts = [
             core::mem::size_of::<M>(),
             core::mem::size_of::<B>(),
@@ -585,6 +588,7 @@ where
             bounds_max: self.bounds.device_box().max.to_array(),
             settings: SettingsParams::from(&self.settings),
             mesh: self.bounds.mesh_params(upload),
+            lights: LightsParams::from(&self.lights),
             medium: self.medium.to_params(upload),
             boundary: self.boundary.to_params(upload),
             phase: self.phase.to_params(upload),
@@ -609,6 +613,7 @@ where
                 boundary: B::from_params(&p.boundary),
                 phase: P::from_params(&p.phase),
                 environment: E::from_params(&p.environment),
+                lights: Lights::from(&p.lights),
                 settings: PathSettings::from(&p.settings),
             }
         }

@@ -22,6 +22,7 @@ pub mod frame;
 pub mod fresnel;
 pub mod geometry;
 pub mod grid;
+pub mod light;
 pub mod majorant;
 pub mod material;
 pub mod math;
@@ -51,6 +52,7 @@ pub use grid::{
     AnyLayout, DenseTrilinear, Grid, GridLayout, GridLookup, GridMapping, GridPlacement, GridReads,
     TexelFormat, TextureTrilinear,
 };
+pub use light::{DirectionalLight, Lights, SpotLight};
 pub use majorant::MajorantGrid;
 pub use material::{Material, MaterialGrid};
 pub use medium::{

@@ -35,6 +35,7 @@ use core::ops::Range;
 use crate::bsdf::Bsdf;
 use crate::environment::Environment;
 use crate::geometry::BoxHit;
+use crate::light;
 use crate::medium::Medium;
 use crate::phase::PhaseFunction;
 use crate::rng::Rng;
@@ -239,7 +240,7 @@ impl<X: SpectralState> PathState<X> {
 
     /// Ends the path at a safety bound; it contributes zero.
     #[inline]
-    fn truncate(&mut self, bound: Truncation) {
+    pub(crate) fn truncate(&mut self, bound: Truncation) {
         self.truncated = bound;
         self.radiance = Spectrum::ZERO;
         self.alive = false;
@@ -348,7 +349,7 @@ fn advance<S: Scene, const DEFER_SCATTER: bool>(scene: &S, path: &mut PathOf<S>)
                     let light_pdf = scene.environment().pdf(path.ray.dir);
                     light *= power_heuristic(path.mis_pdf, light_pdf);
                 }
-                path.radiance += light;
+                path.radiance += light + light::escaped_sun(scene, path);
                 path.alive = false;
             }
         }
@@ -411,12 +412,15 @@ pub fn scatter<S: Scene>(scene: &S, path: &mut PathOf<S>, p: Vec3, albedo: Optio
     }
     let next_event = PathOf::<S>::uses_next_event(scene);
     let phase = collision_phase(scene, p);
-    if next_event && !next_event_estimate(scene, path, p, &phase) {
+    // The scene's other lights are sampled behind an index-matched boundary whatever the
+    // estimator: a delta light is reached by no other strategy.
+    let lights = S::Bsdf::IS_NULL && scene.lights().any();
+    if (next_event || lights) && !next_event_estimate(scene, path, p, &phase, next_event) {
         return;
     }
     let sample = phase.sample(path.ray.dir, path.rng.next_2d());
     path.ray = Ray::new(p, sample.wo);
-    if next_event {
+    if next_event || lights {
         path.mis_pdf = sample.pdf;
     }
     path.russian_roulette(settings);
@@ -435,58 +439,85 @@ fn collision_phase<S: Scene>(scene: &S, p: Vec3) -> S::Phase {
 }
 
 /// Next-event estimation at a scattering event at `p` (Veach 1997, ch. 9; pbrt-v4 section 14.2.2):
-/// a look direction `w` sampled from the environment with density `p_env` adds
+/// a look direction `w` sampled from the environment (if `environment`) with density `p_env` adds
 /// `throughput * phase(w) * T(p, w) * L_env(w) * w_env / p_env`, with `T` the transmittance to the
 /// box estimated by ratio tracking and `w_env = p_env^2 / (p_env^2 + phase(w)^2)` the power
 /// heuristic; the path's phase-sampled continuation keeps `phase(wo)` so that, should it escape,
-/// its light takes the complementary weight. Both strategies together are unbiased. Valid only
-/// where nothing but the medium lies between `p` and the environment: an index-matched boundary.
-/// False (and the path is cut) when ratio tracking runs out of steps.
+/// its light takes the complementary weight. Both strategies together are unbiased. Each of the
+/// scene's other lights adds the same with its own sample ([`light::samples`]: weight 1 for a
+/// delta light; `T` up to a point light). Valid only where nothing but the medium lies between
+/// `p` and the lights: an index-matched boundary. False (and the path is cut) when ratio tracking
+/// runs out of steps.
 #[inline(always)]
 fn next_event_estimate<S: Scene>(
     scene: &S,
     path: &mut PathOf<S>,
     p: Vec3,
     phase: &S::Phase,
+    environment: bool,
 ) -> bool {
-    let Some(light) = scene.environment().sample(path.rng.next_2d()) else {
-        return true;
+    let env = if environment {
+        scene
+            .environment()
+            .sample(path.rng.next_2d())
+            .map(light::LightSample::from)
+    } else {
+        None
     };
-    let phase = phase.eval(path.ray.dir, light.dir);
-    let shadow = Ray::new(p, light.dir);
-    let Some(transmittance) = shadow_transmittance(scene, path, shadow) else {
-        path.truncate(Truncation::TrackingSteps);
-        return false;
-    };
-    path.radiance += path.spectral.next_event_light(
-        path.throughput,
-        light.radiance,
-        power_heuristic(light.pdf, phase),
-        phase,
-        light.pdf,
-        transmittance,
-    );
+    let [sun, spot] = light::samples(scene, path, p);
+    // One loop over the samples, not an array of them (a GPU would keep an indexed array in local
+    // memory): one body keeps one copy of ratio tracking in the kernels.
+    for slot in 0..3 {
+        let Some(light) = (match slot {
+            0 => env,
+            1 => sun,
+            _ => spot,
+        }) else {
+            continue;
+        };
+        let phase = phase.eval(path.ray.dir, light.dir);
+        let mis = if light.delta {
+            1.0
+        } else {
+            power_heuristic(light.pdf, phase)
+        };
+        let shadow = Ray::new(p, light.dir);
+        let Some(transmittance) = shadow_transmittance(scene, path, shadow, light.distance) else {
+            path.truncate(Truncation::TrackingSteps);
+            return false;
+        };
+        path.radiance += path.spectral.next_event_light(
+            path.throughput,
+            light.light,
+            mis,
+            phase,
+            light.pdf,
+            transmittance,
+        );
+    }
     true
 }
 
-/// The transmittance along `shadow` to the environment, estimated by ratio tracking over each
-/// chord through the medium: one for a convex shape (the box's code is the single call); a ray
-/// that leaves a non-convex one (a torus) may enter it again. `None` when tracking runs out of
-/// steps. Per channel for a chromatic medium ([`SpectralState::Transmittance`]).
+/// The transmittance along `shadow` up to `distance` (a point light's; infinite for the
+/// environment), estimated by ratio tracking over each chord through the medium: one for a convex
+/// shape (the box's code is the single call); a ray that leaves a non-convex one (a torus) may
+/// enter it again. `None` when tracking runs out of steps. Per channel for a chromatic medium
+/// ([`SpectralState::Transmittance`]).
 ///
-/// One ratio tracking, in the loop: a shape convex only at run time (the kernels' boundary)
-/// then costs the box no second copy of it.
+/// One ratio tracking, in the loop: a shape convex only at run time then costs the box no second
+/// copy of it.
 #[inline(always)]
 fn shadow_transmittance<S: Scene>(
     scene: &S,
     path: &mut PathOf<S>,
     shadow: Ray,
+    distance: f32,
 ) -> Option<Transmittance<S>> {
-    let mut shadow = shadow;
+    let (mut shadow, mut distance) = (shadow, distance);
     // The product of the chords before this one.
     let mut before: Option<Transmittance<S>> = None;
     loop {
-        let chord = chord_transmittance(scene, path, &shadow)?;
+        let chord = chord_transmittance(scene, path, &shadow, distance)?;
         let transmittance = match before {
             Some(mut t) => {
                 t *= chord;
@@ -499,8 +530,11 @@ fn shadow_transmittance<S: Scene>(
         }
         let exit = scene.shape().exit(&shadow);
         match scene.shape().entry(&Ray::new(exit.point, shadow.dir)) {
-            Some(entry) => shadow.origin = entry.point,
-            None => return Some(transmittance),
+            Some(entry) if entry.point.distance(shadow.origin) < distance => {
+                distance -= entry.point.distance(shadow.origin);
+                shadow.origin = entry.point;
+            }
+            _ => return Some(transmittance),
         }
         before = Some(transmittance);
     }
@@ -509,7 +543,8 @@ fn shadow_transmittance<S: Scene>(
 /// A transmittance estimate of scene `S`'s medium.
 type Transmittance<S> = <SpectralOf<S> as SpectralState>::Transmittance;
 
-/// Ratio tracking's estimate along `ray`, from inside the medium to where it leaves the shape.
+/// Ratio tracking's estimate along `ray`, from inside the medium to where it leaves the shape or
+/// to `distance`, whichever is nearer.
 /// A function, not a closure: a closure called from two places may stay a function of its own,
 /// which on a GPU takes the scene into local memory.
 #[inline(always)]
@@ -517,11 +552,15 @@ fn chord_transmittance<S: Scene>(
     scene: &S,
     path: &mut PathOf<S>,
     ray: &Ray,
+    distance: f32,
 ) -> Option<Transmittance<S>> {
+    let exit = scene.shape().exit_distance(ray);
+    // Compared, not `min`: an infinite `distance` (the environment's) folds away.
+    let t_max = if distance < exit { distance } else { exit };
     SpectralOf::<S>::transmittance(
         scene.medium(),
         ray,
-        scene.shape().exit_distance(ray),
+        t_max,
         &mut path.rng,
         &mut path.tracking_steps,
         scene.settings().max_tracking_steps,
@@ -568,7 +607,7 @@ fn boundary_next_event_estimate<S: Scene>(scene: &S, path: &mut PathOf<S>, hit: 
 /// Veach's power heuristic with exponent 2: the weight of a strategy of density `a` against one of
 /// density `b`.
 #[inline]
-fn power_heuristic(a: f32, b: f32) -> f32 {
+pub(crate) fn power_heuristic(a: f32, b: f32) -> f32 {
     let (a2, b2) = (a * a, b * b);
     if a2 + b2 > 0.0 {
         a2 / (a2 + b2)

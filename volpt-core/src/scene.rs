@@ -3,6 +3,7 @@
 use crate::bsdf::Bsdf;
 use crate::camera::PerspectiveCamera;
 use crate::environment::Environment;
+use crate::light::Lights;
 use crate::medium::Medium;
 use crate::path::PathSettings;
 use crate::phase::PhaseFunction;
@@ -10,7 +11,7 @@ use crate::shape::Shape;
 use crate::{Aabb, Spectrum, Vec3};
 
 /// A solid participating medium inside a closed boundary (a box or a triangle mesh), lit by its
-/// environment.
+/// environment and the lights besides it ([`Lights`]: a sun, a point or spot).
 ///
 /// Backends are generic over `Scene`, so every combination of parts is monomorphised: a scene whose
 /// boundary is index-matched compiles no Fresnel code, and a constant albedo reads no grid.
@@ -33,6 +34,11 @@ pub trait Scene {
     fn boundary(&self) -> &Self::Bsdf;
     fn phase(&self) -> &Self::Phase;
     fn environment(&self) -> &Self::Environment;
+    /// The lights besides the environment; none unless the scene has them.
+    #[inline]
+    fn lights(&self) -> &Lights {
+        &Lights::NONE
+    }
     fn settings(&self) -> &PathSettings;
 
     #[inline]
@@ -52,6 +58,8 @@ pub struct VolumeScene<M, B, P, E, S = Aabb> {
     pub boundary: B,
     pub phase: P,
     pub environment: E,
+    /// The lights besides the environment ([`Lights::NONE`] for none).
+    pub lights: Lights,
     pub settings: PathSettings,
 }
 
@@ -91,6 +99,10 @@ impl<M: Medium, B: Bsdf, P: PhaseFunction, E: Environment, S: Shape> Scene
     #[inline]
     fn environment(&self) -> &E {
         &self.environment
+    }
+    #[inline]
+    fn lights(&self) -> &Lights {
+        &self.lights
     }
     #[inline]
     fn settings(&self) -> &PathSettings {
@@ -136,6 +148,10 @@ impl<S: Scene, Sh: Shape> Scene for WithShape<'_, S, Sh> {
     #[inline]
     fn environment(&self) -> &S::Environment {
         self.scene.environment()
+    }
+    #[inline]
+    fn lights(&self) -> &Lights {
+        self.scene.lights()
     }
     #[inline]
     fn settings(&self) -> &PathSettings {

@@ -152,6 +152,20 @@ fn scene() -> Furnace {
         boundary: NullBoundary,
         phase: HenyeyGreenstein { g: 0.6 },
         environment: ConstantEnvironment(Vec3::new(0.25, 1.5, 3.0)),
+        lights: volpt_core::Lights {
+            sun: volpt_core::DirectionalLight::new(
+                Vec3::new(0.3, -1.0, 0.2),
+                0.1,
+                Vec3::new(2.0, 1.5, 1.0),
+            ),
+            spot: volpt_core::SpotLight::spot(
+                Vec3::new(0.0, 2.0, 0.0),
+                Vec3::new(0.0, -1.0, 0.1),
+                Vec3::splat(5.0),
+                0.5,
+                0.3,
+            ),
+        },
         settings: settings()[0],
     }
 }
@@ -203,6 +217,7 @@ fn a_scene_survives_the_device_encoding() {
     assert_eq!(decoded.medium.albedo, scene.medium.albedo);
     assert_eq!(decoded.phase.g, scene.phase.g);
     assert_eq!(decoded.environment.0, scene.environment.0);
+    assert_eq!(decoded.lights, scene.lights);
 }
 
 /// The kernel entry point of a scene type is named by its parts, in registry order (medium,

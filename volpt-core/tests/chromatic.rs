@@ -77,6 +77,7 @@ fn scene_under<M: Medium, B: Bsdf, E: Environment>(
         boundary,
         phase: HenyeyGreenstein { g: 0.3 },
         environment,
+        lights: volpt_core::Lights::NONE,
         settings: PathSettings {
             estimator,
             ..Default::default()

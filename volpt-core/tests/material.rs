@@ -62,6 +62,7 @@ fn scene<M: Medium, B: Bsdf>(
         boundary,
         phase: HenyeyGreenstein { g },
         environment: ConstantEnvironment(Spectrum::from_array(LIGHT)),
+        lights: volpt_core::Lights::NONE,
         settings: PathSettings {
             estimator,
             ..Default::default()

@@ -345,6 +345,7 @@ fn an_absorber_in_a_sphere_and_a_torus_transmits_exp_minus_sigma_chord() {
             boundary: NullBoundary,
             phase: HenyeyGreenstein { g: 0.0 },
             environment: ConstantEnvironment(Spectrum::ONE),
+            lights: volpt_core::Lights::NONE,
             settings: PathSettings::default(),
         };
         let mut worst: f64 = 0.0;
@@ -426,6 +427,7 @@ fn box_and_mesh<B: volpt_core::Bsdf + Copy>(boundary: B, estimator: Estimator, s
         boundary,
         phase: HenyeyGreenstein { g: 0.3 },
         environment: ConstantEnvironment(Spectrum::ONE),
+        lights: volpt_core::Lights::NONE,
         settings,
     };
     let meshed = VolumeScene {
@@ -435,6 +437,7 @@ fn box_and_mesh<B: volpt_core::Bsdf + Copy>(boundary: B, estimator: Estimator, s
         boundary,
         phase: boxed.phase,
         environment: boxed.environment,
+        lights: volpt_core::Lights::NONE,
         settings,
     };
     // The factory's scene: either held as a run-time `BoundaryShape`.
@@ -445,10 +448,12 @@ fn box_and_mesh<B: volpt_core::Bsdf + Copy>(boundary: B, estimator: Estimator, s
         boundary,
         phase: boxed.phase,
         environment: boxed.environment,
+        lights: volpt_core::Lights::NONE,
         settings,
     };
     let as_run_time_device = |shape| VolumeScene {
         bounds: shape,
+        lights: boxed.lights,
         camera: boxed.camera,
         medium: boxed.medium,
         boundary,
@@ -530,6 +535,7 @@ fn the_kernels_mesh_boundary_traces_the_cpus_paths_in_a_sphere_and_a_torus() {
                 let scene = |bounds| VolumeScene {
                     camera: camera(),
                     bounds,
+                    lights: volpt_core::Lights::NONE,
                     medium: HomogeneousMedium {
                         sigma_t,
                         albedo: Spectrum::new(0.95, 0.8, 0.6),
@@ -545,6 +551,7 @@ fn the_kernels_mesh_boundary_traces_the_cpus_paths_in_a_sphere_and_a_torus() {
                 let cpu = scene(BoundaryShape::Mesh(buffers.mesh()));
                 let device = VolumeScene {
                     bounds: DeviceBoundary::mesh(&buffers.mesh()),
+                    lights: cpu.lights,
                     camera: cpu.camera,
                     medium: cpu.medium,
                     boundary: cpu.boundary,
@@ -641,6 +648,7 @@ fn the_furnace_in_a_torus_returns_the_light_with_and_without_next_event_estimati
             boundary: NullBoundary,
             phase: HenyeyGreenstein { g: 0.3 },
             environment: ConstantEnvironment(Spectrum::ONE),
+            lights: volpt_core::Lights::NONE,
             settings: PathSettings {
                 estimator,
                 ..PathSettings::default()

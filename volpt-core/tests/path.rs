@@ -58,6 +58,7 @@ fn furnace_behind<B>(boundary: B, settings: PathSettings) -> Furnace<B> {
         boundary,
         phase: HenyeyGreenstein { g: 0.6 },
         environment: ConstantEnvironment(Spectrum::splat(LIGHT)),
+        lights: volpt_core::Lights::NONE,
         settings,
     }
 }

@@ -45,6 +45,7 @@ fn rough_furnace(
         },
         phase: HenyeyGreenstein { g: 0.6 },
         environment: ConstantEnvironment(Spectrum::splat(LIGHT)),
+        lights: volpt_core::Lights::NONE,
         settings: PathSettings {
             rr_depth: PathSettings::UNLIMITED,
             ..PathSettings::default()
@@ -114,6 +115,7 @@ fn sunlit<'a>(
             distribution: Ggx { alpha: 0.2 },
         },
         environment: sky,
+        lights: volpt_core::Lights::NONE,
         settings: PathSettings {
             rr_depth: 5,
             estimator,

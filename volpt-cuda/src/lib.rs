@@ -8,6 +8,9 @@
 //!   [`Math`]: exact or fast kernels.
 //! - [`selftest`]: the strategies' collective building blocks, texture lookups and the kernels' math
 //!   functions on the GPU against the CPU.
+//! - [`in_flight`]: renders that stop at a deadline with paths in flight, continued by the next
+//!   call (a viewer's frames do not wait for their longest path).
+//! - [`tone`]: the viewer's frames tone mapped on the GPU, from the film a render left there.
 //! - [`error`]: what can go wrong, from "no GPU here" to a failed launch.
 //!
 //! The CUDA driver is loaded at run time, so a binary with this crate builds and runs on machines
@@ -15,9 +18,11 @@
 
 pub mod entry;
 pub mod error;
+pub mod in_flight;
 pub mod kernels;
 pub mod renderer;
 pub mod selftest;
+pub mod tone;
 
 pub use error::CudaError;
 pub use renderer::{CudaRenderer, Schedule, DEFAULT_REFILL_AT};

@@ -52,7 +52,7 @@ pub const DEFAULT_REFILL_AT: u32 = 8;
 
 /// Iterations a multi-kernel strategy queues between looks at its counters: a look waits for
 /// the GPU, and the iterations queued beyond the last path's end cost a few microseconds each.
-const WAVEFRONT_BATCH: u32 = 16;
+pub(crate) const WAVEFRONT_BATCH: u32 = 16;
 
 impl From<Strategy> for Schedule {
     fn from(strategy: Strategy) -> Self {
@@ -108,7 +108,7 @@ pub struct CudaRenderer {
     /// The modules compiled so far, one kernel each, by entry point and register cap.
     modules: Mutex<HashMap<KernelKey, Arc<CudaModule>>>,
     device_name: String,
-    multiprocessors: u32,
+    pub(crate) multiprocessors: u32,
     volumes: VolumePolicy,
     /// The grids of the scene rendered last by [`CudaRenderer::render_samples_keeping`].
     resident: Arc<ResidentGrids>,
@@ -119,20 +119,34 @@ pub struct CudaRenderer {
     /// The last render's film and counters on the device, which the next render of an image of
     /// the same size zeroes and reuses: a viewer's frames and several GPUs' batches are many
     /// short renders, and allocating them anew cost milliseconds each.
-    buffers: Mutex<Option<RenderBuffers>>,
+    pub(crate) buffers: Mutex<Option<RenderBuffers>>,
+    /// A render stopped at its deadline with paths in flight ([`crate::in_flight`]).
+    pub(crate) in_flight: Mutex<Option<crate::in_flight::InFlight>>,
+    /// The last 8-bit frame tone mapped on the device ([`crate::tone`]), three bytes a pixel.
+    pub(crate) frame: Mutex<Option<CudaSlice<u8>>>,
 }
 
 /// A render's device memory besides its grids and queues.
-struct RenderBuffers {
+pub(crate) struct RenderBuffers {
     /// Three `f64` sums per pixel.
-    film: CudaSlice<f64>,
-    counters: CudaSlice<u64>,
-    next_path: CudaSlice<u64>,
-    queue_state: CudaSlice<u64>,
+    pub(crate) film: CudaSlice<f64>,
+    pub(crate) counters: CudaSlice<u64>,
+    pub(crate) next_path: CudaSlice<u64>,
+    pub(crate) queue_state: CudaSlice<u64>,
+    /// What `film` holds after the last render: the sums of samples `0..spp` of an image of
+    /// `size`, or `None` (a batch of several GPUs holds later samples alone) ([`crate::tone`]).
+    pub(crate) holds: Option<FilmHeld>,
+}
+
+/// A device film's image size and the samples `0..spp` it holds the sums of.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct FilmHeld {
+    pub(crate) size: (u32, u32),
+    pub(crate) spp: u32,
 }
 
 impl RenderBuffers {
-    fn new(stream: &Arc<CudaStream>, pixels: u64) -> Result<Self, CudaError> {
+    pub(crate) fn new(stream: &Arc<CudaStream>, pixels: u64) -> Result<Self, CudaError> {
         Ok(Self {
             film: stream
                 .alloc_zeros(3 * pixels as usize)
@@ -144,12 +158,13 @@ impl RenderBuffers {
             queue_state: stream
                 .alloc_zeros(size_of::<Wavefront>() / 8)
                 .doing("allocating the queue counters")?,
+            holds: None,
         })
     }
 
     /// Zeroes what a render reads before it writes: the counters, and the film unless the
     /// caller copies sums into it.
-    fn zero(&mut self, stream: &Arc<CudaStream>, film: bool) -> Result<(), CudaError> {
+    pub(crate) fn zero(&mut self, stream: &Arc<CudaStream>, film: bool) -> Result<(), CudaError> {
         if film {
             stream
                 .memset_zeros(&mut self.film)
@@ -225,6 +240,8 @@ impl CudaRenderer {
             resident: Arc::default(),
             launch_budget: Mutex::default(),
             buffers: Mutex::default(),
+            in_flight: Mutex::default(),
+            frame: Mutex::default(),
         })
     }
 
@@ -282,7 +299,7 @@ impl CudaRenderer {
     ///
     /// # Safety
     /// With `keep`, as [`CudaRenderer::render_samples_keeping`].
-    unsafe fn place<S: SceneAbi>(
+    pub(crate) unsafe fn place<S: SceneAbi>(
         &self,
         scene: &S,
         keep: Option<u64>,
@@ -421,6 +438,8 @@ impl CudaRenderer {
         // whose film starts empty.
         let resumed = samples.start > 0 && film.holds_samples();
         buffers.zero(stream, !resumed)?;
+        // Until this render has ended, the film holds nothing a frame may show.
+        buffers.holds = None;
         if resumed {
             stream
                 .memcpy_htod(film.flat_sums(), &mut buffers.film)
@@ -431,6 +450,7 @@ impl CudaRenderer {
             counters,
             next_path,
             queue_state,
+            ..
         } = &mut buffers;
         let per_sm = kernel
             .occupancy_max_active_blocks_per_multiprocessor(BLOCK_SIZE, 0, None)
@@ -586,6 +606,15 @@ impl CudaRenderer {
             .doing("reading the film")?;
         let totals = stream.clone_dtoh(counters).doing("reading the counters")?;
         drop(volumes);
+        // The sums of every sample before `samples.end`: a render from sample 0, or one that
+        // continued the caller's sums; a batch of several GPUs (a later range into an empty film)
+        // holds its own samples alone.
+        if samples.start == 0 || resumed {
+            buffers.holds = Some(FilmHeld {
+                size: (width, height),
+                spp: samples.end,
+            });
+        }
         *self.buffers.lock().unwrap_or_else(|e| e.into_inner()) = Some(buffers);
         let counters = PathCounters {
             paths: totals[0],
@@ -608,7 +637,7 @@ impl CudaRenderer {
 /// Launch parameters passed by value: the driver copies their bytes into the kernel's parameter
 /// space (the constant bank), as the kernel's signature asks.
 #[repr(transparent)]
-struct ByValue<P>(LaunchParams<P>);
+pub(crate) struct ByValue<P>(pub(crate) LaunchParams<P>);
 
 // SAFETY: `LaunchParams<P>` of `Pod` scene parameters is plain `repr(C)` data without padding
 // (`LaunchParams::LAYOUT`), the layout the kernel's parameter declares.

@@ -4,9 +4,11 @@
 //! the sorting strategies (Morton keys, ended paths as the largest key, ties) and the warp and
 //! block index takers of regeneration (`volpt_device::selftest`); grid lookups through textures against
 //! the CPU's reproduction of the texture unit's filter; and `volpt_core::math` as the loaded kernels
-//! compile it ([`math`]: the CPU's bits, or the fast kernels' documented accuracy).
+//! compile it ([`math`]: the CPU's bits, or the fast kernels' documented accuracy); and the
+//! viewer's tone mapping against the CPU's frames ([`tone`]).
 
 pub mod math;
+pub mod tone;
 
 use cudarc::driver::{CudaSlice, LaunchConfig, PushKernelArg};
 use volpt_core::abi::GridParams;
@@ -233,7 +235,38 @@ impl CudaRenderer {
             results.push(self.texture_lookups::<1>(texel, Samples::Constant)?);
         }
         results.push(self.math_functions()?);
+        results.push(self.tone_mapping()?);
         Ok(results)
+    }
+
+    /// Tone maps [`tone::film`] on the GPU at each of [`tone::EXPOSURES`] and compares with the
+    /// CPU's frames ([`tone::check`]).
+    pub fn tone_mapping(&self) -> Result<SelfTest, CudaError> {
+        const PIXELS: u32 = 1 << 16;
+        const SPP: u32 = 7;
+        let stream = self.stream();
+        let film = tone::film(PIXELS, SPP);
+        let device_film = stream
+            .clone_htod(film.flat_sums())
+            .doing("copying test input")?;
+        let mut frame: CudaSlice<u8> = stream
+            .alloc_zeros(3 * PIXELS as usize)
+            .doing("allocating test output")?;
+        let (mut failures, mut measured) = (Vec::new(), Vec::new());
+        for exposure in tone::EXPOSURES {
+            self.launch_tone_map(&device_film, &mut frame, PIXELS, SPP, exposure)?;
+            let got = stream.clone_dtoh(&frame).doing("reading test output")?;
+            let expected = tone::cpu_frame(&film, SPP, exposure);
+            let (f, m) = tone::check(&expected, &got, &format!("exposure {exposure}"));
+            failures.extend(f);
+            measured.push(m);
+        }
+        Ok(SelfTest {
+            name: "tone mapping",
+            threads: PIXELS as usize,
+            failures,
+            measured: measured.join("; "),
+        })
     }
 
     /// Runs `volpt_core::math`'s functions on the GPU ([`math`]) and compares with the CPU's bits

@@ -1,5 +1,6 @@
 //! The kernels this build embeds are exactly the registry's: every variant has an entry point for
-//! every strategy, and the PTX holds no entry point that no variant uses; and the pack they are
+//! every strategy, and the PTX holds no entry point that no variant uses (besides the selftests
+//! and the tone mapping, which serve every variant); and the pack they are
 //! embedded in gives back every kernel alone, and the whole PTX it was made of.
 //!
 //! CI builds the PTX (`cargo xtask ptx`) and sets `VOLPT_REQUIRE_PTX=1`, so a missing PTX fails
@@ -46,6 +47,7 @@ fn exports_exactly_the_registry(math: Math) {
         .iter()
         .map(String::as_str)
         .chain(volpt_device::selftest::ENTRIES)
+        .chain(volpt_device::tone::ENTRIES)
         .collect();
     let missing: Vec<_> = registry.difference(&exported).collect();
     let unused: Vec<_> = exported.difference(&registry).collect();

@@ -120,7 +120,7 @@ impl Image {
 }
 
 /// The sRGB transfer function (IEC 61966-2-1) of a linear value clipped to [0, 1]; NaN maps to 0.
-fn srgb_encode(linear: f32) -> f32 {
+pub(crate) fn srgb_encode(linear: f32) -> f32 {
     let c = if linear.is_nan() {
         0.0
     } else {

@@ -7,11 +7,13 @@
 //! - [`checkpoint`]: a render's sums saved to a file, to resume it bit for bit.
 //! - [`film_file`]: the sums of any sample ranges of a render, to merge with the other ranges'.
 //! - [`regular`]: opening only regular files (a FIFO would block a reader for ever).
+//! - [`tone`]: the viewer's frames (exposure, sRGB, 8 bits) on the CPU.
 
 pub mod checkpoint;
 pub mod film_file;
 pub mod image;
 pub mod regular;
+pub mod tone;
 
 use std::ops::Range;
 use std::time::Duration;

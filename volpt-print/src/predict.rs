@@ -256,6 +256,7 @@ impl SceneBuilder for PrintScene<'_> {
             [0.0, 0.0, 0.0, 1.0],
         ];
         Ok(SceneDescription {
+            lights: Default::default(),
             camera: CameraDesc {
                 to_world,
                 // Unused by an orthographic camera.

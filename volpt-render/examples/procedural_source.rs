@@ -41,6 +41,7 @@ impl SceneBuilder for Shell {
         let to_world = volpt_scene::toml_scene::look_at([2.0, 1.5, 3.0], [0.0; 3], [0.0, 1.0, 0.0])
             .expect("a valid camera");
         Ok(SceneDescription {
+            lights: Default::default(),
             camera: CameraDesc {
                 to_world,
                 fov_degrees: 30.0,

@@ -11,6 +11,7 @@ use serde::Serialize;
 
 pub use crate::boundary::BsdfDesc;
 pub use crate::environment::{EnvironmentDesc, LatLongDesc, LatLongRows};
+pub use crate::light::{LightsDesc, SpotCone, SpotDesc, SunDesc};
 pub use crate::medium::{AlbedoDesc, DensityDesc, GridLookup, GridStorage, MediumDesc};
 pub use crate::mesh::MeshDesc;
 pub use crate::phase::PhaseDesc;
@@ -43,6 +44,8 @@ pub struct SceneDescription {
     pub boundary: BoundaryDesc,
     pub medium: MediumDesc,
     pub environment: EnvironmentDesc,
+    /// The lights besides the environment (a sun, a point or spot light).
+    pub lights: LightsDesc,
 }
 
 /// Which image axis the field of view spans (Mitsuba's `fovAxis` / `fov_axis`).

@@ -4,6 +4,8 @@
 //! - [`medium`], [`phase`], [`boundary`], [`environment`]: one axis of the scene each, everything about its
 //!   descriptions: what they say, how each format spells them, their checks, their export, how
 //!   `volpt info` prints them, and how each registry part of the axis is built from them.
+//! - [`light`]: the lights besides the environment (a sun, a point or spot light), as the
+//!   environment's file does it for the environment (no registry axis: a run-time part).
 //! - [`from_description`]: the rule from a description to a registry part ([`FromDescription`]),
 //!   and [`simplification`]: where a part is simpler than the description names.
 //! - [`param`]: the numbers of a description a scene takes between renders.
@@ -42,6 +44,7 @@ pub mod environment;
 pub mod error;
 pub mod from_description;
 pub mod generate;
+pub mod light;
 pub mod limits;
 pub mod material;
 pub mod medium;

@@ -20,6 +20,7 @@ use crate::{normalise, read_metaimage, read_vol, read_vtk};
 
 pub use crate::boundary::{BoundarySpec, BsdfKind, Ior};
 pub use crate::environment::EnvironmentSpec;
+pub use crate::light::LightSpec;
 pub use crate::medium::AlbedoSpec;
 pub use crate::phase::PhaseSpec;
 
@@ -45,6 +46,9 @@ pub struct SceneFile {
     pub integrator: IntegratorSpec,
     #[serde(default)]
     pub environment: EnvironmentSpec,
+    /// Lights besides the environment: a sun, a point or a spot light ([`LightSpec`]).
+    #[serde(default)]
+    pub lights: Vec<LightSpec>,
     /// A material-indexed volume's table: `[volume]` is then its index grid (or PNG slices).
     #[serde(default)]
     pub materials: Vec<MaterialSpec>,
@@ -389,6 +393,7 @@ pub fn load_volume_only(
         sampler: SamplerSpec::default(),
         integrator: IntegratorSpec::default(),
         environment: EnvironmentSpec::default(),
+        lights: Vec::new(),
         materials: Vec::new(),
     };
     assemble(&Cx { path, text: "" }, Path::new(""), file, params)
@@ -740,6 +745,7 @@ fn finish(
         boundary,
         medium,
         environment,
+        lights: LightSpec::lights(&file.lights, cx)?,
     })
 }
 

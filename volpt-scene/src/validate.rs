@@ -119,6 +119,7 @@ fn check(
     }
 
     desc.environment.check(source, checked.is_none())?;
+    desc.lights.check(source)?;
     Ok(data)
 }
 

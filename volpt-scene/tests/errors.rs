@@ -455,13 +455,16 @@ fn second_emitter_is_unsupported() {
 }
 
 #[test]
-fn emitter_other_than_an_environment_is_unsupported() {
+fn emitter_volpt_does_not_have_is_unsupported() {
     let text = bsdf_scene(r#"<bsdf type="null"/>"#).replace(
         "<shape",
-        "<emitter type=\"point\"><point name=\"position\" x=\"0\" y=\"2\" z=\"0\"/></emitter>\n<shape",
+        "<emitter type=\"projector\"><float name=\"fov\" value=\"30\"/></emitter>\n<shape",
     );
-    let err = error_at(&text, "type=\"point\"");
-    message_of(&err, &["<emitter type=\"point\">", "constant", "envmap"]);
+    let err = error_at(&text, "type=\"projector\"");
+    message_of(
+        &err,
+        &["<emitter type=\"projector\">", "constant", "envmap"],
+    );
 }
 
 #[test]

@@ -10,11 +10,19 @@
 //! 3. orbit: camera moves at 60 Hz (interactive, as a drag sends them) for SECONDS: frames/s of
 //!    frames showing a move, the time from a move to the frame showing it, and the resolution.
 //!
-//! Between 1 and 2, the view of the first move is shown again: its first frame must equal the
-//! first one byte for byte (`repeat_identical`), as a render of a scene whose camera went
+//! Between 1 and 2, the view of the first move is shown again: its first frame of one whole sample
+//! (the first frame, unless paths were in flight at its deadline) must equal the first time's
+//! byte for byte (`repeat_identical`), as a render of a scene whose camera went
 //! elsewhere and came back, its grids kept on the GPU in between, must.
 //!
 //! Prints one JSON object.
+//!
+//! Usage: viewer_bench WS_URL --snapshot FILE
+//!
+//! The accumulation instead: a drag away from the initial view and a still move back, then the
+//! linear image (`/snapshot.exr`) once the still view has all its samples, written to FILE
+//! (bench/device/viewer.sh compares the GPU's with the CPU's); prints the last frame's header and
+//! how many of the still view's frames had paths in flight.
 
 use std::time::{Duration, Instant};
 
@@ -74,6 +82,22 @@ async fn next_frame(ws: &mut Ws, deadline: Instant) -> Option<(Value, usize, u64
     }
 }
 
+/// The image hash of epoch `epoch`'s first frame of one whole sample: `first` (that epoch's first
+/// frame) if it is one, else the next that is. A frame with paths in flight (a multi-kernel
+/// strategy's, stopped at its deadline) shows those that had ended by then, which depends on time.
+async fn first_sample(ws: &mut Ws, epoch: u64, first: &(Value, u64)) -> Option<u64> {
+    if first.0["spp"].as_u64() >= Some(1) {
+        return Some(first.1);
+    }
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while let Some((h, _, image)) = next_frame(ws, deadline).await {
+        if h["epoch"].as_u64() == Some(epoch) && h["spp"].as_u64() >= Some(1) {
+            return Some(image);
+        }
+    }
+    None
+}
+
 fn median(mut v: Vec<f64>) -> Option<f64> {
     v.sort_by(|a, b| a.total_cmp(b));
     (!v.is_empty()).then(|| v[v.len() / 2])
@@ -83,11 +107,81 @@ fn mean(v: &[f64]) -> Option<f64> {
     (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
 }
 
+/// The accumulation mode: a drag away, a still move back to the initial view, then its linear
+/// image once it has all its samples, written to `file`. Prints the last frame's header and how
+/// many frames of the still view showed paths in flight.
+async fn snapshot(ws: &mut Ws, url: &str, hello: &Value, file: &str) {
+    let initial = &hello["initial"];
+    let (origin, target, up) = (
+        vec3(&initial["origin"]),
+        vec3(&initial["target"]),
+        vec3(&initial["up"]),
+    );
+    let far = Instant::now() + Duration::from_secs(60);
+    next_frame(ws, far).await.expect("a first frame");
+    let away = orbit(origin, target, up, 0.3);
+    let drag = json!({"type": "camera", "origin": away, "target": target, "interactive": true});
+    send(ws, drag).await;
+    while let Some((h, _, _)) = next_frame(ws, far).await {
+        if h["interactive"] == true {
+            break;
+        }
+    }
+    send(
+        ws,
+        json!({"type": "camera", "origin": initial["origin"], "target": initial["target"]}),
+    )
+    .await;
+    let mut in_flight = 0u32;
+    let last = loop {
+        let (h, _, _) = next_frame(ws, far).await.expect("the still view's frames");
+        in_flight += u32::from(h["spp_in_flight"].as_u64() > Some(0));
+        let still = h["interactive"] == false && h["view"]["origin"] == initial["origin"];
+        if still && h["spp"] == h["spp_target"] {
+            break h;
+        }
+    };
+    // The page's server, by HTTP: ws://HOST:PORT/ws -> HOST:PORT.
+    let host = url
+        .trim_start_matches("ws://")
+        .split('/')
+        .next()
+        .expect("ws://HOST:PORT/ws");
+    let mut stream = std::net::TcpStream::connect(host).expect("connecting for the snapshot");
+    use std::io::{Read, Write};
+    write!(
+        stream,
+        "GET /snapshot.exr HTTP/1.1\r\nHost: {host}\r\nConnection: close\r\n\r\n"
+    )
+    .expect("asking for the snapshot");
+    let mut response = Vec::new();
+    stream
+        .read_to_end(&mut response)
+        .expect("reading the snapshot");
+    assert!(
+        response.starts_with(b"HTTP/1.1 200"),
+        "snapshot refused: {}",
+        String::from_utf8_lossy(&response[..response.len().min(200)])
+    );
+    let body = response
+        .windows(4)
+        .position(|w| w == b"\r\n\r\n")
+        .expect("an HTTP response")
+        + 4;
+    std::fs::write(file, &response[body..]).expect("writing the snapshot");
+    println!(
+        "{}",
+        json!({"last": last, "still_frames_with_paths_in_flight": in_flight})
+    );
+}
+
 #[tokio::main(flavor = "current_thread")]
 async fn main() {
     let mut args = std::env::args().skip(1);
-    let url = args.next().expect("usage: viewer_bench WS_URL [SECONDS]");
-    let seconds: f64 = args.next().map_or(3.0, |s| s.parse().expect("SECONDS"));
+    let url = args
+        .next()
+        .expect("usage: viewer_bench WS_URL [SECONDS | --snapshot FILE]");
+    let mode = args.next();
     let (mut ws, _) = tokio_tungstenite::connect_async(&url)
         .await
         .expect("connecting");
@@ -95,6 +189,11 @@ async fn main() {
         Some(Ok(Message::Text(t))) => serde_json::from_str(&t).expect("hello"),
         other => panic!("expected hello, got {other:?}"),
     };
+    if mode.as_deref() == Some("--snapshot") {
+        let file = args.next().expect("--snapshot FILE");
+        return snapshot(&mut ws, &url, &hello, &file).await;
+    }
+    let seconds: f64 = mode.map_or(3.0, |s| s.parse().expect("SECONDS"));
     let initial = &hello["initial"];
     let (origin, target, up) = (
         vec3(&initial["origin"]),
@@ -114,6 +213,7 @@ async fn main() {
     // 1. Latency of a still move: send, wait for the new epoch's first frame.
     let mut latency = Vec::new();
     let mut first_frames = Vec::new();
+    let mut reference = None;
     for i in 0..10 {
         let o = orbit(origin, target, up, 0.05 * f64::from(i + 1));
         let sent = Instant::now();
@@ -130,6 +230,9 @@ async fn main() {
                 break;
             }
         }
+        if i == 0 {
+            reference = first_sample(&mut ws, epoch, &first_frames[0]).await;
+        }
     }
     // The first move's view again: the same image.
     let sent = Instant::now();
@@ -143,7 +246,8 @@ async fn main() {
     while let Some((h, _, image)) = next_frame(&mut ws, sent + Duration::from_secs(60)).await {
         if h["epoch"].as_u64() > Some(epoch) {
             epoch = h["epoch"].as_u64().unwrap_or(epoch);
-            repeat_identical = first_frames.first().map(|(_, first)| *first == image);
+            let shown = first_sample(&mut ws, epoch, &(h, image)).await;
+            repeat_identical = reference.zip(shown).map(|(a, b)| a == b);
             break;
         }
     }

@@ -39,6 +39,12 @@ pub const SETTABLE: &[&str] = &[
     "medium.albedo",
     "phase.g",
     "camera.fov",
+    "sun.direction",
+    "sun.irradiance",
+    "sun.angular_radius",
+    "light.position",
+    "light.intensity",
+    "light.direction",
 ];
 
 /// What `materials.<m>.` may be followed by in a `set` message: RGB, RGB, a number.
@@ -130,7 +136,7 @@ pub fn param_value(key: &str, value: &serde_json::Value) -> Result<ParamValue, P
         });
         match rgb.as_deref() {
             Some(&[r, g, b]) => Ok(ParamValue::Rgb([r, g, b])),
-            _ => Err(wrong("[r, g, b]")),
+            _ => Err(wrong("three numbers ([r, g, b] or [x, y, z])")),
         }
     };
     let field = key
@@ -153,11 +159,12 @@ pub fn param_value(key: &str, value: &serde_json::Value) -> Result<ParamValue, P
             .as_i64()
             .map(ParamValue::Int)
             .ok_or_else(|| wrong("an integer")),
-        "medium.scale" | "phase.g" | "camera.fov" => number()
+        "medium.scale" | "phase.g" | "camera.fov" | "sun.angular_radius" => number()
             .filter(|v| v.abs() <= f64::from(f32::MAX))
             .map(|v| ParamValue::Float(v as f32))
             .ok_or_else(|| wrong("a number")),
-        "medium.albedo" => rgb(),
+        "medium.albedo" | "sun.direction" | "sun.irradiance" | "light.position"
+        | "light.intensity" | "light.direction" => rgb(),
         _ => Err(ProtocolError::Invalid(format!(
             "set: unknown parameter {key:?} (expected one of {}, or materials.<name>.{})",
             SETTABLE.join(", "),
@@ -244,6 +251,9 @@ pub struct FrameHeader {
     /// Samples per pixel in this frame, and the number the accumulation stops at.
     pub spp: u32,
     pub spp_target: u32,
+    /// Samples whose paths are still in flight on the GPU (the frame shows those that have
+    /// ended: a multi-kernel strategy's frame stopped at its deadline); 0 otherwise.
+    pub spp_in_flight: u32,
     pub interactive: bool,
     /// Milliseconds of this frame's render (its new samples), tone mapping and JPEG encoding.
     pub render_ms: f64,

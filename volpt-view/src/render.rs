@@ -3,8 +3,13 @@
 //! parameter changes. Frames go out through a `watch` channel, which keeps only the latest:
 //! a client that falls behind skips frames instead of queueing them.
 //!
+//! A frame's render stops at its deadline with paths in flight where the GPU's strategy keeps
+//! them (the multi-kernel ones); the next frames of the view continue them, so that a frame need
+//! not wait for its longest path, and a move discards them.
+//!
 //! Invariants: `film` holds samples `0..done` of `scene` as it is now, at the scene's current
-//! resolution; every published frame's `epoch` names the scene state it was rendered from.
+//! resolution, and of the range `in_flight` (if any) the paths that have ended; every published
+//! frame's `epoch` names the scene state it was rendered from.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, RecvTimeoutError, SyncSender, TrySendError};
@@ -100,6 +105,9 @@ pub struct Shared {
 
 /// While the user drags, the renderer aims at this frame time (30 frames/s with a margin).
 const INTERACTIVE_BUDGET: f64 = 0.030;
+/// While the user drags, a frame's render stops here with paths in flight where the GPU can
+/// keep them: the rest of the frame time is for the tone mapping, the JPEG and the send.
+const DRAG_RENDER_BUDGET: f64 = 0.6 * INTERACTIVE_BUDGET;
 /// Reduced resolutions while dragging: the full one divided by these.
 const SCALES: [f32; 9] = [1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0];
 /// A drag whose last move is this old is over (a lost or never-sent release).
@@ -122,6 +130,10 @@ struct Renderer {
     epoch_started: Instant,
     epoch_render: Duration,
     epoch_paths: u64,
+    /// Samples whose paths are in flight on the GPU: the next frames continue them.
+    in_flight: Option<std::ops::Range<u32>>,
+    /// Render time of the range being rendered so far, over its frames.
+    range_render: Duration,
     exposure: f32,
     /// Index into [`SCALES`] used while dragging, adapted to the measured frame time.
     scale: usize,
@@ -199,6 +211,8 @@ impl Renderer {
             epoch_started: now,
             epoch_render: Duration::ZERO,
             epoch_paths: 0,
+            in_flight: None,
+            range_render: Duration::ZERO,
             exposure: 0.0,
             scale: 2,
             sample_time: None,
@@ -305,7 +319,7 @@ impl Renderer {
             }
             if self.done < self.cap() {
                 self.render_batch();
-            } else if self.retone && self.done > 0 {
+            } else if self.retone && self.shown() > 0 {
                 self.publish(Duration::ZERO);
             }
             self.retone = false;
@@ -359,42 +373,74 @@ impl Renderer {
         }
         self.film = self.scene.film();
         self.done = 0;
+        // The old view's paths in flight are discarded (the GPU's, by the next render).
+        self.in_flight = None;
+        self.range_render = Duration::ZERO;
         self.epoch_started = Instant::now();
         self.epoch_render = Duration::ZERO;
         self.epoch_paths = 0;
     }
 
-    /// Samples for the next frame: one while dragging or for an epoch's first frame, then as
-    /// many as fit a frame time that grows with the epoch's age (4 to 33 frames/s).
-    fn batch(&self) -> u32 {
+    /// Samples for the next frame and the time its render may take: one sample while dragging
+    /// (within [`DRAG_RENDER_BUDGET`]) or for an epoch's first frame, then as many as fit a frame
+    /// time that grows with the epoch's age (4 to 33 frames/s).
+    fn batch(&self) -> (u32, f64) {
         let left = self.cap().saturating_sub(self.done);
-        if self.interactive || self.done == 0 {
-            return left.min(1);
+        if self.interactive {
+            return (left.min(1), DRAG_RENDER_BUDGET);
         }
-        let (w, h) = self.scene.resolution();
-        let Some(per_sample) = self.sample_time.map(|t| t * f64::from(w) * f64::from(h)) else {
-            return left.min(1);
-        };
         let budget = (0.25 * self.epoch_started.elapsed().as_secs_f64()).clamp(0.03, 0.25);
-        ((budget / per_sample.max(1e-9)) as u32).clamp(1, left.max(1))
+        let (w, h) = self.scene.resolution();
+        let per_sample = self.sample_time.map(|t| t * f64::from(w) * f64::from(h));
+        let k = match per_sample {
+            Some(per_sample) if self.done > 0 => {
+                ((budget / per_sample.max(1e-9)) as u32).clamp(1, left.max(1))
+            }
+            _ => left.min(1),
+        };
+        (k, budget)
     }
 
+    /// Samples the film's frames are over: the complete ones, and the range in flight.
+    fn shown(&self) -> u32 {
+        self.in_flight.as_ref().map_or(self.done, |r| r.end)
+    }
+
+    /// Renders the next frame's samples until its deadline. Where the GPU's strategy keeps paths
+    /// in flight ([`volpt::Backend::render_until`]), a range whose deadline passed stays in
+    /// flight, its frame showing the paths that have ended, and the next frames continue it; a
+    /// new epoch (a move) discards it. Samples count as done once every path of theirs has ended.
     fn render_batch(&mut self) {
-        let k = self.batch();
-        let samples = self.done..self.done + k;
+        let (samples, budget) = match &self.in_flight {
+            Some(range) => (range.clone(), self.batch().1),
+            None => {
+                let (k, budget) = self.batch();
+                (self.done..self.done + k, budget)
+            }
+        };
         let started = Instant::now();
+        let deadline = started + Duration::from_secs_f64(budget);
         let result =
             self.backend
-                .render(&self.scene, &mut self.film, samples.clone(), &volpt::Quiet);
+                .render_until(&self.scene, &mut self.film, samples.clone(), deadline);
         let elapsed = started.elapsed();
         match result {
             Ok(rendered) => {
-                self.done = rendered.samples.end;
-                let (w, h) = self.scene.resolution();
-                let pixel_samples = u64::from(w) * u64::from(h) * u64::from(k);
-                self.sample_time = Some(elapsed.as_secs_f64() / pixel_samples.max(1) as f64);
                 self.epoch_render += elapsed;
-                self.epoch_paths += pixel_samples;
+                self.range_render += elapsed;
+                if rendered.samples.end == samples.end {
+                    self.done = samples.end;
+                    self.in_flight = None;
+                    let (w, h) = self.scene.resolution();
+                    let pixel_samples =
+                        u64::from(w) * u64::from(h) * u64::from(samples.end - samples.start);
+                    self.sample_time =
+                        Some(self.range_render.as_secs_f64() / pixel_samples.max(1) as f64);
+                    self.range_render = Duration::ZERO;
+                    self.epoch_paths += pixel_samples;
+                } else {
+                    self.in_flight = Some(samples);
+                }
                 let frame_time = self.publish(elapsed);
                 if self.interactive {
                     self.adapt_scale(frame_time);
@@ -408,6 +454,7 @@ impl Renderer {
                 }
                 .to_json();
                 let _ = self.shared.notices.send(message);
+                self.in_flight = None;
                 self.done = self.cap();
             }
         }
@@ -426,8 +473,8 @@ impl Renderer {
     /// Tone maps, encodes and publishes the film; returns the frame's seconds (render included).
     fn publish(&mut self, render: Duration) -> f64 {
         let t0 = Instant::now();
-        let linear = self.film.image(self.done);
-        let rgb = encode::tone_map(&linear, self.exposure);
+        let linear = self.film.image(self.shown());
+        let rgb = self.tone_map(&linear);
         let tonemap = t0.elapsed();
         let t1 = Instant::now();
         let jpeg = match encode::jpeg(&rgb, linear.width, linear.height, QUALITY) {
@@ -449,6 +496,7 @@ impl Renderer {
             height: linear.height,
             spp: self.done,
             spp_target: self.cap(),
+            spp_in_flight: self.shown() - self.done,
             interactive: self.interactive,
             render_ms: ms(render),
             tonemap_ms: ms(tonemap),
@@ -472,6 +520,22 @@ impl Renderer {
             png: OnceLock::new(),
         })));
         (render + tonemap + encode).as_secs_f64()
+    }
+
+    /// The frame of the film (whose image is `linear`): tone mapped by the GPU that rendered
+    /// it, which sends back the frame's bytes alone, or else on the CPU.
+    fn tone_map(&self, linear: &Image) -> Vec<u8> {
+        match self
+            .backend
+            .tone_map(&self.film, self.shown(), self.exposure)
+        {
+            Ok(Some(rgb)) => rgb,
+            Ok(None) => encode::tone_map(linear, self.exposure),
+            Err(e) => {
+                tracing::warn!("tone mapping on the GPU failed ({e}); on the CPU instead");
+                encode::tone_map(linear, self.exposure)
+            }
+        }
     }
 
     fn params(&self) -> Params {

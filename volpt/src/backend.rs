@@ -396,6 +396,20 @@ impl Backend {
         }
     }
 
+    /// The frame of `film` over `spp` samples at 2^`exposure` (8-bit sRGB RGB, as
+    /// [`volpt_film::tone::tone_map`] of its image gives it within one level), tone mapped where
+    /// the last render left the film: on one GPU, which sends back the frame's bytes alone.
+    /// `None` where this backend has no such film (the CPU, several GPUs, or a `film` that is
+    /// not what the last render left): the caller tone maps on the CPU.
+    pub fn tone_map(&self, film: &Film, spp: u32, exposure: f32) -> Result<Option<Vec<u8>>, Error> {
+        match &self.0 {
+            Inner::Cuda { renderers, .. } if renderers.len() == 1 => {
+                Ok(renderers[0].tone_map_film((film.width, film.height), spp, exposure)?)
+            }
+            _ => Ok(None),
+        }
+    }
+
     pub fn kind(&self) -> BackendKind {
         match &self.0 {
             Inner::Cpu | Inner::CpuDevices(_) => BackendKind::Cpu,
@@ -455,6 +469,44 @@ impl Backend {
         observer: &dyn Observer,
         after_chunk: &mut dyn FnMut(&Film, u32) -> Result<(), Error>,
     ) -> Result<Rendered, Error> {
+        self.render_with(scene, film, request, observer, after_chunk, None)
+    }
+
+    /// [`Backend::render`] of samples `samples` in one go that returns at `deadline` with paths
+    /// still in flight where the GPU's strategy keeps them between its launches (the
+    /// multi-kernel strategies on one GPU; elsewhere the render finishes as always). Then
+    /// [`Rendered::samples`] ends where it starts, and `film` holds the samples before the range
+    /// plus the range's paths that have ended (what a frame over `samples.end` shows, short of
+    /// the paths in flight); calling again with the same scene, film and range continues them,
+    /// and any other render discards them. Every path is traced once, so the finished film is
+    /// the uninterrupted render's: a viewer's frame need not wait for its longest path.
+    pub fn render_until(
+        &self,
+        scene: &Scene,
+        film: &mut Film,
+        samples: Range<u32>,
+        deadline: Instant,
+    ) -> Result<Rendered, Error> {
+        let request = RenderRequest::samples(samples);
+        self.render_with(
+            scene,
+            film,
+            &request,
+            &crate::Quiet,
+            &mut |_, _| Ok(()),
+            Some(deadline),
+        )
+    }
+
+    fn render_with(
+        &self,
+        scene: &Scene,
+        film: &mut Film,
+        request: &RenderRequest,
+        observer: &dyn Observer,
+        after_chunk: &mut dyn FnMut(&Film, u32) -> Result<(), Error>,
+        deadline: Option<Instant>,
+    ) -> Result<Rendered, Error> {
         let (width, height) = scene.resolution();
         if (film.width, film.height) != (width, height) {
             return Err(Error::FilmSize {
@@ -479,6 +531,7 @@ impl Backend {
             samples: request.samples.clone(),
             observer,
             after_chunk,
+            deadline,
         };
         with_scene_cached(&desc, path, effects, factory, visitor)
     }
@@ -686,6 +739,9 @@ struct Render<'a> {
     samples: Range<u32>,
     observer: &'a dyn Observer,
     after_chunk: &'a mut dyn FnMut(&Film, u32) -> Result<(), Error>,
+    /// [`Backend::render_until`]'s: one GPU's multi-kernel strategy stops there with paths in
+    /// flight.
+    deadline: Option<Instant>,
 }
 
 impl SceneVisitor for Render<'_> {
@@ -701,6 +757,7 @@ impl SceneVisitor for Render<'_> {
             samples,
             observer,
             after_chunk,
+            deadline,
         } = self;
         let camera = scene.camera();
         let pixels = u64::from(camera.width) * u64::from(camera.height);
@@ -814,6 +871,35 @@ impl SceneVisitor for Render<'_> {
             });
         }
         let schedule = schedules[0];
+        if let (Some(deadline), Inner::Cuda { renderers, .. }, Some(schedule)) =
+            (deadline, &backend.0, schedule)
+        {
+            // SAFETY: as the chunks' renders below.
+            let progress = unsafe {
+                renderers[0].render_samples_until(
+                    scene,
+                    schedule,
+                    film,
+                    samples.clone(),
+                    &options,
+                    grids,
+                    deadline,
+                )
+            }?;
+            let done = if progress.finished {
+                samples.end
+            } else {
+                samples.start
+            };
+            if progress.finished {
+                after_chunk(film, done)?;
+            }
+            return Ok(Rendered {
+                stats: progress.stats,
+                samples: samples.start..done,
+                schedule: Some(schedule),
+            });
+        }
 
         let mut stats = RenderStats {
             elapsed: Duration::ZERO,

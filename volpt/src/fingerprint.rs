@@ -32,6 +32,7 @@ pub fn fingerprint(
         boundary,
         medium,
         environment,
+        lights,
     } = desc;
     let mut hasher = Hasher(Fnv::default());
     let identity = (
@@ -41,6 +42,7 @@ pub fn fingerprint(
         boundary,
         medium,
         environment,
+        lights,
         settings,
         effects,
         content,

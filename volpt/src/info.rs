@@ -133,7 +133,39 @@ pub fn describe(
     );
     field("phase", m.phase.to_string());
     field("light", desc.environment.to_string());
+    if !desc.lights.is_empty() {
+        field("lights", lights(desc, &parts));
+    }
     Info { fields }
+}
+
+/// The lights besides the environment, and how paths reach them behind this boundary.
+fn lights(desc: &SceneDescription, parts: &Parts<'_>) -> String {
+    let lights = &desc.lights;
+    let how = if parts.boundary.kind().index_matched() {
+        "sampled at every scattering event by next-event estimation with ratio tracking, whatever          the estimator (a sun with an angular radius also by the phase function's escapes, MIS)"
+    } else if lights.any_delta() {
+        delta_behind_dielectric(parts.boundary.kind().rough())
+    } else {
+        "behind a dielectric boundary a sun with an angular radius is reached only by paths that          escape into its disc (path tracing: noisy for a small disc)"
+    };
+    format!("{lights}\n{how}")
+}
+
+/// What `volpt info` and the loader's warning say of a delta light behind a dielectric boundary
+/// (`rough` or smooth).
+pub(crate) fn delta_behind_dielectric(rough: bool) -> &'static str {
+    if rough {
+        "WARNING: the rough dielectric boundary bends every shadow ray, and volpt samples lights \
+         only from inside an index-matched boundary, so a delta light (a sun of angular radius 0, \
+         a point or spot light) adds nothing (Mitsuba 3 samples it where paths meet the rough \
+         surface); give the boundary index-matched, or the sun an angular radius"
+    } else {
+        "WARNING: the smooth dielectric boundary bends every shadow ray, so a delta light (a sun \
+         of angular radius 0, a point or spot light) adds nothing inside it (Mitsuba 3 renders \
+         the same, silently: its shadow rays stop at the surface); give the boundary \
+         index-matched, or the sun an angular radius"
+    }
 }
 
 /// The majorants delta and ratio tracking use, and what they cost along camera rays.

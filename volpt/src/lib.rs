@@ -83,6 +83,7 @@ pub use settings::{check_majorant_resolution, RenderSettings, Tracking, MAJORANT
 pub use volpt_core::{Estimator, PathCounters, PathSettings, Roulette};
 pub use volpt_cuda::{CudaRenderer, Math, Schedule, Strategy};
 pub use volpt_film::film_file::format_ranges;
+pub use volpt_film::tone;
 pub use volpt_film::{
     preview_path, Accumulation, CheckpointError, Film, FilmFileError, Image, ImageError,
     RenderStats,

@@ -14,8 +14,8 @@ use volpt_scene::medium::{MediumParam, ParamRefused};
 use volpt_scene::toml_scene::look_at;
 use volpt_scene::validate::CheckedData;
 use volpt_scene::{
-    AlbedoDesc, DensityDesc, GridDesc, GridLookup, GridStorage, MediumDesc, NumberParam, PhaseDesc,
-    SampleLayout, SceneAssembler, SceneBuilder, SceneDescription,
+    AlbedoDesc, DensityDesc, GridDesc, GridLookup, GridStorage, LightsDesc, MediumDesc,
+    NumberParam, PhaseDesc, SampleLayout, SceneAssembler, SceneBuilder, SceneDescription,
 };
 
 use crate::settings::RenderSettings;
@@ -131,10 +131,19 @@ pub enum ParamValue {
 }
 
 /// The parameters a scene takes between renders: key and what it is. The scene's own, then the
-/// medium's ([`MediumDesc::PARAMS`]), then the phase's ([`PhaseDesc::PARAMS`]).
+/// medium's ([`MediumDesc::PARAMS`]), the lights' ([`LightsDesc::PARAMS`]: a scene has those of
+/// the lights it has), then the phase's ([`PhaseDesc::PARAMS`]).
 pub const PARAMS: &[(&str, &str)] = &with_numbers::<
-    { SCENE_PARAMS.len() + MediumDesc::PARAMS.len() + PhaseDesc::PARAMS.len() },
->(&[SCENE_PARAMS, MediumDesc::PARAMS], PhaseDesc::PARAMS);
+    {
+        SCENE_PARAMS.len()
+            + MediumDesc::PARAMS.len()
+            + LightsDesc::PARAMS.len()
+            + PhaseDesc::PARAMS.len()
+    },
+>(
+    &[SCENE_PARAMS, MediumDesc::PARAMS, LightsDesc::PARAMS],
+    PhaseDesc::PARAMS,
+);
 
 /// Each of `keys`, then the key and description of each of `numbers`, `N` in all.
 const fn with_numbers<const N: usize>(
@@ -211,7 +220,7 @@ impl Scene {
         }
         check_lookup(&desc, desc.medium.lookup, checked)?;
         let m = &desc.camera.to_world;
-        Ok(Self {
+        let scene = Self {
             up: [m[0][1], m[1][1], m[2][1]],
             source: builder.source(),
             path: settings.path_settings(&desc)?,
@@ -222,7 +231,16 @@ impl Scene {
             desc,
             data: Arc::new(DataFacts::new(checked)),
             read_otherwise: Mutex::new(None),
-        })
+        };
+        let boundary = scene.variant().boundary;
+        if scene.desc.lights.any_delta() && !boundary.index_matched() {
+            tracing::warn!(
+                "{}: {}",
+                scene.source,
+                crate::info::delta_behind_dielectric(boundary.rough())
+            );
+        }
+        Ok(scene)
     }
 
     pub fn description(&self) -> &SceneDescription {
@@ -425,6 +443,23 @@ impl Scene {
             "camera.target" => ParamValue::Vec3(self.look_at().1),
             "camera.up" => ParamValue::Vec3(self.look_at().2),
             "camera.fov" => ParamValue::Float(d.camera.fov_degrees),
+            _ if LightsDesc::PARAMS.iter().any(|&(k, _)| k == key) => {
+                let absent = |what: &str| Error::Param {
+                    key: key.to_owned(),
+                    expected: format!("a scene with {what}"),
+                    found: format!("a scene without: {}", d.lights),
+                };
+                let sun = || d.lights.sun.ok_or_else(|| absent("a sun"));
+                let spot = || d.lights.spot.ok_or_else(|| absent("a point or spot light"));
+                match key {
+                    "sun.direction" => ParamValue::Vec3(sun()?.direction),
+                    "sun.irradiance" => ParamValue::Rgb(sun()?.irradiance),
+                    "sun.angular_radius" => ParamValue::Float(sun()?.angular_radius),
+                    "light.position" => ParamValue::Vec3(spot()?.position),
+                    "light.intensity" => ParamValue::Rgb(spot()?.intensity),
+                    _ => ParamValue::Vec3(spot()?.cone.ok_or_else(|| absent("a spot"))?.direction),
+                }
+            }
             _ => match (d.medium.param(key), d.medium.phase.param(key)) {
                 (Some(Ok(MediumParam::Float(v))), _) => ParamValue::Float(v),
                 (Some(Ok(MediumParam::Rgb(v))), _) => ParamValue::Rgb(v),
@@ -543,6 +578,27 @@ impl Scene {
             }
             "camera.fov" => {
                 d.camera.fov_degrees = float(&|v| v > 0.0 && v < 180.0, "degrees in (0, 180)")?
+            }
+            _ if LightsDesc::PARAMS.iter().any(|&(k, _)| k == key) => {
+                // Present, as `get` says; the values are checked with the scene (`validate`).
+                self.get(key)?;
+                let l = &mut self.desc.lights;
+                match (key, &mut l.sun, &mut l.spot) {
+                    ("sun.direction", Some(s), _) => s.direction = vec3()?,
+                    ("sun.irradiance", Some(s), _) => s.irradiance = vec3()?,
+                    ("sun.angular_radius", Some(s), _) => {
+                        s.angular_radius =
+                            float(&|v| (0.0..=90.0).contains(&v), "degrees in [0, 90]")?
+                    }
+                    ("light.position", _, Some(s)) => s.position = vec3()?,
+                    ("light.intensity", _, Some(s)) => s.intensity = vec3()?,
+                    (_, _, Some(s)) => {
+                        if let Some(cone) = &mut s.cone {
+                            cone.direction = vec3()?;
+                        }
+                    }
+                    _ => {}
+                }
             }
             _ if MediumDesc::PARAMS.iter().any(|&(k, _)| k == key)
                 || d.medium.material_params().iter().any(|(k, _)| k == key) =>
@@ -747,6 +803,7 @@ impl Scene {
                 })
                 .collect(),
             phase: d.medium.phase,
+            lights: d.lights,
             path: self.path,
             seed: self.seed,
             up: self.up,
@@ -763,6 +820,7 @@ impl Scene {
             let _ = d.medium.set_param(&key, value);
         }
         d.medium.phase = l.phase;
+        d.lights = l.lights;
         self.path = l.path;
         self.seed = l.seed;
         self.up = l.up;
@@ -776,6 +834,7 @@ struct Light {
     /// The medium's parameters that it has ([`MediumDesc::param`]), its materials' included.
     medium: Vec<(String, MediumParam)>,
     phase: PhaseDesc,
+    lights: LightsDesc,
     path: PathSettings,
     seed: u32,
     up: [f32; 3],

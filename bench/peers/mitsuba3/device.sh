@@ -12,7 +12,8 @@
 # Settings: GPU_RES/GPU_SPP (default 400/100, the thesis settings), CPU_RES/CPU_SPP (default 100/64:
 # Mitsuba's LLVM backend is slow on these dense scenes), SCENES (names, default the seven grey
 # scenes; chromatic-cube and chromatic-slab name scenes/chromatic's media, which Mitsuba renders with
-# `volpathmis`).
+# `volpathmis`; sun-slab, spot-fog and spot-fog-chromatic name scenes/lights' directional and spot
+# emitters: `SCENES="sun-slab spot-fog spot-fog-chromatic"`).
 # Everything lands under $OUT/peers: results.md (one Markdown row per scene and device), <name>.json,
 # the EXR images, the Mitsuba 3 XML each scene was rendered from, and the logs.
 #
@@ -92,6 +93,9 @@ scene_args() { # name -> file and -D parameters
         envmap-cube) echo "bundle/scenes/envmap-cube/scene.xml" ;;
         chromatic-cube) echo "bundle/scenes/chromatic/cube.xml" ;;
         chromatic-slab) echo "bundle/scenes/chromatic/slab.xml" ;;
+        sun-slab) echo "bundle/scenes/lights/sun-slab.xml" ;;
+        spot-fog) echo "bundle/scenes/lights/spot-fog.xml" ;;
+        spot-fog-chromatic) echo "bundle/scenes/lights/spot-fog.xml -D sigma_t=1,2,4" ;;
         *) echo "" ;;
     esac
 }

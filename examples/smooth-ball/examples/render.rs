@@ -49,6 +49,7 @@ fn scene(size: u32) -> BallScene {
         boundary: NullBoundary,
         phase: HenyeyGreenstein { g: 0.5 },
         environment: ConstantEnvironment(Spectrum::ONE),
+        lights: volpt_core::Lights::NONE,
         settings: PathSettings::default(),
     }
 }

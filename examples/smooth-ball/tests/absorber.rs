@@ -32,6 +32,7 @@ fn an_absorbing_ball_transmits_its_analytic_transmittance() {
         boundary: NullBoundary,
         phase: Isotropic,
         environment: ConstantEnvironment(Spectrum::ONE),
+        lights: volpt_core::Lights::NONE,
         settings: PathSettings::default(),
     };
     let (spp, seed) = (400, 3);

@@ -11,6 +11,7 @@
 //!   scene of their own parts (see `docs/extending.md`).
 //! - [`selftest`]: kernels that test the strategies' collective building blocks, texture lookups
 //!   and `volpt_core::math` against the CPU.
+//! - [`tone`]: the viewer's tone mapping (exposure, sRGB, 8 bits) on the GPU, beside the film.
 //! - on nvptx64 only: [`strategy`] (the strategies' kernel bodies) and the PTX intrinsics they use.
 #![no_std]
 #![cfg_attr(
@@ -27,6 +28,7 @@ mod math;
 pub mod order;
 pub mod selftest;
 mod strategies;
+pub mod tone;
 
 #[cfg(target_arch = "nvptx64")]
 pub mod nvptx;

@@ -4,11 +4,13 @@
 //! The list of variants is the registry's, the list of strategies `volpt_device`'s, and the kernel
 //! bodies and entry names come from [`volpt_device::export_kernels!`]: this crate only asks for the
 //! cartesian product. The host launches a scene type's kernel by the names of its parts
-//! (`volpt_core::abi::SceneAbi::names`).
+//! (`volpt_core::abi::SceneAbi::names`). Besides, one kernel serves every scene: the viewer's
+//! tone mapping (`volpt_device::tone`).
 //!
 //! On any target but nvptx64 this crate is empty, so that host builds of the workspace pass.
 //! With `--cfg volpt_selftests_only` (`cargo xtask ptx-selftests`) it exports the selftest
-//! kernels alone: a build in a minute, for judging mutants of volpt-core's GPU-only code.
+//! kernels (and the tone mapping, which they check) alone: a build in a minute, for judging
+//! mutants of volpt-core's GPU-only code.
 #![cfg_attr(target_arch = "nvptx64", no_std)]
 #![cfg_attr(target_arch = "nvptx64", feature(abi_ptx))]
 
@@ -26,3 +28,7 @@ volpt_core::variants!('static => export_registry {});
 
 #[cfg(target_arch = "nvptx64")]
 volpt_device::export_selftests!();
+
+// The viewer's tone mapping: with the selftests too, which check it (`volpt selftest`).
+#[cfg(target_arch = "nvptx64")]
+volpt_device::export_tone_map!();

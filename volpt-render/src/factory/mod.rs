@@ -255,6 +255,7 @@ macro_rules! factory {
                     boundary,
                     phase,
                     environment,
+                    lights: shared.lights,
                 }),)*
             }
         }
@@ -351,6 +352,8 @@ struct Shared<'a> {
     camera: PerspectiveCamera,
     shape: BoundaryShape<'a>,
     settings: PathSettings,
+    /// The lights besides the environment: a run-time part of every variant.
+    lights: volpt_core::Lights,
 }
 
 /// The boundary's geometry `desc` describes, borrowing its mesh.
@@ -394,6 +397,7 @@ pub fn with_scene_cached<V: SceneVisitor>(
         camera: camera(&desc.camera, &desc.film),
         shape: boundary_shape(desc),
         settings,
+        lights: desc.lights.lights(),
     };
     let parts = Parts::of_cached(desc, effects, cache);
     let derived = Derived::of_cached(&parts, shared.shape.bounds(), &settings, cache);

@@ -99,7 +99,8 @@ pub fn write_mitsuba3(
     let bsdf = desc.boundary.bsdf.to_mitsuba3();
     let emitter = desc
         .environment
-        .to_mitsuba3(dir, name, &xml_path, &mut written)?;
+        .to_mitsuba3(dir, name, &xml_path, &mut written)?
+        + &desc.lights.to_mitsuba3(&xml_path)?;
     let depth = |d: Option<u32>, none: i64| d.map_or(none, i64::from);
     let fov_axis = match desc.camera.fov_axis {
         FovAxis::X => "x",

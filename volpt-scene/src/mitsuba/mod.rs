@@ -32,11 +32,11 @@ pub use ior::named_ior;
 
 use self::emitter::environment;
 use self::integrator::{integrator, DEFAULT_INTEGRATOR};
-use self::plugin::{Ctx, OBJECT_TAGS};
+use self::plugin::{Ctx, Plugin, OBJECT_TAGS};
 use self::sensor::sensor;
 use self::shape::boundary;
 use self::xml::Element;
-use crate::description::SceneDescription;
+use crate::description::{LightsDesc, SceneDescription};
 use crate::error::SceneError;
 
 /// Loads a Mitsuba scene, with `params` as `(name, value)` pairs overriding its `<default>`s.
@@ -107,7 +107,19 @@ fn scene(root: &Element, ctx: &Ctx<'_>) -> Result<SceneDescription, SceneError> 
         Some(el) => integrator(el, ctx)?,
         None => DEFAULT_INTEGRATOR,
     };
-    let environment = environment(&emitters, ctx)?;
+    // Lights besides the environment are their own emitters; the rest is the environment.
+    let mut lights = LightsDesc::default();
+    let mut environments = Vec::new();
+    for el in emitters {
+        let p = Plugin::new(el, ctx);
+        if LightsDesc::is_mitsuba_light(p.kind()?) {
+            lights.add_mitsuba(&p)?;
+            p.finish()?;
+        } else {
+            environments.push(el);
+        }
+    }
+    let environment = environment(&environments, ctx)?;
     let (boundary, medium) = boundary(shape_el, ctx)?;
     Ok(SceneDescription {
         camera: sensor.camera,
@@ -117,5 +129,6 @@ fn scene(root: &Element, ctx: &Ctx<'_>) -> Result<SceneDescription, SceneError> 
         boundary,
         medium,
         environment,
+        lights,
     })
 }
