@@ -91,7 +91,8 @@ ptxas)
 peers)
     # The wheel travels in parts (the tree and the whole wheel pass the carry limit): each call
     # unpacks the parts it carries (PEER_PARTS: folders at the repository's root) into the site
-    # device.sh reuses; PEER_RUN=1 then runs device.sh (MODE, SCENES) on the kept binary.
+    # device.sh reuses; PEER_RUN (device.sh's MODEs, e.g. "gpu print") then runs it on the kept
+    # binary, each mode under PEER_LIMIT seconds (SCENES as device.sh reads it).
     root=$PWD; while [ ! -f "$root/bench/peers/mitsuba3/device.sh" ] && [ "$root" != / ]; do root=$(dirname "$root"); done
     PEER_SITE=${PEER_SITE:-/tmp/volpt-peer-site}
     mkdir -p "$PEER_SITE"
@@ -105,7 +106,10 @@ peers)
         mkdir -p "$root/bundle/bin" && cp "$KEEP/volpt" "$root/bundle/bin/volpt"
         ln -sfn "$KEEP/data" "$root/bundle/data"
         ln -sfn "$root/scenes" "$root/bundle/scenes"
-        part peers "${PEER_LIMIT:-400}" env PEER_SITE="$PEER_SITE" MODE="${MODE:-gpu}" bash "$root/bench/peers/mitsuba3/device.sh"
+        for f in "$root"/bench/device/*.sh "$root"/bench/device/*.py; do ln -sfn "$f" "$root/bundle/"; done
+        for mode in $PEER_RUN; do
+            part "peers-$mode" "${PEER_LIMIT:-300}" env PEER_SITE="$PEER_SITE" MODE="$mode" bash "$root/bench/peers/mitsuba3/device.sh"
+        done
     fi
     ;;
 kernels)
@@ -126,7 +130,7 @@ kernels)
     done >"$OUT/ptxas/registers.txt"
     ;;
 esac
-for f in "$OUT"/*/summary.txt "$OUT"/peers/peers/device-summary.txt "$OUT"/peers/peers/results.md "$OUT"/ab-bin/ab-bin.txt "$OUT"/*/sparse-table.txt "$OUT"/ab-round*/ab.txt "$OUT"/ptxas/registers.txt; do
+for f in "$OUT"/*/summary.txt "$OUT"/peers-*/peers/device-summary.txt "$OUT"/peers-*/peers/results.md "$OUT"/ab-bin/ab-bin.txt "$OUT"/*/sparse-table.txt "$OUT"/ab-round*/ab.txt "$OUT"/ptxas/registers.txt; do
     [ -f "$f" ] && { echo "---- $f"; cat "$f"; } >>"$summary"
 done
 for d in "$OUT"/*/; do tail -n 3 "$d/stdout.txt" 2>/dev/null | sed "s|^|$(basename "$d"): |" >>"$summary"; done

@@ -31,7 +31,7 @@ log "date $(date -u +%Y-%m-%dT%H:%MZ) $(nvidia-smi --query-gpu=name,driver_versi
 STRATEGIES=(${STRATEGIES:-naive-sk regeneration-sk regeneration-warp-sk regeneration-block-sk regeneration-2p-sk streaming-sk streaming-sorted-sk sorting-sk naive-mk streaming-mk})
 # name:file:extra arguments
 SCENES=("sun-slab:scenes/lights/sun-slab.xml:" "spot-fog:scenes/lights/spot-fog.xml:"
-    "spot-fog-chromatic:scenes/lights/spot-fog.xml:-Dsigma_t=1,2,4" "sun-disc-spot:scenes/lights/lights.toml:")
+    "spot-fog-chromatic:scenes/lights/spot-fog.xml:-Dsigma_t=0.25,0.5,1" "sun-disc-spot:scenes/lights/lights.toml:")
 COMMON=(--spp 4 --seed 7 --resolution 64x64)
 for entry in "${SCENES[@]}"; do
     IFS=: read -r name file extra <<<"$entry"

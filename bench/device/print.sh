@@ -9,7 +9,10 @@
 # 1. CPU against GPU: the same 32 x 32-texel compensation (100 layers, 40 of colour, 256 samples,
 #    no noise control, 3 iterations, seed 1) with `--backend cpu` and `--backend cuda`. Each
 #    prediction is an independent unbiased render, so each iteration's mean CIEDE2000 agrees
-#    within noise. Expected: PASS, naive means within 2% (and best within 5%).
+#    within noise. Expected: PASS, naive means within 2% (and best within 5%). Then the same
+#    without --backend (expected: "PASS default-backend: on NVIDIA H200 (no --backend: a GPU is
+#    present (1 seen by the driver)") and with --gpus all (expected: a summary line like the
+#    others).
 # 2. The thesis's slab size: 320 x 320 texels, 100 layers (40 of colour), one compensation on
 #    the GPU from 64 samples per texel with the noise control on (at most 1024 samples), at most
 #    10 iterations. Expected: a line "320 x 320 texels: N iteration(s) in T s ..." with T well
@@ -82,6 +85,16 @@ print(f"== {'PASS' if ok else 'FAIL'} cpu-vs-cuda: mean dE00 per iteration cpu {
       f"naive differ by {100 * naive:.2f}% (< 2%), best by {100 * best:.2f}% (< 5%)")
 PY
 grep -q "FAIL cpu-vs-cuda" "$OUT/summary.txt" && failures=$((failures + 1))
+
+# 1b. No --backend: the GPU where one is usable (said on the first line), and --gpus all (every GPU
+#     of the machine splitting each prediction's samples).
+compensate small-default "$OUT/bars32.png" "${small[@]}"
+if grep -q "(no --backend: a GPU is present" "$OUT/small-default.log"; then
+    log "PASS default-backend: $(grep -o 'on [^(]*(no --backend: [^;]*' "$OUT/small-default.log" | head -1)"
+else
+    log "FAIL default-backend: $(head -n 2 "$OUT/small-default.log" | tr '\n' ' ')"; failures=$((failures + 1))
+fi
+compensate small-gpus "$OUT/bars32.png" "${small[@]}" --gpus all
 
 # 2. The thesis's slab size, timed.
 target 320 "$OUT/bars320.png"

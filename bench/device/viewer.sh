@@ -25,8 +25,10 @@
 #      (`--independent`). The CPU's viewer image is `volpt render`'s bit for bit
 #      (volpt-view/tests/accumulation.rs).
 #
-# Quick look at the frames (checks, then ad and the cube on the GPU at both sizes; ~75 s):
-#   SCENES="example-cube ad" BACKENDS=cuda SECONDS_PER_PHASE=2 bash bundle/viewer.sh
+# Issue 41's look at the frames (the checks, then the cube and ad on the GPU at 800x800 with
+# regeneration-sk and with streaming-mk; ~100 s):
+#   SCENES="example-cube ad" BACKENDS=cuda STRATEGIES="regeneration-sk streaming-mk" \
+#       RESOLUTIONS=800x800 SECONDS_PER_PHASE=2 bash bundle/viewer.sh
 #
 # Environment:
 #   OUT                 outputs (default ./out)
@@ -34,6 +36,8 @@
 #   SECONDS_PER_PHASE   seconds of the still and orbit phases each (default 3)
 #   LIMIT               seconds per run before it is killed and reported (default 90)
 #   STRATEGY, MATH      the GPU's (default regeneration-sk: no calibration; exact)
+#   STRATEGIES          several GPU strategies, each a row (e.g. "regeneration-sk streaming-mk":
+#                       a multi-kernel strategy's frames stop at their deadline with paths in flight)
 #   DATA                a folder with smoke.vol and Bucky.raw (default: the bundle's data/)
 set -uo pipefail
 cd "$(dirname "$0")"
@@ -41,6 +45,7 @@ OUT=${OUT:-$PWD/out}
 SECONDS_PER_PHASE=${SECONDS_PER_PHASE:-3}
 LIMIT=${LIMIT:-90}
 STRATEGY=${STRATEGY:-regeneration-sk}
+STRATEGIES=${STRATEGIES:-$STRATEGY}
 MATH=${MATH:-exact}
 BACKENDS=${BACKENDS:-cuda cpu}
 RESOLUTIONS=${RESOLUTIONS:-800x800 1920x1080}
@@ -72,7 +77,7 @@ SCENES=${SCENES:-example-cube homogeneous-cube cgg-logo ad envmap-cube smoke buc
 say "# volpt view, end to end, $(date -u +%Y-%m-%dT%H:%MZ)"
 say ""
 say "device: $(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null | head -n 1); CPU: $(nproc) threads of $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)"
-say "volpt: $($VOLPT --version 2>/dev/null); GPU strategy $STRATEGY, math $MATH; phases of $SECONDS_PER_PHASE s"
+say "volpt: $($VOLPT --version 2>/dev/null); GPU strategy $STRATEGIES, math $MATH; phases of $SECONDS_PER_PHASE s"
 say ""
 say "move->frame: a still camera move to its first frame (1 spp, full resolution), median of 10. still: frames/s of the refinement and the spp reached. orbit: 60 interactive moves/s; frames/s showing a move, move->frame median, the resolution the renderer chose, and the mean render / tone map / JPEG ms per frame."
 say ""
@@ -164,30 +169,44 @@ fi
 num() { python3 -c "import json,sys; v=json.loads(sys.argv[1]).get(sys.argv[2]); print('-' if v is None else (f'{v:.1f}' if isinstance(v,float) else v))" "$1" "$2"; }
 say "| scene | backend | resolution | move->frame ms | still frames/s | still spp after | orbit frames/s | orbit move->frame ms | orbit at | orbit render / tone / jpeg ms |"
 say "|---|---|---|---|---|---|---|---|---|---|"
+# The backends to run: the CPU, and the GPU once per strategy of STRATEGIES.
+configs=()
+for backend in $BACKENDS; do
+    if [ "$backend" = cuda ]; then
+        for strategy in $STRATEGIES; do configs+=("cuda:$strategy"); done
+    else
+        configs+=("$backend:")
+    fi
+done
 for scene in $SCENES; do
-  for backend in $BACKENDS; do
+  for config in "${configs[@]}"; do
+    backend=${config%%:*} strategy=${config#*:}
     for res in $RESOLUTIONS; do
-      gpu=()
-      [ "$backend" = cuda ] && gpu=(--strategy "$STRATEGY" --math "$MATH")
+      # The backend column names the strategy where several run.
+      gpu=() label=$backend
+      if [ "$backend" = cuda ]; then
+          gpu=(--strategy "$strategy" --math "$MATH")
+          [ "$STRATEGIES" != "$STRATEGY" ] && label="cuda $strategy"
+      fi
       # shellcheck disable=SC2086 # FILES holds the scene file and its -D parameter
-      serve "$scene-$backend-$res" ${FILES[$scene]} --backend "$backend" "${gpu[@]}" --resolution "$res"
+      serve "$scene-${label// /-}-$res" ${FILES[$scene]} --backend "$backend" "${gpu[@]}" --resolution "$res"
       if [ -z "$url" ]; then
-          say "| $scene | $backend | $res | FAIL: no server ($(tail -n 1 "$log")) |"
+          say "| $scene | $label | $res | FAIL: no server ($(tail -n 1 "$log")) |"
           failures=$((failures + 1)); kill "$server" 2>/dev/null; wait "$server" 2>/dev/null; continue
       fi
       json=$(timeout "$LIMIT" "$CLIENT" "${url}ws" "$SECONDS_PER_PHASE" 2>>"$log")
       rc=$?
       stop
       if [ $rc -ne 0 ] || [ -z "$json" ]; then
-          say "| $scene | $backend | $res | FAIL: client rc $rc ($(tail -n 1 "$log")) |"
+          say "| $scene | $label | $res | FAIL: client rc $rc ($(tail -n 1 "$log")) |"
           failures=$((failures + 1)); continue
       fi
       echo "{\"scene\":\"$scene\",\"resolution\":\"$res\",\"result\":$json}" >>"$JSONL"
       if [ "$(num "$json" repeat_identical)" != True ]; then
-          say "| $scene | $backend | $res | FAIL: a view shown again is not its first image ($(num "$json" repeat_identical)) |"
+          say "| $scene | $label | $res | FAIL: a view shown again is not its first image ($(num "$json" repeat_identical)) |"
           failures=$((failures + 1))
       fi
-      say "| $scene | $backend | $res | $(num "$json" still_move_to_frame_ms_median) | $(num "$json" still_frames_per_s) | $(num "$json" still_spp_after) | $(num "$json" orbit_frames_per_s) | $(num "$json" orbit_move_to_frame_ms_median) | $(num "$json" orbit_resolution) | $(num "$json" orbit_render_ms_mean) / $(num "$json" orbit_tonemap_ms_mean) / $(num "$json" orbit_encode_ms_mean) |"
+      say "| $scene | $label | $res | $(num "$json" still_move_to_frame_ms_median) | $(num "$json" still_frames_per_s) | $(num "$json" still_spp_after) | $(num "$json" orbit_frames_per_s) | $(num "$json" orbit_move_to_frame_ms_median) | $(num "$json" orbit_resolution) | $(num "$json" orbit_render_ms_mean) / $(num "$json" orbit_tonemap_ms_mean) / $(num "$json" orbit_encode_ms_mean) |"
     done
   done
 done

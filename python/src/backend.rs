@@ -25,6 +25,26 @@ impl Backend {
             .map_err(to_py)?;
         Ok(Self { inner, options })
     }
+
+    /// The backend of a caller who names none: a GPU where one is usable, else the CPU
+    /// (`volpt::Backend::open_preferred`), and why.
+    pub fn preferred(py: Python<'_>) -> PyResult<(Self, String)> {
+        let gpu = volpt::GpuOptions::default();
+        let preferred = py
+            .allow_threads(|| volpt::Backend::open_preferred(&gpu))
+            .map_err(to_py)?;
+        let options = BackendOptions {
+            kind: preferred.backend.kind(),
+            gpu,
+        };
+        Ok((
+            Self {
+                inner: preferred.backend,
+                options,
+            },
+            preferred.reason,
+        ))
+    }
 }
 
 /// `gpus=`: `"all"`, one ordinal, or a sequence of them.

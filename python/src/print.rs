@@ -10,13 +10,15 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use volpt::BackendKind;
 use volpt_print::compensate::{CompensateError, Iteration, Options};
-use volpt_print::job::{run, Job, JobError};
+use volpt_print::job::{run_on, Job, JobError, Renderer};
 use volpt_print::predict::PredictError;
 
+use crate::backend::Backend;
 use crate::convert::describe;
 use crate::errors::{to_py, PrintError, SettingsError};
+use crate::film::Film;
 use crate::observer::PyObserver;
-use crate::scene::choose;
+use crate::scene::{choose, Chosen};
 
 /// The Python exception for a compensation's error: a render's as any render's, a bad argument
 /// or file as `PrintError` (a `ValueError`).
@@ -45,6 +47,25 @@ fn print_error(error: &dyn std::error::Error) -> PyErr {
     PrintError::new_err(text)
 }
 
+/// The image of a `render=` callable's film: samples `0..samples` of the print's scene.
+fn film_image(py: Python<'_>, film: PyObject, samples: u32) -> PyResult<volpt::Image> {
+    let film = film.bind(py);
+    let Ok(film) = film.downcast::<Film>() else {
+        return Err(SettingsError::new_err(format!(
+            "render: expected it to return a volpt.Film, found {}",
+            describe(film)
+        )));
+    };
+    let part = &film.borrow().part;
+    if part.samples != (0..samples) {
+        return Err(SettingsError::new_err(format!(
+            "render: expected a film of samples 0..{samples}, found {:?}",
+            part.samples
+        )));
+    }
+    Ok(part.film.image(samples))
+}
+
 /// An iteration as Python sees it: `{"mean", "p95", "noise", "spp"}`.
 fn summary<'py>(py: Python<'py>, it: &Iteration) -> PyResult<Bound<'py, PyDict>> {
     let row = PyDict::new(py);
@@ -60,7 +81,7 @@ fn summary<'py>(py: Python<'py>, it: &Iteration) -> PyResult<Bound<'py, PyDict>>
 #[pyo3(signature = (target, materials, out, *, layers=100, colour_layers=40, voxel_size=None,
                     spp=16, max_spp=volpt_print::predict::RenderPredictor::MAX_SPP,
                     iterations=None, step=None, noise_ratio=Some(0.25), ior=Some(1.5), seed=0,
-                    backend=None, progress=None, iteration=None))]
+                    backend=None, render=None, progress=None, iteration=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn compensate_print<'py>(
     py: Python<'py>,
@@ -78,6 +99,7 @@ pub fn compensate_print<'py>(
     ior: Option<f32>,
     seed: u32,
     backend: Option<Bound<'py, PyAny>>,
+    render: Option<Bound<'py, PyAny>>,
     progress: Option<Bound<'py, PyAny>>,
     iteration: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -87,12 +109,28 @@ pub fn compensate_print<'py>(
             describe(callback)
         )));
     }
+    if let Some(callback) = render.as_ref().filter(|c| !c.is_callable()) {
+        return Err(SettingsError::new_err(format!(
+            "render: expected a callable(scene_path, samples, seed) returning a volpt.Film, found {}",
+            describe(callback)
+        )));
+    }
+    if render.is_some() && backend.is_some() {
+        return Err(SettingsError::new_err(
+            "render and backend: expected one of them (render renders every prediction itself)",
+        ));
+    }
     let iteration = iteration.map(Bound::unbind);
-    let backend = match backend {
-        Some(backend) => backend,
-        None => BackendKind::Cpu.to_string().into_pyobject(py)?.into_any(),
+    let render = render.map(Bound::unbind);
+    // No backend named: a GPU where one is usable, else the CPU (volpt::Backend::open_preferred).
+    let (backend, reason) = match (&backend, &render) {
+        (Some(backend), _) => (Some(choose(backend, None, None)?), "backend=".to_owned()),
+        (None, Some(_)) => (None, "render=".to_owned()),
+        (None, None) => {
+            let (backend, reason) = Backend::preferred(py)?;
+            (Some(Chosen::Opened(Box::new(backend))), reason)
+        }
     };
-    let backend = choose(&backend, None, None)?;
     let defaults = Options::default();
     let mut job = Job::new(target, materials, out);
     job.layers = layers;
@@ -108,12 +146,32 @@ pub fn compensate_print<'py>(
         noise_ratio,
         ..defaults
     };
-    let observer = Arc::new(PyObserver::new(progress, backend.inner.kind())?);
-    let inner = &backend.inner;
+    let kind = backend
+        .as_ref()
+        .map_or(BackendKind::Cpu, |b| b.inner.kind());
+    let device = match &backend {
+        Some(b) => b.inner.device_name(),
+        None => "render=".to_owned(),
+    };
+    let observer = Arc::new(PyObserver::new(progress, kind)?);
     let shared = observer.clone();
     let observer = &observer;
+    let renderer = match (&backend, &render) {
+        (Some(b), _) => Renderer::Backend(&b.inner),
+        (None, Some(render)) => Renderer::Elsewhere(Box::new(move |scene, samples, seed| {
+            Python::with_gil(|py| {
+                let film = render
+                    .call1(py, (scene.to_path_buf(), samples, seed))
+                    .and_then(|film| film_image(py, film, samples));
+                // Its exception (a render that failed, Ctrl-C) stops the loop as Ctrl-C does,
+                // and is raised after the record of the iterations finished is written.
+                film.map_err(|error| observer.fail(error)).ok()
+            })
+        })),
+        (None, None) => unreachable!("a backend is opened where no render is given"),
+    };
     let outcome = py.allow_threads(|| {
-        run(&job, inner, shared, |k, it| {
+        run_on(&job, renderer, shared, |k, it| {
             if let Some(callback) = &iteration {
                 Python::with_gil(|py| {
                     // Its exception (Ctrl-C's KeyboardInterrupt, while it runs) stops the loop
@@ -144,5 +202,7 @@ pub fn compensate_print<'py>(
     result.set_item("size", (outcome.size[0], outcome.size[1]))?;
     result.set_item("seconds", outcome.seconds)?;
     result.set_item("out", job.out.clone())?;
+    result.set_item("backend", device)?;
+    result.set_item("backend_reason", reason)?;
     Ok(result)
 }

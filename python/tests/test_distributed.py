@@ -256,3 +256,31 @@ def test_task_killed_beyond_its_retries_is_named(cluster, tmp_path, grid_scene):
     # The part that arrived is kept, for `volpt merge` with the missing range's film.
     kept = list(tmp_path.iterdir())
     assert len(kept) == 1 and kept[0].name in ("part-0000.vfilm", "part-0001.vfilm")
+
+
+def test_a_compensation_renders_its_predictions_on_the_cluster(cluster, tmp_path):
+    # volpt.distributed.compensate_print: each prediction's halves split into sample ranges
+    # rendered on the two worker nodes; the same compensation as this process's render of the
+    # same scene files and partitions, bit for bit.
+    from test_print import MATERIALS, bars, write_png
+
+    target = write_png(tmp_path / "target.png", 6, 5, bars)
+    args = dict(layers=6, colour_layers=3, spp=16, iterations=3, seed=2, noise_ratio=None)
+    arrived = []
+    ray_result = vd.compensate_print(
+        target, MATERIALS, tmp_path / "ray", parts=2, backend="cpu", parts_done=arrived.append, **args
+    )
+
+    def here(scene, samples, seed):
+        s = volpt.load(scene)
+        return volpt.merge([s.render(samples=r, seed=seed) for r in vd.sample_ranges(samples, 2)])
+
+    local = volpt.compensate_print(target, MATERIALS, tmp_path / "local", render=here, **args)
+    assert [it["mean"] for it in ray_result["iterations"]] == [it["mean"] for it in local["iterations"]]
+    # Two parts per half, two halves per prediction, from both nodes.
+    assert len(arrived) == 2 * 2 * len(ray_result["iterations"])
+    assert len({p.node_id for p in arrived}) == 2, arrived
+    for name in ["iterations.csv", *(f"slices/{p.name}" for p in (tmp_path / "local" / "slices").iterdir())]:
+        assert (tmp_path / "ray" / name).read_bytes() == (tmp_path / "local" / name).read_bytes(), name
+    with pytest.raises(volpt.SettingsError, match="render: not an option"):
+        vd.compensate_print(target, MATERIALS, tmp_path / "x", render=here)

@@ -125,3 +125,51 @@ def test_ctrl_c_writes_the_iterations_finished_and_raises_keyboard_interrupt(tmp
     rows = (out / "iterations.csv").read_text().splitlines()[1:]
     assert 1 <= len(rows) < 50
     assert (out / "slices" / "materials.toml").is_file() and (out / "delta_e.svg").is_file()
+
+
+def test_no_backend_named_is_a_gpu_where_one_is_usable_else_the_cpu_and_says_which(tmp_path):
+    target = write_png(tmp_path / "target.png", 4, 3, bars)
+    args = dict(layers=4, colour_layers=2, spp=2, iterations=1)
+    result = volpt.compensate_print(target, MATERIALS, tmp_path / "a", **args)
+    if result["backend"].startswith("CPU"):
+        no_gpu = ("this build carries no GPU kernels", "no GPU is usable", "the CUDA driver sees no GPU",
+                  "the GPU did not open")
+        assert result["backend_reason"].startswith(no_gpu), result
+    else:
+        assert result["backend_reason"].startswith("a GPU is present"), result
+    # A backend named wins.
+    named = volpt.compensate_print(target, MATERIALS, tmp_path / "b", **args, backend="cpu")
+    assert named["backend"].startswith("CPU") and named["backend_reason"] == "backend="
+
+
+def test_render_renders_each_prediction_from_its_scene_files(tmp_path):
+    # What volpt.distributed.compensate_print passes: here, the same render in this process.
+    target = write_png(tmp_path / "target.png", 6, 5, bars)
+    args = dict(layers=6, colour_layers=3, spp=8, iterations=2, seed=2, noise_ratio=None)
+    calls = []
+
+    def render(scene, samples, seed):
+        calls.append((Path(scene).relative_to(tmp_path / "files"), samples, seed))
+        return volpt.load(scene).render(samples=range(samples), seed=seed)
+
+    files = volpt.compensate_print(target, MATERIALS, tmp_path / "files", **args, render=render)
+    assert files["backend"] == "render=" and files["backend_reason"] == "render="
+    assert calls == [(Path("renders/scene.toml"), 4, seed) for _ in files["iterations"] for seed in (2, 3)]
+    assert not (tmp_path / "files" / "renders").exists()  # removed once the loop ends
+    here = volpt.compensate_print(target, MATERIALS, tmp_path / "here", **args, backend="cpu")
+    # The scene files are the predictor's scene, to the float rounding of the camera's transform.
+    assert [it["mean"] for it in files["iterations"]] == pytest.approx(
+        [it["mean"] for it in here["iterations"]], rel=1e-3)
+    with pytest.raises(volpt.SettingsError, match="render and backend"):
+        volpt.compensate_print(target, MATERIALS, tmp_path / "c", render=render, backend="cpu")
+    with pytest.raises(volpt.SettingsError, match="render: expected a callable"):
+        volpt.compensate_print(target, MATERIALS, tmp_path / "d", render=3)
+    # A render's exception stops the loop as Ctrl-C does, and is raised once the record is written.
+    def broken(scene, samples, seed):
+        raise RuntimeError("the cluster is gone")
+
+    with pytest.raises(RuntimeError, match="the cluster is gone"):
+        volpt.compensate_print(target, MATERIALS, tmp_path / "e", **args, render=broken)
+    with pytest.raises(volpt.SettingsError, match="expected a film of samples 0..4"):
+        volpt.compensate_print(target, MATERIALS, tmp_path / "f", **args,
+                               render=lambda s, n, seed: volpt.load(s).render(samples=range(1), seed=seed))

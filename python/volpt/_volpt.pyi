@@ -52,6 +52,7 @@ def compensate_print(
     ior: Optional[float] = 1.5,
     seed: int = 0,
     backend: Union[str, Backend, None] = None,
+    render: Optional[Callable[[str, int, int], "Film"]] = None,
     progress: Union[bool, Callable[[int, int], Any], None] = None,
     iteration: Optional[Callable[[int, Dict[str, Any]], Any]] = None,
 ) -> Dict[str, Any]:
@@ -68,8 +69,17 @@ def compensate_print(
 
     Writes into ``out``: target.png, prediction.png, comparison.png, iteration_NN/prediction.png
     and delta_e.png, iterations.csv, delta_e.svg and the best print's slice stack (slices/).
+    ``backend``: ``"cpu"``, ``"cuda"`` or a ``volpt.Backend`` (several GPUs:
+    ``volpt.Backend("cuda", gpus="all")``, each prediction's samples split between them); default:
+    a GPU where one is usable, else the CPU (the result's ``backend`` and ``backend_reason`` say
+    which and why). ``render(scene_path, samples, seed)``, instead of a backend, renders each
+    prediction elsewhere: it is given a volpt TOML scene written under ``out/renders/`` (with its
+    slice stack) and returns the ``volpt.Film`` of samples ``0..samples`` with that seed
+    (``volpt.distributed.compensate_print`` passes a Ray cluster's render); an exception it
+    raises stops the loop as Ctrl-C does, and is raised after the record is written.
+
     Returns ``{"iterations": [{"mean", "p95", "noise", "spp"}, ...], "best", "size", "seconds",
-    "out"}``; ``iteration(k, {"mean", "p95", "noise", "spp"})`` is called as each iteration ends
+    "out", "backend", "backend_reason"}``; ``iteration(k, {"mean", "p95", "noise", "spp"})`` is called as each iteration ends
     (an exception it raises stops the loop as Ctrl-C does, and is raised). ``progress`` is as ``Scene.render``'s, per render.
     The GIL is released; Ctrl-C writes the record of the iterations finished and raises
     ``KeyboardInterrupt`` (the record of an interrupted loop is whole but for the iterations not

@@ -32,7 +32,7 @@ from typing import Any, Callable, Dict, List, Mapping, Optional, Tuple, Union
 from . import _volpt
 from .errors import RenderError, SettingsError, VolptError
 
-__all__ = ["render", "sample_ranges", "PartDone"]
+__all__ = ["render", "compensate_print", "sample_ranges", "PartDone"]
 
 
 @dataclass(frozen=True)
@@ -288,3 +288,48 @@ def render(
     if out is not None:
         merged.write(out)
     return merged
+
+
+def compensate_print(
+    target: "str | os.PathLike[str]",
+    materials: "str | os.PathLike[str]",
+    out: "str | os.PathLike[str]",
+    *,
+    parts: Optional[int] = None,
+    backend: str = "auto",
+    num_cpus: int = 1,
+    max_retries: int = 3,
+    address: Optional[str] = None,
+    parts_done: Optional[Callable[[PartDone], Any]] = None,
+    **options: Any,
+) -> Dict[str, Any]:
+    """``volpt.compensate_print`` with every prediction rendered on a Ray cluster: each of a
+    prediction's two independent halves is one ``render`` of the print's scene (written under
+    ``out/renders/``, which every node must read at the same path: a shared file system), split
+    into ``parts`` sample ranges (default: as ``render``'s, at most the half's samples) rendered as
+    Ray tasks and merged. ``backend``, ``num_cpus``, ``max_retries`` and ``address`` are
+    ``render``'s; ``parts_done`` is called with each part as it arrives (``render``'s
+    ``progress``); ``options`` are ``volpt.compensate_print``'s (``layers``, ``spp``,
+    ``iterations``, ``iteration``, ...; not ``render``).
+
+    The record is the one ``volpt.compensate_print`` writes (its ``backend`` says ``render=``).
+    A part that fails beyond its retries raises ``RenderError`` after the record of the iterations
+    finished is written, as Ctrl-C does.
+    """
+    if "render" in options:
+        raise SettingsError("render: not an option of volpt.distributed.compensate_print (the Ray cluster renders)")
+
+    def render_on_cluster(scene: str, samples: int, seed: int) -> "_volpt.Film":
+        return render(
+            scene,
+            samples,
+            parts=None if parts is None else min(parts, samples),
+            seed=seed,
+            backend=backend,
+            num_cpus=num_cpus,
+            max_retries=max_retries,
+            address=address,
+            progress=parts_done,
+        )
+
+    return _volpt.compensate_print(target, materials, out, render=render_on_cluster, **options)

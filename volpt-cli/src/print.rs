@@ -83,9 +83,10 @@ pub struct CompensateArgs {
     /// Seed of the renders' random streams and of the halftone.
     #[arg(long, default_value_t = 0)]
     seed: u32,
-    /// Where to render.
-    #[arg(long, value_parser = crate::named::<BackendKind>(), default_value_t = BackendKind::Cpu)]
-    backend: BackendKind,
+    /// Where to render [default: a GPU where one is usable (or the GPU flags are given), else the
+    /// CPU; the choice and why are printed first].
+    #[arg(long, value_parser = crate::named::<BackendKind>())]
+    backend: Option<BackendKind>,
     #[command(flatten)]
     gpu: GpuArgs,
     #[command(flatten)]
@@ -153,10 +154,17 @@ fn delta_e(target: &std::path::Path, image: &std::path::Path, flip_rows: bool) -
 }
 
 fn compensate(args: CompensateArgs) -> Result<()> {
-    let backend = Backend::open(&BackendOptions {
-        kind: args.backend,
-        gpu: args.gpu.options(&args.volumes),
-    })?;
+    let gpu = args.gpu.options(&args.volumes);
+    let (backend, chosen) = match args.backend {
+        Some(kind) => (
+            Backend::open(&BackendOptions { kind, gpu })?,
+            "--backend".to_owned(),
+        ),
+        None => {
+            let p = Backend::open_preferred(&gpu)?;
+            (p.backend, format!("no --backend: {}", p.reason))
+        }
+    };
     let mut job = Job::new(args.target, args.materials, args.out);
     job.layers = args.layers;
     job.colour_layers = args.colour_layers;
@@ -176,7 +184,7 @@ fn compensate(args: CompensateArgs) -> Result<()> {
     )?);
     if !args.quiet {
         terminal.note(&format!(
-            "compensating {} on {} ({} layers, {} colour, voxel {})\n",
+            "compensating {} on {} ({chosen}; {} layers, {} colour, voxel {})\n",
             job.target.display(),
             backend.device_name(),
             job.layers,

@@ -330,3 +330,49 @@ fn ctrl_c_ends_the_loop_and_keeps_the_iterations_finished() {
     assert!(out.join("slices/materials.toml").is_file());
     assert!(out.join("delta_e.svg").is_file());
 }
+
+#[test]
+fn without_backend_the_gpu_is_chosen_where_usable_else_the_cpu_and_the_choice_is_said() {
+    let dir = tempfile::tempdir().unwrap();
+    let target = dir.path().join("target.png");
+    write_target(&target, [4, 3]);
+    let compensate = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let output = run(&[
+            &[
+                "print",
+                "compensate",
+                s(&target),
+                "--materials",
+                s(&materials()),
+            ],
+            &["--layers", "4", "--colour-layers", "2", "--spp", "2"][..],
+            &["--iterations", "1", "-o", s(&out)],
+            extra,
+        ]
+        .concat());
+        let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+        assert!(output.status.success(), "{stderr}");
+        stderr
+    };
+    let chosen = compensate("default", &[]);
+    let probe = volpt::GpuProbe::now();
+    match probe {
+        volpt::GpuProbe::Gpus(n) if n > 0 => assert!(
+            chosen.contains("(no --backend: a GPU is present"),
+            "{chosen}"
+        ),
+        _ => {
+            let (_, why) = volpt::preferred_kind(&probe, &volpt::GpuOptions::default());
+            assert!(
+                chosen.contains(" on CPU, ") && chosen.contains(&format!("(no --backend: {why};")),
+                "{chosen}"
+            );
+        }
+    }
+    let named = compensate("named", &["--backend", "cpu"]);
+    assert!(
+        named.contains(" on CPU, ") && named.contains("(--backend;"),
+        "{named}"
+    );
+}

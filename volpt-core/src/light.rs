@@ -15,6 +15,7 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::bsdf::Bsdf;
+use crate::environment::Environment;
 use crate::math::{normalize, sqrt, PI};
 use crate::path::{power_heuristic, PathOf};
 use crate::sampling::direction_about;
@@ -364,37 +365,42 @@ pub(crate) fn sample_spot(spot: &SpotLight, p: Vec3) -> Option<LightSample> {
     })
 }
 
-/// The lights' samples for next-event estimation from a collision at `p` (the sun's, then the
-/// point or spot's; `None` for a light that is off or sends nothing to `p`), which
-/// [`crate::path`]'s next-event estimation weighs with the environment's in one loop. A delta
-/// light (the sun at radius 0, a point or spot: `L / p` is then the irradiance, or
-/// `I falloff / r^2`) is reached by no other strategy, so its weight is 1; a sun with extent is
-/// also reached by the phase function's sample when the path escapes into the disc
-/// ([`escaped_sun`]), so both take the power heuristic (pbrt-v4 section 14.2.2, `SampleLd`).
-/// Draws the sun's two numbers only for a sun with extent.
+/// Next-event estimation's light slots: the environment, the sun, the point or spot.
+pub(crate) const SLOTS: u32 = 3;
+
+/// Slot `slot`'s sample for next-event estimation from a collision at `p` (0: the environment's,
+/// where `environment`; 1: the sun's; 2: the point or spot's; `None` for a light that is off or
+/// sends nothing to `p`), which [`crate::path`]'s next-event estimation weighs in one loop,
+/// drawing each sample in its own turn. A delta light (the sun at radius 0, a point or spot:
+/// `L / p` is then the irradiance, or `I falloff / r^2`) is reached by no other strategy, so its
+/// weight is 1; a sun with extent is also reached by the phase function's sample when the path
+/// escapes into the disc ([`escaped_sun`]), so both take the power heuristic (pbrt-v4 section
+/// 14.2.2, `SampleLd`). Draws the sun's two numbers only for a sun with extent.
 #[inline(always)]
-pub(crate) fn samples<S: Scene>(
+pub(crate) fn sample<S: Scene>(
     scene: &S,
     path: &mut PathOf<S>,
     p: Vec3,
-) -> [Option<LightSample>; 2] {
+    slot: u32,
+    environment: bool,
+) -> Option<LightSample> {
     let lights = scene.lights();
-    let sun = if lights.sun.is_on() {
-        let u = if lights.sun.is_delta() {
-            Vec2::ZERO
-        } else {
-            path.rng.next_2d()
-        };
-        Some(sample_sun(&lights.sun, u))
-    } else {
-        None
-    };
-    let spot = if lights.spot.is_on() {
-        sample_spot(&lights.spot, p)
-    } else {
-        None
-    };
-    [sun, spot]
+    match slot {
+        0 if environment => scene
+            .environment()
+            .sample(path.rng.next_2d())
+            .map(LightSample::from),
+        1 if lights.sun.is_on() => {
+            let u = if lights.sun.is_delta() {
+                Vec2::ZERO
+            } else {
+                path.rng.next_2d()
+            };
+            Some(sample_sun(&lights.sun, u))
+        }
+        2 if lights.spot.is_on() => sample_spot(&lights.spot, p),
+        _ => None,
+    }
 }
 
 impl From<crate::environment::LightSample> for LightSample {

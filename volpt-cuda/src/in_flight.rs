@@ -5,8 +5,8 @@
 //! The multi-kernel strategies keep every path in flight in device queues between their
 //! launches (`volpt_device::launch::Stage`): stopping between two iterations loses nothing. The
 //! queues, their counters and the film stay on the GPU, and the next call of the same render
-//! (same kernel, scene parameters with the camera, seed, samples and size) runs the next
-//! iteration; any other render discards them. Every path of the range is traced once and added
+//! (same kernel, scene as the caller's fingerprint names it, camera included, grids, seed, samples
+//! and size) runs the next iteration; any other render discards them. Every path of the range is traced once and added
 //! once, so when the range is finished the film holds the uninterrupted render's sums (up to the
 //! order of the film's additions); before, it holds the samples before the range and the paths of
 //! the range that have ended. The other strategies finish what they start.
@@ -53,8 +53,10 @@ struct Key {
     kernel: String,
     max_registers: Option<u32>,
     refill_at: u32,
-    /// The scene's launch parameters as bytes: the camera, the grids' device addresses.
-    scene: Vec<u8>,
+    /// The caller's fingerprint of the scene as rendered (camera, film, medium, ...): not the
+    /// launch parameters' bytes, whose small arrays are copied anew, to new addresses, each call.
+    render: u64,
+    grids: u64,
     seed: u32,
     samples: Range<u32>,
     size: (u32, u32),
@@ -74,10 +76,12 @@ impl CudaRenderer {
     /// the strategy keeps them (the multi-kernel ones; the others finish what they start). A call
     /// of the same render continues them; `film` must then be the one the previous call left
     /// (it gets the device film's sums back at every call: the samples before the range and
-    /// the range's paths that have ended).
+    /// the range's paths that have ended). `render` names the scene as rendered (with its camera:
+    /// `volpt`'s fingerprint): paths continue only in a call of the same `render`.
     ///
     /// # Safety
-    /// As [`CudaRenderer::render_samples_keeping`].
+    /// As [`CudaRenderer::render_samples_keeping`]; and `render` differs between renders of
+    /// different scenes or views.
     #[allow(clippy::too_many_arguments)]
     pub unsafe fn render_samples_until<S: SceneAbi>(
         &self,
@@ -87,6 +91,7 @@ impl CudaRenderer {
         samples: Range<u32>,
         options: &RenderOptions,
         grids: u64,
+        render: u64,
         deadline: Instant,
     ) -> Result<Progress, CudaError> {
         let schedule = schedule.into();
@@ -122,7 +127,8 @@ impl CudaRenderer {
             kernel: name,
             max_registers: schedule.max_registers,
             refill_at,
-            scene: bytemuck::bytes_of(&scene_params).to_vec(),
+            render,
+            grids,
             seed: options.seed,
             samples: samples.clone(),
             size: (width, height),

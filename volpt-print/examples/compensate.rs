@@ -19,12 +19,12 @@ use volpt_print::compensate::{compensate, Options, Setup};
 use volpt_print::halftone::Halftone;
 use volpt_print::predict::RenderPredictor;
 use volpt_print::record::write_record;
-use volpt_print::{Inks, Material};
+use volpt_print::{Inks, MaterialDesc};
 
-fn inks() -> Vec<Material> {
-    let ink = |name: &str, colour: [u8; 3], sigma_s: f32, sigma_a: [f32; 3]| Material {
+fn inks() -> Vec<MaterialDesc> {
+    let ink = |name: &str, colour: [u8; 3], sigma_s: f32, sigma_a: [f32; 3]| MaterialDesc {
         name: name.into(),
-        colour,
+        colour: Some(colour),
         sigma_s: [sigma_s; 3],
         sigma_a,
         g: 0.0,

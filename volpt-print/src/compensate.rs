@@ -44,8 +44,8 @@ use volpt::metrics::quantile;
 
 use crate::colour::{ciede2000, Lab, LinearRgb};
 use crate::halftone::{naive_mix, Halftone};
-use crate::material::Material;
 use crate::print::VoxelPrint;
+use volpt_scene::material::MaterialDesc;
 
 /// What predicts a print's appearance.
 pub trait Predictor {
@@ -83,7 +83,7 @@ pub trait Predictor {
 /// The print the loop builds: its materials and voxel size, and the halftone of its inks.
 #[derive(Clone, Debug)]
 pub struct Setup {
-    pub materials: Vec<Material>,
+    pub materials: Vec<MaterialDesc>,
     pub voxel_size: [f64; 3],
     pub halftone: Halftone,
 }

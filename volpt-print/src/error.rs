@@ -39,36 +39,12 @@ pub enum PrintError {
         source: Box<toml::de::Error>,
     },
 
-    /// A slice PNG that does not decode.
+    /// A PNG (a target image) that does not decode.
     #[error("{}: not a PNG slice volpt reads: {source}", path.display())]
     Png {
         path: PathBuf,
         #[source]
         source: png::DecodingError,
-    },
-
-    /// A slice pixel whose colour names no material of the palette.
-    #[error(
-        "{}: pixel ({}, {}): expected a palette colour ({palette}), found #{:02x}{:02x}{:02x}",
-        path.display(), pixel[0], pixel[1], colour[0], colour[1], colour[2]
-    )]
-    PaletteColour {
-        path: PathBuf,
-        pixel: [u32; 2],
-        colour: [u8; 3],
-        /// The palette, as `#rrggbb name` entries.
-        palette: String,
-    },
-
-    /// A slice whose size differs from the stack's.
-    #[error(
-        "{}: expected a slice of {} x {} pixels (materials.toml's width and height), found {} x {}",
-        path.display(), expected[0], expected[1], found[0], found[1]
-    )]
-    SliceSize {
-        path: PathBuf,
-        expected: [u32; 2],
-        found: [u32; 2],
     },
 
     /// A slice missing from, or extra to, the numbering `slice_0000.png` .. that `layers` implies.

@@ -18,7 +18,7 @@ use crate::compensate::{
 use crate::error::PrintError;
 use crate::halftone::Halftone;
 use crate::material::{Inks, MaterialFile};
-use crate::predict::{PredictError, RenderPredictor};
+use crate::predict::{PredictError, RenderFiles, RenderPredictor};
 use crate::record::write_record;
 use crate::slices::write_slices;
 use crate::target::Target;
@@ -32,6 +32,17 @@ pub const VOXEL_SIZE: [f64; 3] = [0.0423, 0.0423, 0.027];
 pub const PRINT_SCENE: &str = "print.toml";
 pub const NAIVE_SCENE: &str = "naive.toml";
 pub const NAIVE_SLICES: &str = "naive_slices";
+/// Where [`Renderer::Elsewhere`]'s predictions are written while the job runs (removed after).
+pub const RENDERS: &str = "renders";
+
+/// Where a job's predictions render.
+pub enum Renderer<'b> {
+    /// A backend of this process: the CPU, a GPU, or several (`--gpus`).
+    Backend(&'b Backend),
+    /// A function given each prediction's scene as files under the record's [`RENDERS`] folder
+    /// ([`RenderPredictor::elsewhere`]): Python's Ray cluster.
+    Elsewhere(RenderFiles<'b>),
+}
 
 /// What a compensation is asked to do.
 #[derive(Clone, Debug)]
@@ -122,6 +133,16 @@ pub fn run(
     job: &Job,
     backend: &Backend,
     observer: Arc<dyn Observer + Send + Sync>,
+    on_iteration: impl FnMut(usize, &Iteration),
+) -> Result<Outcome, JobError> {
+    run_on(job, Renderer::Backend(backend), observer, on_iteration)
+}
+
+/// [`run`], its predictions rendered by `renderer`.
+pub fn run_on(
+    job: &Job,
+    renderer: Renderer<'_>,
+    observer: Arc<dyn Observer + Send + Sync>,
     mut on_iteration: impl FnMut(usize, &Iteration),
 ) -> Result<Outcome, JobError> {
     let start = Instant::now();
@@ -185,7 +206,12 @@ pub fn run(
             seed: u64::from(job.seed),
         },
     };
-    let mut predictor = RenderPredictor::new(backend, job.spp).with_observer(observer);
+    let renders = job.out.join(RENDERS);
+    let mut predictor = match renderer {
+        Renderer::Backend(backend) => RenderPredictor::new(backend, job.spp),
+        Renderer::Elsewhere(render) => RenderPredictor::elsewhere(renders.clone(), render, job.spp),
+    }
+    .with_observer(observer);
     predictor.max_spp = job.max_spp;
     predictor.seed = job.seed;
     predictor.boundary = match job.ior {
@@ -206,7 +232,15 @@ pub fn run(
             on_iteration(k, it);
             k += 1;
         },
-    )?;
+    );
+    // The predictions' scene files are of no use after the loop, whatever its end.
+    if renders.exists() {
+        std::fs::remove_dir_all(&renders).map_err(|source| PrintError::Io {
+            path: renders.clone(),
+            source,
+        })?;
+    }
+    let compensation = compensation?;
     write_record(&compensation, &target.texels, target.size, &job.out)?;
     // The kept print and the naive one as volpt scenes (for `volpt render` and the Mitsuba 3
     // export): the naive print is the first iteration's, halftoned again from its aims.

@@ -3,7 +3,7 @@
 //! for 3D printing"). `docs/printing.md` states what exists and the model choices.
 //!
 //! - [`colour`]: sRGB, linear RGB, CIE XYZ, CIE L*a*b* (D65) and CIEDE2000.
-//! - [`material`]: a print's material table and where its five inks are.
+//! - [`material`]: a print's material table (volpt-scene's [`MaterialDesc`]) and where its five inks are.
 //! - [`print`]: a voxel print, one material index per voxel.
 //! - [`slices`]: slice stacks (one PNG per layer and `materials.toml`), written and read.
 //! - [`halftone`]: the printer's naive ink mix and its 3D ordered dithering into voxels.
@@ -27,5 +27,6 @@ pub mod slices;
 pub mod target;
 
 pub use error::PrintError;
-pub use material::{Inks, Material, MaterialFile};
+pub use material::{Inks, MaterialFile};
 pub use print::VoxelPrint;
+pub use volpt_scene::material::MaterialDesc;

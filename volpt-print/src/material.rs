@@ -1,56 +1,13 @@
-//! The material table of a print: each printer material's scattering and absorption (RGB, per
-//! world unit of the scene: give them per millimetre with the voxel size in millimetres), its
-//! Henyey-Greenstein `g`, and the palette colour that names it in a slice stack.
-//!
-//! The fields and their TOML spelling (`[[materials]]` with `name`, `sigma_s`, `sigma_a`, `g`,
-//! `colour`) are those of volpt-scene's material table (the material-indexed volumes issue), so
-//! that a print's `materials.toml` reads as that table. volpt-scene's `MaterialDesc` reached main
-//! at the end of the session that wrote this; this type becomes it (its colour optional there,
-//! required here) when the predictor moves onto material-indexed volumes.
+//! A print's material table: volpt-scene's [`MaterialDesc`] (each printer material's RGB
+//! `sigma_s`, `sigma_a` per world unit of the scene, its Henyey-Greenstein `g`, and the palette
+//! `colour` that names it in a slice stack), read from TOML by volpt-scene's `[[materials]]`
+//! reader ([`MaterialSpec`]: `sigma_s`/`sigma_a` or `sigma_t`/`albedo`, `colour` as `[r, g, b]`
+//! or `"#rrggbb"`). What is a print's own: where its five inks are ([`Inks`]), and that every
+//! material has a distinct colour ([`crate::print::check_table`]).
 
-use serde::{Deserialize, Serialize};
-
-/// One printer material.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Material {
-    pub name: String,
-    /// The colour that names this material in a slice stack (8-bit sRGB values as stored).
-    pub colour: [u8; 3],
-    /// Scattering coefficient per channel, per world unit.
-    pub sigma_s: [f32; 3],
-    /// Absorption coefficient per channel, per world unit.
-    pub sigma_a: [f32; 3],
-    /// Henyey-Greenstein asymmetry, in (-1, 1).
-    #[serde(default)]
-    pub g: f32,
-}
-
-impl Material {
-    /// Why the material's numbers are not ones a renderer can use, if they are not: `(field,
-    /// expected, found)`.
-    pub fn problem(&self) -> Option<(&'static str, &'static str, String)> {
-        let bad = |v: &[f32; 3]| v.iter().any(|c| !(c.is_finite() && *c >= 0.0));
-        if bad(&self.sigma_s) {
-            return Some((
-                "sigma_s",
-                "three finite numbers >= 0",
-                format!("{:?}", self.sigma_s),
-            ));
-        }
-        if bad(&self.sigma_a) {
-            return Some((
-                "sigma_a",
-                "three finite numbers >= 0",
-                format!("{:?}", self.sigma_a),
-            ));
-        }
-        if !(self.g > -1.0 && self.g < 1.0) {
-            return Some(("g", "a number in (-1, 1)", self.g.to_string()));
-        }
-        None
-    }
-}
+use serde::Deserialize;
+use volpt_scene::material::{MaterialDesc, MaterialSpec};
+use volpt_scene::SceneError;
 
 /// Where each ink of the five-tone process sits in a material table.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -68,7 +25,7 @@ impl Inks {
 
     /// The inks of a table whose materials are named `cyan`, `magenta`, `yellow`, `black` and
     /// `white` (case-insensitive); the name missing, if one is.
-    pub fn find(materials: &[Material]) -> Result<Inks, &'static str> {
+    pub fn find(materials: &[MaterialDesc]) -> Result<Inks, &'static str> {
         let mut found = [0u8; 5];
         for (slot, name) in found.iter_mut().zip(Self::NAMES) {
             let k = materials
@@ -97,11 +54,18 @@ impl Inks {
 /// `materials.toml`, and optionally the print's `voxel_size`. A stack's own `materials.toml` is
 /// one: its `width`, `height` and `layers` are taken and not used (a compensation's print has the
 /// target's size and the depth asked for).
-#[derive(Clone, Debug, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct MaterialFile {
     pub voxel_size: Option<[f64; 3]>,
-    pub materials: Vec<Material>,
+    pub materials: Vec<MaterialDesc>,
+}
+
+/// `M.toml` as written.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Spelt {
+    voxel_size: Option<[f64; 3]>,
+    materials: Vec<MaterialSpec>,
     #[serde(default, rename = "width")]
     _width: Option<u32>,
     #[serde(default, rename = "height")]
@@ -110,37 +74,64 @@ pub struct MaterialFile {
     _layers: Option<u32>,
 }
 
+/// The materials of a table file's `[[materials]]`, each checked by volpt-scene's reader, then as
+/// a print's table ([`crate::print::check_table`]: a distinct colour each).
+pub(crate) fn read_table(
+    path: &std::path::Path,
+    specs: &[MaterialSpec],
+) -> Result<Vec<MaterialDesc>, crate::PrintError> {
+    let invalid = |field: String, expected: &str, found: String| crate::PrintError::Invalid {
+        path: path.to_path_buf(),
+        field,
+        expected: expected.into(),
+        found,
+    };
+    let materials = specs
+        .iter()
+        .enumerate()
+        .map(|(k, spec)| {
+            spec.material(&|field, expected, found| {
+                let field = match field {
+                    "" => format!("materials[{k}]"),
+                    f => format!("materials[{k}].{f}"),
+                };
+                SceneError::InvalidScene {
+                    source_name: path.display().to_string(),
+                    field,
+                    expected: expected.into(),
+                    found,
+                }
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    crate::print::check_table(&materials)
+        .map_err(|(field, expected, found)| invalid(field.into(), &expected, found))?;
+    Ok(materials)
+}
+
 impl MaterialFile {
     /// Reads and checks the table in `path` (every material's numbers, distinct palette colours).
     pub fn read(path: &std::path::Path) -> Result<MaterialFile, crate::PrintError> {
         let text = volpt_scene::limits::read_text(path)?;
-        let file: MaterialFile = toml::from_str(&text).map_err(|e| crate::PrintError::Toml {
+        let file: Spelt = toml::from_str(&text).map_err(|e| crate::PrintError::Toml {
             path: path.to_path_buf(),
             source: Box::new(e),
         })?;
-        let invalid = |field: String, expected: &str, found: String| crate::PrintError::Invalid {
-            path: path.to_path_buf(),
-            field,
-            expected: expected.into(),
-            found,
-        };
-        for (k, m) in file.materials.iter().enumerate() {
-            if let Some((field, expected, found)) = m.problem() {
-                return Err(invalid(format!("materials[{k}].{field}"), expected, found));
-            }
-        }
-        crate::print::check_table(&file.materials)
-            .map_err(|(field, expected, found)| invalid(field.into(), &expected, found))?;
+        let materials = read_table(path, &file.materials)?;
         if let Some(size) = file
             .voxel_size
             .filter(|s| !s.iter().all(|v| v.is_finite() && *v > 0.0))
         {
-            return Err(invalid(
-                "voxel_size".into(),
-                "three finite sizes > 0",
-                format!("{size:?}"),
-            ));
+            return Err(crate::PrintError::Invalid {
+                path: path.to_path_buf(),
+                field: "voxel_size".into(),
+                expected: "three finite sizes > 0".into(),
+                found: format!("{size:?}"),
+            });
         }
-        Ok(file)
+        Ok(MaterialFile {
+            voxel_size: file.voxel_size,
+            materials,
+        })
     }
 }

@@ -31,11 +31,17 @@
 //! ([`Predictor::more_samples`], up to [`RenderPredictor::max_spp`]) while a prediction's noise is
 //! above its bound ([`crate::compensate`]'s module docs).
 //!
+//! **Where.** On a backend of this process ([`RenderPredictor::new`]: the CPU, a GPU, several GPUs
+//! through `--gpus`, whose renders split each prediction's samples between them), or elsewhere
+//! ([`RenderPredictor::elsewhere`]: each prediction written as a volpt TOML scene and its slice
+//! stack, rendered by a function given the scene's path, such as Python's Ray cluster, which
+//! splits the samples into ranges rendered on its nodes and merges their films).
+//!
 //! **Progress and interruption**: each render reports to the predictor's observer
 //! ([`RenderPredictor::with_observer`]), which may stop it (Ctrl-C); a prediction so stopped is
 //! not whole, and [`Predictor::interrupted`] says so.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use thiserror::Error;
@@ -49,18 +55,39 @@ use volpt::{Backend, Observer, Quiet, RenderRequest, RenderSettings, Scene};
 
 use crate::colour::LinearRgb;
 use crate::compensate::Predictor;
-use crate::material::Material;
 use crate::print::VoxelPrint;
 
 #[derive(Debug, Error)]
 pub enum PredictError {
     #[error(transparent)]
     Volpt(#[from] volpt::Error),
+    /// Writing a prediction's scene for [`RenderPredictor::elsewhere`].
+    #[error(transparent)]
+    Write(#[from] crate::PrintError),
 }
+
+/// Renders a print's scene elsewhere ([`RenderPredictor::elsewhere`]): given the path of a volpt
+/// TOML scene, a sample count `n` and a seed, the image of samples `0..n` of every pixel (each
+/// pixel's mean), or `None` where it stopped (Ctrl-C, an error its caller keeps).
+pub type RenderFiles<'b> = Box<dyn FnMut(&Path, u32, u32) -> Option<volpt::Image> + Send + 'b>;
+
+/// Where a predictor's renders run.
+enum Renders<'b> {
+    /// A backend of this process, on the scene built in memory.
+    Backend(&'b Backend),
+    /// A function given the scene as files, written into `dir` for each prediction.
+    Files {
+        dir: PathBuf,
+        render: RenderFiles<'b>,
+    },
+}
+
+/// The scene file [`RenderPredictor::elsewhere`] writes (its slice stack beside it, `slices/`).
+pub const ELSEWHERE_SCENE: &str = "scene.toml";
 
 /// Renders prints from above with volpt (see the module docs).
 pub struct RenderPredictor<'b> {
-    backend: &'b Backend,
+    renders: Renders<'b>,
     /// Samples per texel of the next prediction (one chromatic render: every channel).
     pub spp: u32,
     /// The most samples per texel [`Predictor::more_samples`] raises `spp` to.
@@ -92,8 +119,20 @@ impl<'b> RenderPredictor<'b> {
     /// [`RenderPredictor::MAX_SPP`] when the loop asks for more), a smooth dielectric surface of
     /// IOR 1.5 (the order of the photopolymer resins') in air.
     pub fn new(backend: &'b Backend, spp: u32) -> Self {
+        Self::with_renders(Renders::Backend(backend), spp)
+    }
+
+    /// A predictor as [`RenderPredictor::new`]'s whose renders run elsewhere: each prediction's
+    /// scene is written into `dir` (created; [`ELSEWHERE_SCENE`] and its slice stack `slices/`,
+    /// replaced by the next prediction's) and `render` renders it (see [`RenderFiles`]). `dir`
+    /// must be where the renderer reads it (a shared file system for a cluster).
+    pub fn elsewhere(dir: PathBuf, render: RenderFiles<'b>, spp: u32) -> Self {
+        Self::with_renders(Renders::Files { dir, render }, spp)
+    }
+
+    fn with_renders(renders: Renders<'b>, spp: u32) -> Self {
         RenderPredictor {
-            backend,
+            renders,
             spp,
             max_spp: spp.max(Self::MAX_SPP),
             seed: 0,
@@ -113,11 +152,6 @@ impl<'b> RenderPredictor<'b> {
     pub fn with_observer(mut self, observer: Arc<dyn Observer + Send + Sync>) -> Self {
         self.observer = observer;
         self
-    }
-
-    /// The backend the predictor renders on.
-    pub fn backend(&self) -> &'b Backend {
-        self.backend
     }
 
     /// The scene a prediction of `print` renders (the module docs): to inspect it, export it
@@ -163,7 +197,9 @@ impl<'b> RenderPredictor<'b> {
             line(String::new());
             line("[[materials]]".into());
             line(format!("name = {:?}", m.name));
-            line(format!("colour = {:?}", m.colour));
+            if let Some(colour) = m.colour {
+                line(format!("colour = {colour:?}"));
+            }
             line(format!("sigma_s = {:?}", m.sigma_s));
             line(format!("sigma_a = {:?}", m.sigma_a));
             line(format!("g = {:?}", m.g));
@@ -205,11 +241,17 @@ impl<'b> RenderPredictor<'b> {
         t
     }
 
+    /// The scene [`RenderPredictor::elsewhere`] writes: [`RenderPredictor::toml_scene`] over the
+    /// stack `slices/` beside it.
+    fn toml_scene_of(&self, print: &VoxelPrint) -> String {
+        self.toml_scene(print, "slices")
+    }
+
     fn geometry(&self, print: &VoxelPrint) -> Geometry {
         Geometry {
             resolution: print.resolution(),
             voxel_size: print.voxel_size(),
-            materials: print.materials().iter().map(MaterialDesc::from).collect(),
+            materials: print.materials().to_vec(),
             boundary: self.boundary,
         }
     }
@@ -298,47 +340,51 @@ impl Predictor for RenderPredictor<'_> {
 
     fn predict(&mut self, print: &VoxelPrint) -> Result<Vec<LinearRgb>, PredictError> {
         let geometry = self.geometry(print);
-        match &mut self.scene {
-            Some((built, scene)) if *built == geometry => scene.set_indices(print.indices())?,
-            _ => {
-                let builder = PrintScene {
-                    print,
-                    geometry: geometry.clone(),
-                    spp: self.spp.max(1),
-                };
-                self.scene = Some((
-                    geometry.clone(),
-                    Scene::build(&builder, &RenderSettings::default())?,
-                ));
-            }
-        }
-        let (_, scene) = self.scene.as_ref().expect("built above");
         let [w, h, _] = geometry.resolution;
         // Two independent halves (spp / 2 and the rest), averaged by their sample counts.
         let halves = [self.spp / 2, self.spp - self.spp / 2];
-        let mut images = Vec::new();
         // Stopped already (Ctrl-C while the loop halftoned): no render to start.
         self.interrupted = self.observer.cancelled();
         if self.interrupted {
             self.standard_error.clear();
             return Ok(Vec::new());
         }
-        for (k, &n) in halves.iter().enumerate() {
-            if n == 0 {
-                continue;
+        let toml = matches!(self.renders, Renders::Files { .. }).then(|| self.toml_scene_of(print));
+        let rendered = match &mut self.renders {
+            Renders::Backend(backend) => {
+                match &mut self.scene {
+                    Some((built, scene)) if *built == geometry => {
+                        scene.set_indices(print.indices())?
+                    }
+                    _ => {
+                        let builder = PrintScene {
+                            print,
+                            geometry: geometry.clone(),
+                            spp: self.spp.max(1),
+                        };
+                        let scene = Scene::build(&builder, &RenderSettings::default())?;
+                        self.scene = Some((geometry.clone(), scene));
+                    }
+                }
+                let (_, scene) = self.scene.as_ref().expect("built above");
+                let observer = &*self.observer;
+                render_halves(halves, self.seed, |n, seed| {
+                    let mut film = scene.film();
+                    let request = RenderRequest::samples(0..n).with_seed(seed);
+                    let done = backend.render(scene, &mut film, request, observer)?;
+                    Ok((!done.cancelled(&(0..n))).then(|| film.image(n)))
+                })?
             }
-            let mut film = scene.film();
-            let request = RenderRequest::samples(0..n).with_seed(self.seed.wrapping_add(k as u32));
-            let rendered = self
-                .backend
-                .render(scene, &mut film, request, &*self.observer)?;
-            if rendered.cancelled(&(0..n)) {
-                self.interrupted = true;
-                self.standard_error.clear();
-                return Ok(Vec::new());
+            Renders::Files { dir, render } => {
+                let scene = write_scene(dir, print, toml.as_deref().unwrap_or_default())?;
+                render_halves(halves, self.seed, |n, seed| Ok(render(&scene, n, seed)))?
             }
-            images.push((f64::from(n), film.image(n)));
-        }
+        };
+        let Some(images) = rendered else {
+            self.interrupted = true;
+            self.standard_error.clear();
+            return Ok(Vec::new());
+        };
         let total: f64 = images.iter().map(|(n, _)| n).sum();
         let mut texels = Vec::with_capacity(w as usize * h as usize);
         let mut errors = Vec::with_capacity(texels.capacity());
@@ -380,14 +426,40 @@ impl Predictor for RenderPredictor<'_> {
     }
 }
 
-impl From<&Material> for MaterialDesc {
-    fn from(m: &Material) -> Self {
-        MaterialDesc {
-            name: m.name.clone(),
-            sigma_s: m.sigma_s,
-            sigma_a: m.sigma_a,
-            g: m.g,
-            colour: Some(m.colour),
+/// The two halves' images (`(samples, image)`, halves of no samples left out), each rendered by
+/// `render(n, seed)` with its own seed (`seed`, `seed + 1`); `None` if one stopped.
+fn render_halves(
+    halves: [u32; 2],
+    seed: u32,
+    mut render: impl FnMut(u32, u32) -> Result<Option<volpt::Image>, PredictError>,
+) -> Result<Option<Vec<(f64, volpt::Image)>>, PredictError> {
+    let mut images = Vec::new();
+    for (k, &n) in halves.iter().enumerate() {
+        if n == 0 {
+            continue;
+        }
+        match render(n, seed.wrapping_add(k as u32))? {
+            Some(image) => images.push((f64::from(n), image)),
+            None => return Ok(None),
         }
     }
+    Ok(Some(images))
+}
+
+/// Writes `print`'s scene `toml` into `dir` ([`ELSEWHERE_SCENE`] and `slices/`), replacing the
+/// last prediction's; returns the scene's path.
+fn write_scene(dir: &Path, print: &VoxelPrint, toml: &str) -> Result<PathBuf, PredictError> {
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| crate::PrintError::Io { path, source }
+    };
+    let slices = dir.join("slices");
+    match std::fs::remove_dir_all(&slices) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(io(&slices)(e).into()),
+        _ => {}
+    }
+    crate::slices::write_slices(print, &slices)?;
+    let scene = dir.join(ELSEWHERE_SCENE);
+    std::fs::write(&scene, toml).map_err(io(&scene))?;
+    Ok(scene)
 }

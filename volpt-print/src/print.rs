@@ -4,11 +4,11 @@
 //! printed first (`slice_0000.png`), and the top surface, seen from +z, is layer `depth - 1`.
 //! Surface texel `(x, y)` is the column of voxels `(x, y, *)`.
 
-use crate::material::Material;
+use volpt_scene::material::MaterialDesc;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct VoxelPrint {
-    materials: Vec<Material>,
+    materials: Vec<MaterialDesc>,
     /// Voxel size (x, y, layer height), in the units the materials' coefficients are per.
     voxel_size: [f64; 3],
     resolution: [u32; 3],
@@ -22,7 +22,7 @@ impl VoxelPrint {
     /// A print from its parts, checked: every index names a material, the grid has the
     /// resolution's voxel count, sizes are positive and finite, and palette colours are distinct.
     pub fn new(
-        materials: Vec<Material>,
+        materials: Vec<MaterialDesc>,
         voxel_size: [f64; 3],
         resolution: [u32; 3],
         indices: Vec<u8>,
@@ -63,7 +63,7 @@ impl VoxelPrint {
         })
     }
 
-    pub fn materials(&self) -> &[Material] {
+    pub fn materials(&self) -> &[MaterialDesc] {
         &self.materials
     }
 
@@ -94,8 +94,10 @@ impl VoxelPrint {
     }
 }
 
-/// Checks a material table: 1 to 256 materials (an index is a byte), palette colours distinct.
-pub fn check_table(materials: &[Material]) -> Result<(), Problem> {
+/// Checks a print's material table: 1 to 256 materials (an index is a byte: a print's inks are a
+/// handful), each with a palette colour, the colours distinct. Each material's numbers are
+/// volpt-scene's to check (its reader, and [`MaterialDesc::problem`] where a scene is built).
+pub fn check_table(materials: &[MaterialDesc]) -> Result<(), Problem> {
     if materials.is_empty() || materials.len() > usize::from(u8::MAX) + 1 {
         return Err((
             "materials",
@@ -104,13 +106,22 @@ pub fn check_table(materials: &[Material]) -> Result<(), Problem> {
         ));
     }
     for (k, m) in materials.iter().enumerate() {
+        if m.colour.is_none() {
+            return Err((
+                "materials.colour",
+                "a palette colour per material".into(),
+                format!("none for {}", m.name),
+            ));
+        }
         if let Some(j) = materials[..k].iter().position(|o| o.colour == m.colour) {
             return Err((
                 "materials.colour",
                 "a palette colour per material, each distinct".into(),
                 format!(
                     "{:?} for both {} and {}",
-                    m.colour, materials[j].name, m.name
+                    m.colour.unwrap_or_default(),
+                    materials[j].name,
+                    m.name
                 ),
             ));
         }

@@ -16,38 +16,42 @@
 //! ```
 //!
 //! Slice names have four digits, more where `layers` needs them. Within a slice, column `x` is voxel
-//! `x` and row `y` voxel `y`. Slices are 8-bit RGB; reading also takes RGBA (alpha ignored), grey
-//! and palette PNGs.
+//! `x` and row `y` voxel `y`. Slices are 8-bit RGB.
 //!
-//! Reading checks before it decodes a pixel: the numbering (no slice missing, none extra), every
-//! slice's size from its header, and the index grid and one slice's pixels against volpt's memory
-//! limit (`volpt_scene::limits`); it opens only regular files. A pixel whose colour names no
-//! material is an error naming the slice and pixel. The whole stack is read or none of it.
+//! The slices are read by volpt-scene's slice-stack reader ([`volpt_scene::slices`], the one a
+//! TOML scene's `format = "png"` volume uses: RGBA, grey and palette PNGs too; every slice's size
+//! against `materials.toml`'s from its header and one slice's pixels against the memory limit
+//! before a pixel is decoded, regular files only, a pixel whose colour names no material an
+//! error naming the slice and pixel). What is a print's own is checked here first: the table
+//! (`materials.toml`, its materials read by volpt-scene's `[[materials]]` reader), the index grid
+//! that `materials.toml` claims against the memory limit, and the numbering (no slice missing,
+//! none extra). The whole stack is read or none of it.
 
-use std::collections::HashMap;
 use std::fs::File;
-use std::io::{BufReader, BufWriter};
+use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
-use volpt_scene::limits::{bytes_of, check_memory, open_regular, read_text};
+use volpt_scene::limits::{bytes_of, check_memory, read_text};
+use volpt_scene::material::{MaterialDesc, MaterialSpec};
+use volpt_scene::slices::{SliceIndices, StackShape};
 
 use crate::error::PrintError;
-use crate::material::Material;
-use crate::print::{check_table, VoxelPrint};
+use crate::print::VoxelPrint;
 
 /// The name of a stack's material table, beside its slices.
 pub const MATERIALS_FILE: &str = "materials.toml";
 
-/// `materials.toml`.
+/// `materials.toml`, as written (its materials as volpt-scene writes a [`MaterialDesc`]) and as
+/// read (as volpt-scene reads `[[materials]]`).
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct Header {
+struct Header<M> {
     voxel_size: [f64; 3],
     width: u32,
     height: u32,
     layers: u32,
-    materials: Vec<Material>,
+    materials: Vec<M>,
 }
 
 /// The file name of slice `z` of a stack of `layers`: four digits, or as many as the last needs.
@@ -84,7 +88,12 @@ pub fn write_slices(print: &VoxelPrint, dir: &Path) -> Result<(), PrintError> {
     let toml_path = dir.join(MATERIALS_FILE);
     let text = toml::to_string(&header).expect("a material table serialises");
     std::fs::write(&toml_path, text).map_err(io(&toml_path))?;
-    let palette: Vec<[u8; 3]> = print.materials().iter().map(|m| m.colour).collect();
+    // A print's table has a colour for every material (`check_table`).
+    let palette: Vec<[u8; 3]> = print
+        .materials()
+        .iter()
+        .map(|m| m.colour.unwrap_or_default())
+        .collect();
     for z in 0..layers {
         let path = dir.join(slice_name(z, layers));
         let pixels: Vec<u8> = print
@@ -110,29 +119,24 @@ pub fn write_slices(print: &VoxelPrint, dir: &Path) -> Result<(), PrintError> {
 /// Reads the slice stack in `dir` (see the module docs).
 pub fn read_slices(dir: &Path) -> Result<VoxelPrint, PrintError> {
     let toml_path = dir.join(MATERIALS_FILE);
-    let header: Header = toml::from_str(&read_text(&toml_path)?).map_err(|e| PrintError::Toml {
-        path: toml_path.clone(),
-        source: Box::new(e),
-    })?;
+    let header: Header<MaterialSpec> =
+        toml::from_str(&read_text(&toml_path)?).map_err(|e| PrintError::Toml {
+            path: toml_path.clone(),
+            source: Box::new(e),
+        })?;
     let invalid = |field: &str, expected: &str, found: String| PrintError::Invalid {
         path: toml_path.clone(),
         field: field.into(),
         expected: expected.into(),
         found,
     };
-    for (k, m) in header.materials.iter().enumerate() {
-        if let Some((field, expected, found)) = m.problem() {
-            return Err(invalid(&format!("materials[{k}].{field}"), expected, found));
-        }
-    }
-    check_table(&header.materials)
-        .map_err(|(field, expected, found)| invalid(field, &expected, found))?;
+    let materials: Vec<MaterialDesc> = crate::material::read_table(&toml_path, &header.materials)?;
     let Header {
         voxel_size,
         width,
         height,
         layers,
-        materials,
+        ..
     } = header;
     if width == 0 || height == 0 || layers == 0 {
         return Err(invalid(
@@ -141,48 +145,22 @@ pub fn read_slices(dir: &Path) -> Result<VoxelPrint, PrintError> {
             format!("{width}, {height}, {layers}"),
         ));
     }
-    // Sizes before anything else is read: the grid and one slice's decoded pixels (at most 8
-    // bytes each, 16-bit RGBA) within the memory limit.
-    let voxels = bytes_of(u64::from(width) * u64::from(height), u64::from(layers));
+    // The grid materials.toml claims, before a slice is listed or opened.
     check_memory(
         dir,
         &format!("the index grid of {width} x {height} x {layers} voxels"),
-        voxels,
+        bytes_of(u64::from(width) * u64::from(height), u64::from(layers)),
     )?;
-    check_memory(
-        dir,
-        &format!("a slice of {width} x {height} pixels"),
-        bytes_of(u64::from(width) * u64::from(height), 8),
-    )?;
-    let files = numbered_slices(dir, layers)?;
-    for file in &files {
-        let found = header_size(file)?;
-        if found != [width, height] {
-            return Err(PrintError::SliceSize {
-                path: file.clone(),
-                expected: [width, height],
-                found,
-            });
-        }
-    }
-    let palette: HashMap<[u8; 3], u8> = materials
-        .iter()
-        .enumerate()
-        .map(|(k, m)| (m.colour, k as u8))
-        .collect();
-    let palette_text = materials
-        .iter()
-        .map(|m| {
-            let [r, g, b] = m.colour;
-            format!("#{r:02x}{g:02x}{b:02x} {}", m.name)
-        })
-        .collect::<Vec<_>>()
-        .join(", ");
-    let mut indices = Vec::with_capacity(voxels.unwrap_or(0) as usize);
-    for file in &files {
-        decode(file, &palette, &palette_text, &mut indices)?;
-    }
-    VoxelPrint::new(materials, voxel_size, [width, height, layers], indices)
+    check_numbering(dir, layers)?;
+    let shape = StackShape {
+        resolution: [width, height, layers],
+        source: "materials.toml's width, height and layers",
+    };
+    let (indices, resolution) = volpt_scene::slices::read_slices(dir, &materials, Some(shape))?;
+    let SliceIndices::Bytes(indices) = indices else {
+        unreachable!("a print's table has at most 256 materials (check_table): byte indices")
+    };
+    VoxelPrint::new(materials, voxel_size, resolution, indices)
         .map_err(|(field, expected, found)| invalid(field, &expected, found))
 }
 
@@ -212,9 +190,9 @@ fn slice_number(name: &str) -> Option<&str> {
     (!digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit())).then_some(digits)
 }
 
-/// The paths of slices `0 .. layers`, after checking the folder holds exactly those. Works from
-/// the names present (a folder's real files), never from `layers` alone, which a file may inflate.
-fn numbered_slices(dir: &Path, layers: u32) -> Result<Vec<PathBuf>, PrintError> {
+/// Checks the folder holds exactly slices `0 .. layers`. Works from the names present (a folder's
+/// real files), never from `layers` alone, which a file may inflate.
+fn check_numbering(dir: &Path, layers: u32) -> Result<(), PrintError> {
     let numbering = |found: String| PrintError::SliceNumbering {
         path: dir.to_path_buf(),
         expected: format!(
@@ -245,66 +223,6 @@ fn numbered_slices(dir: &Path, layers: u32) -> Result<Vec<PathBuf>, PrintError> 
         .find(|(z, n)| z != *n)
     {
         return Err(numbering(format!("no {}", slice_name(missing.0, layers))));
-    }
-    Ok(numbers
-        .iter()
-        .map(|&z| dir.join(slice_name(z, layers)))
-        .collect())
-}
-
-fn decoder(path: &Path) -> Result<png::Reader<BufReader<File>>, PrintError> {
-    let (file, _) = open_regular(path)?;
-    let mut decoder = png::Decoder::new(BufReader::new(file));
-    decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
-    decoder.read_info().map_err(|source| PrintError::Png {
-        path: path.to_path_buf(),
-        source,
-    })
-}
-
-/// A slice's width and height, from its header alone.
-fn header_size(path: &Path) -> Result<[u32; 2], PrintError> {
-    let reader = decoder(path)?;
-    Ok([reader.info().width, reader.info().height])
-}
-
-/// Appends a slice's material indices to `out`.
-fn decode(
-    path: &Path,
-    palette: &HashMap<[u8; 3], u8>,
-    palette_text: &str,
-    out: &mut Vec<u8>,
-) -> Result<(), PrintError> {
-    let mut reader = decoder(path)?;
-    let [w, h] = [reader.info().width, reader.info().height].map(|n| n as usize);
-    let mut buffer = vec![0; reader.output_buffer_size()];
-    let frame = reader
-        .next_frame(&mut buffer)
-        .map_err(|source| PrintError::Png {
-            path: path.to_path_buf(),
-            source,
-        })?;
-    // After EXPAND, palette images are RGB(A); grey stays grey.
-    let channels = frame.color_type.samples();
-    for y in 0..h {
-        let row = &buffer[y * frame.line_size..];
-        for x in 0..w {
-            let px = &row[x * channels..];
-            let colour = if channels >= 3 {
-                [px[0], px[1], px[2]]
-            } else {
-                [px[0]; 3]
-            };
-            let Some(&k) = palette.get(&colour) else {
-                return Err(PrintError::PaletteColour {
-                    path: path.to_path_buf(),
-                    pixel: [x as u32, y as u32],
-                    colour,
-                    palette: palette_text.into(),
-                });
-            };
-            out.push(k);
-        }
     }
     Ok(())
 }

@@ -11,12 +11,12 @@ use volpt::Backend;
 use volpt_print::compensate::{compensate, Options, Predictor, Setup};
 use volpt_print::halftone::Halftone;
 use volpt_print::predict::RenderPredictor;
-use volpt_print::{Inks, Material, VoxelPrint};
+use volpt_print::{Inks, MaterialDesc, VoxelPrint};
 
-fn absorber(name: &str, colour: [u8; 3], sigma_a: [f32; 3]) -> Material {
-    Material {
+fn absorber(name: &str, colour: [u8; 3], sigma_a: [f32; 3]) -> MaterialDesc {
+    MaterialDesc {
         name: name.into(),
-        colour,
+        colour: Some(colour),
         sigma_s: [0.0; 3],
         sigma_a,
         g: 0.0,
@@ -140,9 +140,9 @@ fn the_loop_runs_on_rendered_predictions_and_keeps_its_best() {
 #[test]
 fn compensation_lowers_the_error_of_rendered_predictions() {
     // Scattering inks of the order of the thesis's resins (per mm), a 1 mm slab.
-    let ink = |name: &str, colour: [u8; 3], sigma_s: f32, sigma_a: [f32; 3]| Material {
+    let ink = |name: &str, colour: [u8; 3], sigma_s: f32, sigma_a: [f32; 3]| MaterialDesc {
         name: name.into(),
-        colour,
+        colour: Some(colour),
         sigma_s: [sigma_s; 3],
         sigma_a,
         g: 0.0,
@@ -404,5 +404,111 @@ fn a_record_s_toml_scene_is_the_scene_the_predictor_renders() {
                 "row {r}: TOML {x:?}, predictor {y:?}"
             );
         }
+    }
+}
+
+/// A small print of the five inks and its setup, for the tests of where predictions render.
+fn small_job() -> (Setup, Vec<volpt_print::colour::LinearRgb>, [u32; 2]) {
+    let materials = common::inks();
+    let setup = Setup {
+        halftone: Halftone {
+            layers: 4,
+            depth: 6,
+            inks: Inks::find(&materials).unwrap(),
+            seed: 3,
+        },
+        materials,
+        voxel_size: [0.05, 0.05, 0.03],
+    };
+    let [w, h] = [6u32, 5];
+    let target = (0..w * h)
+        .map(|i| {
+            let v = [(40 * i) as u8, 200, (255 - 30 * (i % 7)) as u8];
+            volpt_print::colour::Srgb::from_u8(v).to_linear()
+        })
+        .collect();
+    (setup, target, [w, h])
+}
+
+fn means(c: &volpt_print::compensate::Compensation) -> Vec<f64> {
+    c.iterations.iter().map(|i| i.mean).collect()
+}
+
+#[test]
+fn several_devices_split_each_prediction_and_give_the_one_device_compensation() {
+    // The CPU as three devices pulling batches of samples from one queue, as several GPUs do
+    // (`--gpus`): each prediction's render is split between them and added in batch order.
+    let (setup, target, size) = small_job();
+    let options = Options {
+        max_iterations: 3,
+        noise_ratio: None,
+        ..Options::default()
+    };
+    let run = |backend: &Backend| {
+        let mut predictor = RenderPredictor::new(backend, 64);
+        compensate(&target, size, &setup, &options, &mut predictor, |_| {}).unwrap()
+    };
+    let one = run(&Backend::cpu());
+    let three = Backend::cpu_as_devices(3);
+    assert_eq!(three.devices(), 3);
+    let split = run(&three);
+    assert_eq!(means(&split).len(), means(&one).len());
+    for (a, b) in means(&split).iter().zip(means(&one)) {
+        assert!(
+            (a - b).abs() <= 1e-9 * b,
+            "{:?} vs {:?}",
+            means(&split),
+            means(&one)
+        );
+    }
+    assert_eq!(split.print, one.print);
+}
+
+#[test]
+fn predictions_rendered_elsewhere_from_their_scene_files_give_the_in_process_compensation() {
+    // What Python's Ray cluster does: each prediction's scene written as a TOML scene and its
+    // slice stack, loaded and rendered from the files with the seed it is given.
+    let (setup, target, size) = small_job();
+    let options = Options {
+        max_iterations: 3,
+        noise_ratio: None,
+        ..Options::default()
+    };
+    let backend = Backend::cpu();
+    let mut here = RenderPredictor::new(&backend, 64);
+    let local = compensate(&target, size, &setup, &options, &mut here, |_| {}).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let mut scenes = Vec::new();
+    let render = |path: &std::path::Path, n: u32, seed: u32| {
+        let scene = volpt::Scene::load(path, &volpt::RenderSettings::default()).unwrap();
+        let mut film = scene.film();
+        let request = volpt::RenderRequest::samples(0..n).with_seed(seed);
+        backend
+            .render(&scene, &mut film, request, &volpt::Quiet)
+            .unwrap();
+        scenes.push((path.to_path_buf(), seed));
+        Some(film.image(n))
+    };
+    let mut there = RenderPredictor::elsewhere(dir.path().join("renders"), Box::new(render), 64);
+    let remote = compensate(&target, size, &setup, &options, &mut there, |_| {}).unwrap();
+    drop(there);
+    // Two halves a prediction, seeds 0 and 1, each from the scene file.
+    assert_eq!(scenes.len(), 2 * remote.iterations.len());
+    assert!(scenes
+        .iter()
+        .all(|(p, _)| p.ends_with("renders/scene.toml")));
+    assert_eq!(
+        scenes.iter().map(|(_, s)| *s).collect::<Vec<_>>(),
+        [0, 1].repeat(remote.iterations.len())
+    );
+    // The scene files are the predictor's scene (a_record_s_toml_scene_is_the_scene_the_predictor
+    // _renders): the same paths, to the float rounding of the camera's transform.
+    for (a, b) in means(&remote).iter().zip(means(&local)) {
+        assert!(
+            (a - b).abs() <= 1e-3 * b,
+            "{:?} vs {:?}",
+            means(&remote),
+            means(&local)
+        );
     }
 }

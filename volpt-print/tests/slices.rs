@@ -7,17 +7,18 @@ use std::path::Path;
 
 use common::{inks, Rng};
 use volpt_print::slices::{read_slices, slice_name, write_slices, MATERIALS_FILE};
-use volpt_print::{Material, PrintError, VoxelPrint};
+use volpt_print::{MaterialDesc, PrintError, VoxelPrint};
+use volpt_scene::{MaterialProblem, SceneError};
 
 fn random_print(rng: &mut Rng) -> VoxelPrint {
     let count = 1 + rng.below(7) as usize;
-    let mut materials: Vec<Material> = Vec::new();
+    let mut materials: Vec<MaterialDesc> = Vec::new();
     while materials.len() < count {
         let colour = [0, 1, 2].map(|_| rng.below(256) as u8);
-        if materials.iter().all(|m| m.colour != colour) {
-            materials.push(Material {
+        if materials.iter().all(|m| m.colour != Some(colour)) {
+            materials.push(MaterialDesc {
                 name: format!("m{}", materials.len()),
-                colour,
+                colour: Some(colour),
                 sigma_s: [rng.unit() as f32 * 5.0; 3],
                 sigma_a: [0.5, 1.0, rng.unit() as f32],
                 g: 0.25,
@@ -83,7 +84,10 @@ fn a_colour_outside_the_palette_is_refused_naming_slice_and_pixel() {
     write_png(&slice, [5, 4], &rgb);
     let e = read_slices(dir.path()).unwrap_err();
     assert!(
-        matches!(&e, PrintError::PaletteColour { path, pixel: [2, 1], colour: [1, 2, 3], .. } if *path == slice),
+        matches!(&e, PrintError::Scene(SceneError::Material {
+            path,
+            problem: MaterialProblem::PaletteColour { slice: name, pixel: [2, 1], colour: [1, 2, 3], .. },
+        }) if *path == slice && name == "slice_0001.png"),
         "{e:?}"
     );
     let m = message(e);
@@ -102,14 +106,22 @@ fn a_slice_of_another_size_is_refused_before_any_pixel_is_decoded() {
     write_png(&slice, [6, 4], &[7u8; 6 * 4 * 3]);
     let e = read_slices(dir.path()).unwrap_err();
     assert!(
-        matches!(&e, PrintError::SliceSize { path, expected: [5, 4], found: [6, 4] } if *path == slice),
+        matches!(&e, PrintError::Scene(SceneError::Material {
+            problem: MaterialProblem::SliceSize { slice: name, expected: [5, 4], found: [6, 4], .. },
+            ..
+        }) if name == "slice_0002.png"),
         "{e:?}"
     );
-    assert!(message(e).contains("expected a slice of 5 x 4 pixels"));
+    assert!(message(e).contains("expected 5x4 pixels (materials.toml's width, height and layers)"));
+    // The first slice is held to materials.toml's size too, not to the others'.
+    let slice = dir.path().join("slice_0000.png");
     write_png(&slice, [5, 3], &[7u8; 5 * 3 * 3]);
     let e = read_slices(dir.path()).unwrap_err();
     assert!(
-        matches!(&e, PrintError::SliceSize { found: [5, 3], .. }),
+        matches!(&e, PrintError::Scene(SceneError::Material {
+            problem: MaterialProblem::SliceSize { slice: name, expected: [5, 4], found: [5, 3], .. },
+            ..
+        }) if name == "slice_0000.png"),
         "{e:?}"
     );
 }

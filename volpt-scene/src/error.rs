@@ -164,20 +164,27 @@ pub enum MaterialProblem {
     },
     /// The grid file holds something else than one channel of dense samples.
     NotAnIndexGrid { what: String },
-    /// A slice of another size than the first.
+    /// A slice of another size than the expected one (`source` says whose: the first slice's,
+    /// or the scene's resolution).
     SliceSize {
         slice: String,
         expected: [u32; 2],
         found: [u32; 2],
+        source: String,
     },
-    /// A slice whose pixel's colour names no material of the palette.
+    /// A slice whose pixel's colour names no material of the palette (`#rrggbb name, ...`).
     PaletteColour {
         slice: String,
         pixel: [u32; 2],
         colour: [u8; 3],
+        palette: String,
     },
-    /// A slice count other than the one the scene gives.
-    SliceCount { expected: u32, found: u32 },
+    /// A slice count other than the expected one (`source` says what expects it).
+    SliceCount {
+        expected: u32,
+        found: u32,
+        source: String,
+    },
     /// A slice volpt cannot decode (not an 8-bit RGB or RGBA PNG, or corrupt).
     Slice { slice: String, message: String },
 }
@@ -215,25 +222,28 @@ impl fmt::Display for MaterialProblem {
                 slice,
                 expected,
                 found,
+                source,
             } => write!(
                 f,
-                "slice {slice}: expected {}x{} pixels (the first slice's), found {}x{}",
+                "slice {slice}: expected {}x{} pixels ({source}), found {}x{}",
                 expected[0], expected[1], found[0], found[1]
             ),
             Self::PaletteColour {
                 slice,
                 pixel,
                 colour,
+                palette,
             } => write!(
                 f,
-                "slice {slice}, pixel {pixel:?}: expected a palette colour of [[materials]], found \
-                 #{:02x}{:02x}{:02x}",
+                "slice {slice}, pixel {pixel:?}: expected a palette colour of the materials \
+                 ({palette}), found #{:02x}{:02x}{:02x}",
                 colour[0], colour[1], colour[2]
             ),
-            Self::SliceCount { expected, found } => write!(
-                f,
-                "slices: expected {expected} (volume.resolution's z), found {found}"
-            ),
+            Self::SliceCount {
+                expected,
+                found,
+                source,
+            } => write!(f, "slices: expected {expected} ({source}), found {found}"),
             Self::Slice { slice, message } => write!(f, "slice {slice}: {message}"),
         }
     }

@@ -433,7 +433,7 @@ impl Colour {
 impl MaterialSpec {
     /// The material this entry describes; `invalid(field, expected, found)` makes the error of a
     /// field (`materials[k].field`).
-    pub(crate) fn material(
+    pub fn material(
         &self,
         invalid: &dyn Fn(&str, &str, String) -> SceneError,
     ) -> Result<MaterialDesc, SceneError> {

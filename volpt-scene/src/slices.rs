@@ -5,8 +5,9 @@
 //! `y` (the image's top row at the box's minimum y). 8-bit RGB, RGBA (alpha ignored), grey and
 //! palette PNGs are read; 16-bit ones are reduced to 8 bits.
 //!
-//! Every slice's header is read and checked (same size, the expected count) and the volume's size
-//! checked against the memory limit before any pixel is decoded.
+//! Every slice's header is read and checked (same size, the expected count, and the expected
+//! resolution where the caller knows one: [`StackShape`]) and the volume's size and one slice's
+//! decoded pixels checked against the memory limit before any pixel is decoded.
 
 use std::collections::HashMap;
 use std::io::BufReader;
@@ -17,14 +18,29 @@ use crate::limits::{bytes_of, check_memory, open_regular};
 use crate::material::{MaterialDesc, MaterialIndex};
 use volpt_core::material::wide_indices;
 
-/// The PNG files of a folder, in the natural order of their names (hidden files skipped).
+/// The PNG files of a folder, in the natural order of their names (hidden files skipped). A PNG
+/// name that is not a regular file (a folder, a device) is refused, not skipped: it is a layer.
 pub fn slice_files(dir: &Path) -> Result<Vec<PathBuf>, SceneError> {
-    let mut files = crate::dicom::folder_files(dir)?;
-    files.retain(|p| {
+    let png = |p: &Path| {
         p.extension()
             .and_then(|e| e.to_str())
             .is_some_and(|e| e.eq_ignore_ascii_case("png"))
-    });
+    };
+    let mut files = crate::dicom::folder_files(dir)?;
+    files.retain(|p| png(p));
+    let io = |error| SceneError::Io {
+        path: dir.to_path_buf(),
+        error,
+    };
+    for entry in std::fs::read_dir(dir).map_err(io)? {
+        let path = entry.map_err(io)?.path();
+        let hidden = path
+            .file_name()
+            .is_some_and(|n| n.to_string_lossy().starts_with('.'));
+        if png(&path) && !hidden && !path.is_file() {
+            open_regular(&path)?;
+        }
+    }
     Ok(files)
 }
 
@@ -36,18 +52,26 @@ pub enum SliceIndices {
     Wide(Vec<u16>),
 }
 
+/// The resolution a caller expects of a stack (width, height, slices), and what says so (named in
+/// the errors: `volume.resolution`, a print's `materials.toml`).
+#[derive(Clone, Copy, Debug)]
+pub struct StackShape<'a> {
+    pub resolution: [u32; 3],
+    pub source: &'a str,
+}
+
 /// The material indices of the slice stack in `dir` (bytes, or `u16`s for a table of more than
-/// 256 materials) and its resolution; `layers`, if given, is the slice count the scene expects.
+/// 256 materials) and its resolution; `expected`, if given, is the resolution the caller expects.
 pub fn read_slices(
     dir: &Path,
     materials: &[MaterialDesc],
-    layers: Option<u32>,
+    expected: Option<StackShape>,
 ) -> Result<(SliceIndices, [u32; 3]), SceneError> {
     Ok(if wide_indices(materials.len()) {
-        let (indices, res) = read_slices_as(dir, materials, layers)?;
+        let (indices, res) = read_slices_as(dir, materials, expected)?;
         (SliceIndices::Wide(indices), res)
     } else {
-        let (indices, res) = read_slices_as(dir, materials, layers)?;
+        let (indices, res) = read_slices_as(dir, materials, expected)?;
         (SliceIndices::Bytes(indices), res)
     })
 }
@@ -55,7 +79,7 @@ pub fn read_slices(
 fn read_slices_as<I: MaterialIndex>(
     dir: &Path,
     materials: &[MaterialDesc],
-    layers: Option<u32>,
+    expected: Option<StackShape>,
 ) -> Result<(Vec<I>, [u32; 3]), SceneError> {
     let error = |problem| SceneError::Material {
         path: dir.to_owned(),
@@ -64,10 +88,11 @@ fn read_slices_as<I: MaterialIndex>(
     let palette = palette(dir, materials)?;
     let files = slice_files(dir)?;
     let found = u32::try_from(files.len()).unwrap_or(u32::MAX);
-    if files.is_empty() || layers.is_some_and(|n| n != found) {
+    if files.is_empty() || expected.is_some_and(|e| e.resolution[2] != found) {
         return Err(error(MaterialProblem::SliceCount {
-            expected: layers.unwrap_or(1),
+            expected: expected.map_or(1, |e| e.resolution[2]),
             found,
+            source: expected.map_or_else(|| "at least one".into(), |e| e.source.into()),
         }));
     }
     let name = |p: &Path| {
@@ -75,31 +100,46 @@ fn read_slices_as<I: MaterialIndex>(
             .map_or_else(String::new, |n| n.to_string_lossy().into())
     };
     // Headers first: sizes agree and the volume fits before a pixel is decoded.
-    let mut size = None;
+    let mut size = expected.map(|e| ([e.resolution[0], e.resolution[1]], e.source.to_owned()));
     for file in &files {
         let (w, h) = header(file, &name(file))?;
-        match size {
-            None => size = Some([w, h]),
-            Some(s) if s != [w, h] => {
+        match &size {
+            None => size = Some(([w, h], "the first slice's".into())),
+            Some((s, source)) if *s != [w, h] => {
                 return Err(error(MaterialProblem::SliceSize {
                     slice: name(file),
-                    expected: s,
+                    expected: *s,
                     found: [w, h],
+                    source: source.clone(),
                 }))
             }
             Some(_) => {}
         }
     }
-    let [w, h] = size.expect("at least one slice");
+    let [w, h] = size.expect("at least one slice").0;
     let voxels = (w as u64) * (h as u64) * files.len() as u64;
     check_memory(
         dir,
         &format!("the index grid of {w} x {h} x {found} voxels"),
         bytes_of(voxels, std::mem::size_of::<I>() as u64),
     )?;
+    // A slice's decoded pixels: at most 8 bytes each (16-bit RGBA before reduction).
+    check_memory(
+        dir,
+        &format!("a slice of {w} x {h} pixels"),
+        bytes_of(w as u64 * h as u64, 8),
+    )?;
+    let palette_text = materials
+        .iter()
+        .filter_map(|m| {
+            let [r, g, b] = m.colour?;
+            Some(format!("#{r:02x}{g:02x}{b:02x} {}", m.name))
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
     let mut indices = Vec::with_capacity(voxels as usize);
     for file in &files {
-        decode(file, &name(file), &palette, &mut indices)?;
+        decode(file, &name(file), &palette, &palette_text, &mut indices)?;
     }
     Ok((indices, [w, h, found]))
 }
@@ -153,11 +193,12 @@ fn header(file: &Path, slice: &str) -> Result<(u32, u32), SceneError> {
     Ok((info.width, info.height))
 }
 
-/// Appends a slice's material indices to `out`.
+/// Appends a slice's material indices to `out`; `palette_text` lists the palette for errors.
 fn decode<I: MaterialIndex>(
     file: &Path,
     slice: &str,
     palette: &HashMap<[u8; 3], I>,
+    palette_text: &str,
     out: &mut Vec<I>,
 ) -> Result<(), SceneError> {
     let error = |problem| SceneError::Material {
@@ -202,6 +243,7 @@ fn decode<I: MaterialIndex>(
                         slice: slice.into(),
                         pixel: [x as u32, y as u32],
                         colour,
+                        palette: palette_text.into(),
                     }))
                 }
             }

@@ -558,17 +558,11 @@ fn assemble_indexed(
         });
     let indexed = if slices {
         use crate::slices::SliceIndices;
-        let (indices, resolution) =
-            crate::slices::read_slices(volume_path, &materials, v.resolution.map(|r| r[2]))?;
-        if let Some(r) = v.resolution {
-            if r != resolution {
-                return Err(cx.invalid(
-                    "volume.resolution",
-                    "the slices' width, height and count",
-                    format!("{r:?} for slices of {resolution:?}"),
-                ));
-            }
-        }
+        let expected = v.resolution.map(|resolution| crate::slices::StackShape {
+            resolution,
+            source: "volume.resolution",
+        });
+        let (indices, resolution) = crate::slices::read_slices(volume_path, &materials, expected)?;
         let bounds = match (v.bounds, v.voxel_size) {
             (Some(b), None) => checked_box(cx, "volume.bounds", b)?,
             (None, Some(size)) => {

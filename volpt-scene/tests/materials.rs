@@ -404,7 +404,8 @@ fn slices_of_another_size_a_stray_colour_or_a_missing_slice_are_refused() {
             SceneError::Material {
                 problem: MaterialProblem::SliceCount {
                     expected: 3,
-                    found: 2
+                    found: 2,
+                    ..
                 },
                 ..
             }

@@ -874,7 +874,8 @@ impl SceneVisitor for Render<'_> {
         if let (Some(deadline), Inner::Cuda { renderers, .. }, Some(schedule)) =
             (deadline, &backend.0, schedule)
         {
-            // SAFETY: as the chunks' renders below.
+            // SAFETY: as the chunks' renders below; the fingerprint names the scene as rendered,
+            // its camera and film included.
             let progress = unsafe {
                 renderers[0].render_samples_until(
                     scene,
@@ -883,6 +884,7 @@ impl SceneVisitor for Render<'_> {
                     samples.clone(),
                     &options,
                     grids,
+                    fingerprint(),
                     deadline,
                 )
             }?;

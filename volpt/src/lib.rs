@@ -21,6 +21,8 @@
 //! - `backend`: [`Backend`], the CPU or a GPU with its strategy (or `auto`), math and memory
 //!   placement, opened once and reused; [`Backend::render`] adds a request's samples to a
 //!   [`Film`].
+//! - `preferred`: the backend of a caller who names none where a GPU is the better default (a
+//!   GPU where one is usable, else the CPU, and why: [`Backend::open_preferred`]).
 //! - `request`: [`RenderRequest`], one render's samples, seed, path settings and lookup over
 //!   the scene's: renders only read the scene, so threads share one.
 //! - `observer`: what a render tells its caller while it runs (progress, notes) and how the
@@ -60,6 +62,7 @@ pub mod metrics;
 mod multi;
 pub mod names;
 mod observer;
+mod preferred;
 mod request;
 mod scene;
 mod settings;
@@ -76,6 +79,7 @@ pub use image::read_exr;
 pub use info::Info;
 pub use names::Named;
 pub use observer::{Observer, Quiet};
+pub use preferred::{preferred_kind, GpuProbe, Preferred};
 pub use request::RenderRequest;
 pub use scene::{ParamValue, Scene, PARAMS};
 pub use settings::{check_majorant_resolution, RenderSettings, Tracking, MAJORANT_RESOLUTION};

@@ -95,7 +95,7 @@ scene_args() { # name -> file and -D parameters
         chromatic-slab) echo "bundle/scenes/chromatic/slab.xml" ;;
         sun-slab) echo "bundle/scenes/lights/sun-slab.xml" ;;
         spot-fog) echo "bundle/scenes/lights/spot-fog.xml" ;;
-        spot-fog-chromatic) echo "bundle/scenes/lights/spot-fog.xml -D sigma_t=1,2,4" ;;
+        spot-fog-chromatic) echo "bundle/scenes/lights/spot-fog.xml -D sigma_t=0.25,0.5,1" ;;
         *) echo "" ;;
     esac
 }

@@ -4,14 +4,14 @@
 
 use volpt_print::colour::{LinearRgb, Srgb};
 use volpt_print::compensate::Predictor;
-use volpt_print::{Material, VoxelPrint};
+use volpt_print::{MaterialDesc, VoxelPrint};
 
 /// The five-tone process's inks, palette colours as a slice stack names them. The coefficients
 /// are of the order of the thesis's resins (per mm); these tests do not depend on them.
-pub fn inks() -> Vec<Material> {
-    let ink = |name: &str, colour: [u8; 3], sigma_a: [f32; 3]| Material {
+pub fn inks() -> Vec<MaterialDesc> {
+    let ink = |name: &str, colour: [u8; 3], sigma_a: [f32; 3]| MaterialDesc {
         name: name.into(),
-        colour,
+        colour: Some(colour),
         sigma_s: [10.0; 3],
         sigma_a,
         g: 0.0,
@@ -68,7 +68,11 @@ impl Predictor for BlurModel {
         let colours: Vec<[f64; 3]> = print
             .materials()
             .iter()
-            .map(|m| Srgb::from_u8(m.colour).to_linear().0)
+            .map(|m| {
+                Srgb::from_u8(m.colour.expect("a palette colour"))
+                    .to_linear()
+                    .0
+            })
             .collect();
         let weights: Vec<f64> = (0..d).map(|k| self.rho.powi(k as i32)).collect();
         let total: f64 = weights.iter().sum();
