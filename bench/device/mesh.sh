@@ -1,19 +1,31 @@
 #!/usr/bin/env bash
 # Mesh boundaries (issue 39) on the device host, with the stripped `volpt` binary only (no cargo).
-# The GPU kernels trace box boundaries (a mesh scene renders on the CPU); what this checks:
+# What this checks:
 #   1. `volpt info` describes a mesh boundary (shape line);
-#   2. the GPU refuses a mesh scene with the message that says to render it on the CPU;
+#   2. whether the GPU takes a mesh scene. Main's kernels trace boxes and refuse it with the message
+#      that says to render it on the CPU ("OK refused"); a binary whose kernels take
+#      `volpt_core::DeviceBoundary` (docs/gpu.md, "Mesh boundaries") renders it, and then 6-9 run;
 #   3. CPU, 16 cores: scenes/mesh-cube (homogeneous-cube's box as a 24-triangle mesh) renders
 #      homogeneous-cube's image bit for bit, and its segments per second against the box's (the
-#      distance grid's work: issue target >= 0.8x);
-#      The same for cgg-logo (its box written as the same mesh, scenes/cgg-logo/mesh.xml);
+#      distance grid's work: issue target >= 0.8x); the same for cgg-logo (its box written as the
+#      same mesh, scenes/cgg-logo/mesh.xml);
 #   4. CPU: the sphere mesh scene (Mitsuba `sphere`, 16,128 triangles) renders, and its speed;
-#   5. GPU: homogeneous-cube still renders on the GPU bit for bit as on the CPU (naive-sk, exact
-#      math): the box kernels after the BoundaryShape / FlightEnd changes.
+#   5. GPU: homogeneous-cube renders on the GPU bit for bit as on the CPU (naive-sk, exact math):
+#      the box kernels after the ABI change (SceneParams carries a mesh block);
+#   only where the GPU takes meshes:
+#   6. GPU naive-sk exact = CPU, bit for bit: mesh-cube (and = the box's image), the sphere, a
+#      torus (non-convex: generated here as torus.obj, 4,608 triangles) with next-event estimation
+#      through an index-matched boundary (shadow rays cross two chords);
+#   7. every strategy (fast math, another seed) against the CPU's torus: `volpt compare --independent`;
+#   8. the analytic absorber on the GPU: albedo 0, index-matched sphere, GPU exact = CPU bit for bit
+#      (the CPU's image is exp(-sigma_t chord) by `cargo test -p volpt-core --test mesh`);
+#   9. GPU speed: homogeneous-cube box vs mesh-cube, cgg-logo box vs mesh (segments/s, regeneration-sk).
 # Run from a bundle (bin/volpt beside scenes/) or a checkout with VOLPT=target/release/volpt:
 #   bash bench/device/mesh.sh            -> $OUT/mesh.txt
-# Expected (about 40 s): "shape      closed triangle mesh from ...box.obj: 24 triangles",
-# "OK refused", "identical" three times, two mesh/box ratio lines, "sphere ... M segments/s".
+# Expected on main (about 40 s): the shape line with 24 triangles, "OK refused", "identical" three
+# times (box vs mesh CPU twice, box CPU vs GPU once), two CPU mesh/box ratio lines (~0.6), the
+# sphere's segments/s. With mesh kernels (about 90 s): "GPU takes meshes", then "identical" for
+# each GPU check of 6 and 8, "OK" per strategy in 7, and two GPU mesh/box ratio lines.
 set -uo pipefail
 cd "$(dirname "$0")"
 [ -d scenes ] || cd ../..
@@ -29,9 +41,11 @@ log "# $(date -u +%Y-%m-%dT%H:%MZ) $(nvidia-smi --query-gpu=name --format=csv,no
 # 1. info
 "$VOLPT" info scenes/mesh-cube/scene.xml 2>&1 | grep -E "^(shape|bounds|variant)" | tee -a "$OUT/mesh.txt"
 
-# 2. the GPU refuses a mesh
-if "$VOLPT" render scenes/mesh-cube/scene.xml --backend cuda --spp 1 -o "$OUT/refused.exr" >"$OUT/refused.log" 2>&1; then
-    log "FAIL the GPU rendered a mesh scene"
+# 2. does the GPU take a mesh? (main: no, it refuses with the CPU message)
+gpu_meshes=0
+if "$VOLPT" render scenes/mesh-cube/scene.xml --backend cuda --spp 1 --resolution 16x16 -o "$OUT/probe.exr" >"$OUT/refused.log" 2>&1; then
+    gpu_meshes=1
+    log "GPU takes meshes"
 elif grep -q "trace box boundaries only" "$OUT/refused.log"; then
     log "OK refused: $(grep -o 'the GPU kernels trace box boundaries only[^)]*)' "$OUT/refused.log" | head -n 1)"
 else
@@ -78,10 +92,80 @@ log "cgg-logo CPU segments/s: box ${box:-?} M, mesh ${mesh:-?} M, ratio $(python
 log "sphere (16,128 triangles) on the CPU: $(seg "$OUT/sphere.log") M segments/s"
 
 # 5. the box kernels: GPU naive-sk exact = CPU, bit for bit
-"$VOLPT" render scenes/homogeneous-cube/scene.xml --backend cuda --strategy naive-sk --math exact \
-    --spp "$SPP" --resolution "${RES}x${RES}" --seed 1 -o "$OUT/box-gpu.exr" >"$OUT/box-gpu.log" 2>&1 || log "FAIL box GPU render"
-if "$VOLPT" compare "$OUT/box.exr" "$OUT/box-gpu.exr" --identical >"$OUT/compare-gpu.log" 2>&1; then
-    log "box CPU vs GPU naive-sk exact: identical"
-else
-    log "FAIL box CPU vs GPU: $(tail -n 2 "$OUT/compare-gpu.log")"
-fi
+gpu_exact=(--backend cuda --strategy naive-sk --math exact --spp "$SPP" --resolution "${RES}x${RES}" --seed 1)
+"$VOLPT" render scenes/homogeneous-cube/scene.xml "${gpu_exact[@]}" -o "$OUT/box-gpu.exr" >"$OUT/box-gpu.log" 2>&1 || log "FAIL box GPU render"
+same() { # same NAME A.exr B.exr: bit-identical images
+    if "$VOLPT" compare "$2" "$3" --identical >"$OUT/compare-$1.log" 2>&1; then
+        log "$1: identical"
+    else
+        log "FAIL $1: $(tail -n 2 "$OUT/compare-$1.log")"
+    fi
+}
+same "box CPU vs GPU naive-sk exact" "$OUT/box.exr" "$OUT/box-gpu.exr"
+
+[ "$gpu_meshes" = 1 ] || exit 0
+
+# 6. GPU naive-sk exact = CPU on meshes
+"$VOLPT" render scenes/mesh-cube/scene.xml "${gpu_exact[@]}" -o "$OUT/mesh-gpu.exr" >"$OUT/mesh-gpu.log" 2>&1 || log "FAIL mesh-cube GPU render"
+same "mesh-cube GPU vs box CPU" "$OUT/box.exr" "$OUT/mesh-gpu.exr"
+"$VOLPT" render scenes/mesh-sphere/scene.xml "${gpu_exact[@]}" -o "$OUT/sphere-gpu.exr" >"$OUT/sphere-gpu.log" 2>&1 || log "FAIL sphere GPU render"
+same "sphere CPU vs GPU naive-sk exact" "$OUT/sphere.exr" "$OUT/sphere-gpu.exr"
+# A torus (major radius 0.35, minor 0.15, 48 x 48 quads), counter-clockwise seen from outside,
+# in the sphere scene's place; index-matched with next-event estimation (volpath's default).
+python3 - <<'PY'
+import math, re
+R, r, n, m = 0.35, 0.15, 48, 48
+lines = []
+for i in range(n):
+    u = 2 * math.pi * i / n
+    for j in range(m):
+        v = 2 * math.pi * j / m
+        x = (R + r * math.cos(v)) * math.cos(u)
+        y = (R + r * math.cos(v)) * math.sin(u)
+        lines.append(f"v {x:.9f} {y:.9f} {r * math.sin(v):.9f}")
+k = lambda i, j: (i % n) * m + (j % m) + 1
+for i in range(n):
+    for j in range(m):
+        a, b, c, d = k(i, j), k(i + 1, j), k(i + 1, j + 1), k(i, j + 1)
+        lines += [f"f {a} {b} {c}", f"f {a} {c} {d}"]
+open("scenes/mesh-sphere/torus.obj", "w").write("\n".join(lines) + "\n")
+s = open("scenes/mesh-sphere/scene.xml").read()
+s, count = re.subn(r'<shape type="sphere">\s*<float name="radius" value="0.5"/>',
+                   '<shape type="obj"><string name="filename" value="torus.obj"/>'
+                   '<transform name="to_world"><rotate x="1" angle="60"/></transform>', s)
+assert count == 1, "mesh-sphere's shape is not the sphere this script expects"
+open("scenes/mesh-sphere/torus.xml", "w").write(s)
+PY
+torus=(scenes/mesh-sphere/torus.xml -D boundary=null -D sigma_t=3)
+"$VOLPT" render "${torus[@]}" "${common[@]}" -o "$OUT/torus.exr" >"$OUT/torus.log" 2>&1 || log "FAIL torus CPU render"
+"$VOLPT" render "${torus[@]}" "${gpu_exact[@]}" -o "$OUT/torus-gpu.exr" >"$OUT/torus-gpu.log" 2>&1 || log "FAIL torus GPU render"
+same "torus CPU vs GPU naive-sk exact" "$OUT/torus.exr" "$OUT/torus-gpu.exr"
+
+# 7. every strategy, fast math, against the CPU (statistically)
+for s in naive-sk regeneration-sk regeneration-warp-sk regeneration-block-sk regeneration-2p-sk \
+         streaming-sk streaming-sorted-sk sorting-sk naive-mk streaming-mk; do
+    "$VOLPT" render "${torus[@]}" --backend cuda --strategy "$s" --spp "$SPP" --resolution "${RES}x${RES}" --seed 2 \
+        -o "$OUT/torus-$s.exr" >"$OUT/torus-$s.log" 2>&1 || { log "FAIL torus $s render"; continue; }
+    if "$VOLPT" compare "$OUT/torus.exr" "$OUT/torus-$s.exr" --independent >"$OUT/compare-torus-$s.log" 2>&1; then
+        log "OK torus $s within the statistical test"
+    else
+        log "FAIL torus $s: $(tail -n 2 "$OUT/compare-torus-$s.log")"
+    fi
+done
+
+# 8. the analytic absorber (albedo 0, index-matched sphere mesh): GPU = CPU bit for bit
+absorber=(scenes/mesh-sphere/scene.xml -D boundary=null -D albedo=0 -D sigma_t=2)
+"$VOLPT" render "${absorber[@]}" "${common[@]}" -o "$OUT/absorber.exr" >"$OUT/absorber.log" 2>&1 || log "FAIL absorber CPU render"
+"$VOLPT" render "${absorber[@]}" "${gpu_exact[@]}" -o "$OUT/absorber-gpu.exr" >"$OUT/absorber-gpu.log" 2>&1 || log "FAIL absorber GPU render"
+same "absorber sphere CPU vs GPU naive-sk exact" "$OUT/absorber.exr" "$OUT/absorber-gpu.exr"
+
+# 9. GPU speed: box against mesh (regeneration-sk, fast math, 64 spp)
+gpu_speed=(--backend cuda --strategy regeneration-sk --spp 64 --resolution 400x400 --seed 1)
+for pair in "homogeneous-cube/scene.xml mesh-cube/scene.xml" "cgg-logo/scene.xml cgg-logo/mesh.xml"; do
+    set -- $pair
+    "$VOLPT" render "scenes/$1" "${gpu_speed[@]}" -o "$OUT/speed-box.exr" >"$OUT/speed-box.log" 2>&1 || log "FAIL $1 GPU speed render"
+    "$VOLPT" render "scenes/$2" "${gpu_speed[@]}" -o "$OUT/speed-mesh.exr" >"$OUT/speed-mesh.log" 2>&1 || log "FAIL $2 GPU speed render"
+    box=$(seg "$OUT/speed-box.log")
+    mesh=$(seg "$OUT/speed-mesh.log")
+    log "GPU segments/s $1 ${box:-?} M vs $2 ${mesh:-?} M, ratio $(python3 -c "print(f'{float(\"${mesh:-0}\")/float(\"${box:-1}\"):.3f}')" 2>/dev/null)"
+done

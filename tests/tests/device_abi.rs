@@ -10,7 +10,8 @@ use std::collections::BTreeSet;
 
 use volpt_core::abi::{PlacedGrid, Uploader};
 use volpt_core::{
-    AnyLayout, Component, GridLayout, GridPlacement, GridReads, HomogeneousMedium, TexelFormat,
+    AnyLayout, Component, GridLayout, GridPlacement, GridReads, HomogeneousMedium, SceneAbi,
+    TexelFormat,
 };
 use volpt_render::{render, with_scene, Image, RenderOptions, RenderScene, SceneVisitor, Variant};
 use volpt_scene::description::*;
@@ -86,13 +87,15 @@ impl Uploader for HostUploader {
     }
 }
 
-/// Renders the scene, and the scene rebuilt from its launch parameters with grids in `layout`.
+/// Renders the scene, the scene rebuilt from its launch parameters with grids in `layout`, and
+/// the scene a mesh-capable kernel rebuilds from them (`SceneAbi::Kernel`: its boundary a
+/// `DeviceBoundary`).
 struct RoundTrip {
     layout: GridLayout,
 }
 
 impl SceneVisitor for RoundTrip {
-    type Output = (Image, Image);
+    type Output = (Image, Image, Image);
 
     fn visit<S: RenderScene>(self, scene: &S) -> Self::Output {
         let mut uploader = HostUploader {
@@ -103,6 +106,8 @@ impl SceneVisitor for RoundTrip {
         // SAFETY: every address is a slice of the description or of `uploader`, alive for this
         // whole visit.
         let rebuilt = unsafe { S::from_params(&params) };
+        // SAFETY: as above.
+        let kernel = unsafe { <S::Kernel as SceneAbi>::from_params(&params) };
         let options = RenderOptions {
             spp: 4,
             seed: 11,
@@ -110,7 +115,8 @@ impl SceneVisitor for RoundTrip {
         };
         let original = render(scene, &options, &|_, _| {}).expect("render");
         let decoded = render(&rebuilt, &options, &|_, _| {}).expect("render");
-        (original.0, decoded.0)
+        let kernels = render(&kernel, &options, &|_, _| {}).expect("render");
+        (original.0, decoded.0, kernels.0)
     }
 }
 
@@ -194,7 +200,8 @@ fn check_round_trips(descs: Vec<SceneDescription>, expected: BTreeSet<String>, l
     );
     for desc in &descs {
         let trip = RoundTrip { layout };
-        let (original, decoded) = with_scene(desc, volpt_render::path_settings(desc), trip);
+        let (original, decoded, kernels) =
+            with_scene(desc, volpt_render::path_settings(desc), trip);
         assert!(
             original.pixels.iter().flatten().any(|&v| v > 0.0),
             "{}: a black image proves nothing",
@@ -205,6 +212,11 @@ fn check_round_trips(descs: Vec<SceneDescription>, expected: BTreeSet<String>, l
             .filter(|(a, b)| a != b)
             .count();
         assert_eq!(differing, 0, "{}: pixels that differ", Variant::of(desc));
+        assert!(
+            kernels.pixels == original.pixels,
+            "{}: the kernels' scene type renders another image",
+            Variant::of(desc)
+        );
     }
 }
 
@@ -255,16 +267,16 @@ fn a_new_instantiation_needs_only_its_registry_line() {
         environment: volpt_core::ConstantEnvironment(rgb.into()),
         lights: volpt_core::Lights::NONE,
     };
-    let (new, decoded) = RoundTrip {
+    let (new, decoded, kernel) = RoundTrip {
         layout: GridLayout::Bricked,
     }
     .visit(&scene);
     assert!(new.pixels.iter().flatten().any(|&v| v > 0.0));
     assert!(
-        new.pixels == decoded.pixels,
+        new.pixels == decoded.pixels && new.pixels == kernel.pixels,
         "the device ABI changed the image"
     );
-    let (registry, _) = with_scene(
+    let (registry, _, _) = with_scene(
         &desc,
         volpt_render::path_settings(&desc),
         RoundTrip {

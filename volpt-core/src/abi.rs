@@ -21,11 +21,15 @@ pub mod name;
 use bytemuck::{Pod, Zeroable};
 
 use crate::camera::PerspectiveCamera;
+use crate::geometry::Aabb;
 use crate::grid::{Grid, GridLayout, GridLookup, GridMapping, GridPlacement, TexelFormat};
 use crate::light::{Lights, LightsParams};
+use crate::mesh::{BvhNode, MeshTriangle, SurfaceDistance, TriangleMesh};
 use crate::path::{Estimator, PathSettings, Roulette};
 use crate::scene::{Scene, VolumeScene};
-use crate::{Aabb, Vec2, Vec3};
+use crate::shape::{BoundaryShape, DeviceBoundary, Shape};
+use crate::{Bsdf, Environment, Medium, PhaseFunction};
+use crate::{Vec2, Vec3};
 
 /// Places grid or map values in memory a device can read and returns their device address; the
 /// caller keeps that memory alive for as long as the parameters are used. Any
@@ -338,6 +342,8 @@ pub struct SceneParams<M, B, P, E> {
     pub bounds_min: [f32; 3],
     pub bounds_max: [f32; 3],
     pub settings: SettingsParams,
+    /// The boundary's BVH if it is a mesh (its box is `bounds_min`, `bounds_max`).
+    pub mesh: MeshParams,
     pub lights: LightsParams,
     pub medium: M,
     pub boundary: B,
@@ -352,6 +358,7 @@ impl<M: Pod, B: Pod, P: Pod, E: Pod> SceneParams<M, B, P, E> {
         let fixed = core::mem::size_of::<CameraParams>()
             + 24
             + core::mem::size_of::<SettingsParams>()
+            + core::mem::size_of::<MeshParams>()
             + core::mem::size_of::<LightsParams>();
         let parts = [
             core::mem::size_of::<M>(),
@@ -393,9 +400,15 @@ pub trait SceneAbi: Scene + Sized {
     fn names() -> [&'static str; 4];
     fn to_params(&self, upload: &mut Upload<'_>) -> Self::Params;
 
-    /// Whether the kernels can render this scene: not one whose boundary is a mesh, which its
-    /// parameters would carry as its bounding box.
+    /// Whether the kernels can render this scene: not one whose boundary is a mesh. The
+    /// parameters carry a mesh's BVH, but the kernels rebuild every scene as a box scene
+    /// (`volpt_device::launch::Scene`): a kernel that takes [`SceneAbi::Kernel`] instead traces
+    /// meshes too, at the price of registers in every box kernel (docs/gpu.md, meshes).
     fn on_device(&self) -> bool;
+
+    /// This scene rebuilt from its parameters with its boundary a [`DeviceBoundary`], the shape a
+    /// kernel traces a box or a mesh as (the CPU renders it too, to check that code).
+    type Kernel: Scene + SceneAbi<Params = Self::Params>;
 
     /// The device side of [`SceneAbi::to_params`].
     ///
@@ -404,20 +417,39 @@ pub trait SceneAbi: Scene + Sized {
     unsafe fn from_params(p: &Self::Params) -> Self;
 }
 
-/// A boundary shape as the kernels receive it: today every kernel's scene is a box scene
-/// (`SceneParams::bounds_min`/`bounds_max`), so a shape travels as its box, and only a box
-/// shape can ([`DeviceShape::on_device`]).
+/// A mesh boundary's BVH in device memory: `node_count` [`BvhNode`]s at `nodes` and
+/// `triangle_count` [`MeshTriangle`]s at `triangles`; all 0 for a box.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct MeshParams {
+    pub nodes: u64,
+    pub triangles: u64,
+    pub node_count: u32,
+    pub triangle_count: u32,
+}
+
+/// A boundary shape as it travels to the kernels: its box ([`SceneParams::bounds_min`] and
+/// `bounds_max`) and, for a mesh, its BVH ([`MeshParams`]). A box scene's kernel rebuilds the
+/// box; a [`DeviceBoundary`] ([`DeviceShape::Kernel`]) rebuilds either, chosen at run time.
 pub trait DeviceShape: Sized {
-    /// Whether the kernels trace this shape: a mesh is not (yet) a kernel's boundary.
+    /// The shape a mesh-capable kernel rebuilds from this one's parameters.
+    type Kernel: DeviceShape + Shape;
+    /// Whether the kernels (box scenes) trace this shape: not a mesh.
     fn on_device(&self) -> bool;
-    /// The box the kernels receive.
+    /// The box: a mesh's bounding box.
     fn device_box(&self) -> Aabb;
-    /// The shape a kernel rebuilds from its box.
-    fn from_device_box(b: Aabb) -> Self;
+    /// Places a mesh's BVH with `upload`; a box has none.
+    fn mesh_params(&self, upload: &mut Upload<'_>) -> MeshParams;
+    /// The device side: the shape of box `bounds` and BVH `mesh`.
+    ///
+    /// # Safety
+    /// `mesh`'s addresses must point to its counts of nodes and triangles that
+    /// [`DeviceShape::mesh_params`] uploaded, valid and unchanged for the shape's lifetime.
+    unsafe fn from_device(bounds: Aabb, mesh: &MeshParams) -> Self;
 }
 
 impl DeviceShape for Aabb {
-    #[inline(always)]
+    type Kernel = DeviceBoundary<'static>;
     fn on_device(&self) -> bool {
         true
     }
@@ -425,38 +457,123 @@ impl DeviceShape for Aabb {
     fn device_box(&self) -> Aabb {
         *self
     }
+    fn mesh_params(&self, _: &mut Upload<'_>) -> MeshParams {
+        MeshParams::default()
+    }
     #[inline(always)]
-    fn from_device_box(b: Aabb) -> Self {
-        b
+    unsafe fn from_device(bounds: Aabb, _: &MeshParams) -> Self {
+        bounds
     }
 }
 
-impl DeviceShape for crate::shape::BoundaryShape<'_> {
+/// A mesh's slices as [`MeshParams`].
+fn upload_mesh(
+    nodes: &[BvhNode],
+    triangles: &[MeshTriangle],
+    upload: &mut Upload<'_>,
+) -> MeshParams {
+    if nodes.is_empty() {
+        return MeshParams::default();
+    }
+    MeshParams {
+        nodes: upload.values(bytemuck::cast_slice(nodes)),
+        triangles: upload.values(bytemuck::cast_slice(triangles)),
+        node_count: nodes.len() as u32,
+        triangle_count: triangles.len() as u32,
+    }
+}
+
+/// The slices [`upload_mesh`] placed; empty for a box.
+///
+/// # Safety
+/// As [`DeviceShape::from_device`].
+#[inline(always)]
+unsafe fn mesh_slices<'a>(mesh: &MeshParams) -> (&'a [BvhNode], &'a [MeshTriangle]) {
+    if mesh.node_count == 0 {
+        return (&[], &[]);
+    }
+    // SAFETY: the caller guarantees the address ranges.
+    unsafe {
+        (
+            core::slice::from_raw_parts(mesh.nodes as *const BvhNode, mesh.node_count as usize),
+            core::slice::from_raw_parts(
+                mesh.triangles as *const MeshTriangle,
+                mesh.triangle_count as usize,
+            ),
+        )
+    }
+}
+
+impl<'a> DeviceShape for DeviceBoundary<'a> {
+    type Kernel = Self;
     fn on_device(&self) -> bool {
-        matches!(self, crate::shape::BoundaryShape::Box(_))
+        self.nodes.is_empty()
+    }
+    #[inline(always)]
+    fn device_box(&self) -> Aabb {
+        self.bounds
+    }
+    fn mesh_params(&self, upload: &mut Upload<'_>) -> MeshParams {
+        upload_mesh(self.nodes, self.triangles, upload)
+    }
+    #[inline(always)]
+    unsafe fn from_device(bounds: Aabb, mesh: &MeshParams) -> Self {
+        // SAFETY: forwarded to the caller.
+        let (nodes, triangles) = unsafe { mesh_slices(mesh) };
+        Self {
+            bounds,
+            nodes,
+            triangles,
+        }
+    }
+}
+
+impl<'a> DeviceShape for BoundaryShape<'a> {
+    type Kernel = DeviceBoundary<'a>;
+    fn on_device(&self) -> bool {
+        matches!(self, BoundaryShape::Box(_))
     }
     fn device_box(&self) -> Aabb {
-        crate::shape::Shape::bounds(self)
+        Shape::bounds(self)
     }
-    fn from_device_box(b: Aabb) -> Self {
-        crate::shape::BoundaryShape::Box(b)
+    fn mesh_params(&self, upload: &mut Upload<'_>) -> MeshParams {
+        match self {
+            BoundaryShape::Box(_) => MeshParams::default(),
+            BoundaryShape::Mesh(m) => upload_mesh(m.nodes, m.triangles, upload),
+        }
+    }
+    /// A mesh comes back without its distance grid (which the kernels do not read): every
+    /// flight casts its exit, and traces the same path.
+    unsafe fn from_device(bounds: Aabb, mesh: &MeshParams) -> Self {
+        // SAFETY: forwarded to the caller.
+        let (nodes, triangles) = unsafe { mesh_slices(mesh) };
+        if nodes.is_empty() {
+            return BoundaryShape::Box(bounds);
+        }
+        BoundaryShape::Mesh(TriangleMesh {
+            nodes,
+            triangles,
+            bounds,
+            distance: SurfaceDistance::NONE,
+        })
     }
 }
 
 impl<M, B, P, E, S> SceneAbi for VolumeScene<M, B, P, E, S>
 where
-    Self: Scene,
-    S: DeviceShape,
-    M: Component,
-    B: Component,
-    P: Component,
-    E: Component,
+    S: DeviceShape + Shape,
+    M: Component + Medium,
+    B: Component + Bsdf,
+    P: Component + PhaseFunction,
+    E: Component + Environment,
 {
     type Params = SceneParams<M::Params, B::Params, P::Params, E::Params>;
 
     fn names() -> [&'static str; 4] {
         [M::NAME, B::NAME, P::NAME, E::NAME]
     }
+
+    type Kernel = VolumeScene<M, B, P, E, S::Kernel>;
 
     fn on_device(&self) -> bool {
         self.bounds.on_device()
@@ -470,6 +587,7 @@ where
             bounds_min: self.bounds.device_box().min.to_array(),
             bounds_max: self.bounds.device_box().max.to_array(),
             settings: SettingsParams::from(&self.settings),
+            mesh: self.bounds.mesh_params(upload),
             lights: LightsParams::from(&self.lights),
             medium: self.medium.to_params(upload),
             boundary: self.boundary.to_params(upload),
@@ -484,10 +602,13 @@ where
         unsafe {
             Self {
                 camera: PerspectiveCamera::from(&p.camera),
-                bounds: S::from_device_box(Aabb::new(
-                    Vec3::from_array(p.bounds_min),
-                    Vec3::from_array(p.bounds_max),
-                )),
+                bounds: S::from_device(
+                    Aabb::new(
+                        Vec3::from_array(p.bounds_min),
+                        Vec3::from_array(p.bounds_max),
+                    ),
+                    &p.mesh,
+                ),
                 medium: M::from_params(&p.medium),
                 boundary: B::from_params(&p.boundary),
                 phase: P::from_params(&p.phase),

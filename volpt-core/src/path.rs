@@ -491,6 +491,9 @@ fn next_event_estimate<S: Scene>(
 /// shape (the box's code is the single call); a ray that leaves a non-convex one (a torus) may
 /// enter it again. `None` when tracking runs out of steps. Per channel for a chromatic medium
 /// ([`SpectralState::Transmittance`]).
+///
+/// One ratio tracking, in the loop: a shape convex only at run time then costs the box no second
+/// copy of it.
 #[inline(always)]
 fn shadow_transmittance<S: Scene>(
     scene: &S,
@@ -498,23 +501,31 @@ fn shadow_transmittance<S: Scene>(
     shadow: Ray,
     distance: f32,
 ) -> Option<Transmittance<S>> {
-    let mut transmittance = chord_transmittance(scene, path, &shadow, distance)?;
-    if scene.shape().convex() {
-        return Some(transmittance);
-    }
     let (mut shadow, mut distance) = (shadow, distance);
-    while SpectralOf::<S>::transmits(transmittance) {
+    // The product of the chords before this one.
+    let mut before: Option<Transmittance<S>> = None;
+    loop {
+        let chord = chord_transmittance(scene, path, &shadow, distance)?;
+        let transmittance = match before {
+            Some(mut t) => {
+                t *= chord;
+                t
+            }
+            None => chord,
+        };
+        if scene.shape().convex() || !SpectralOf::<S>::transmits(transmittance) {
+            return Some(transmittance);
+        }
         let exit = scene.shape().exit(&shadow);
         match scene.shape().entry(&Ray::new(exit.point, shadow.dir)) {
             Some(entry) if entry.point.distance(shadow.origin) < distance => {
                 distance -= entry.point.distance(shadow.origin);
                 shadow.origin = entry.point;
             }
-            _ => break,
+            _ => return Some(transmittance),
         }
-        transmittance *= chord_transmittance(scene, path, &shadow, distance)?;
+        before = Some(transmittance);
     }
-    Some(transmittance)
 }
 
 /// A transmittance estimate of scene `S`'s medium.

@@ -8,7 +8,8 @@
 
 use crate::flight::{FlightEnd, LazyExit};
 use crate::geometry::{Aabb, BoxHit, Ray};
-use crate::mesh::TriangleMesh;
+use crate::mesh::{BvhNode, Crossing, MeshTriangle, SurfaceDistance, TriangleMesh};
+use crate::Vec3;
 
 /// A closed surface bounding the medium.
 ///
@@ -177,4 +178,182 @@ fn mesh_exit(mesh: &TriangleMesh<'_>, ray: &Ray) -> BoxHit {
 #[inline(never)]
 fn mesh_exit_distance(mesh: &TriangleMesh<'_>, ray: &Ray) -> f32 {
     mesh.exit_distance(ray)
+}
+
+/// The boundary as a kernel that traces meshes rebuilds it from the launch parameters
+/// ([`crate::abi::DeviceShape::Kernel`]): the box, and a mesh's BVH nodes and triangles (none for
+/// a box), so that one kernel serves both and a box pays a test of a launch parameter (`nodes`
+/// empty) per question. The kernels do not take it yet: it costs every box kernel registers
+/// (docs/gpu.md, meshes); the CPU renders it to check that it traces the CPU's paths.
+///
+/// A mesh's ray cast is one out-of-line function of scalars ([`device_nearest`]): an aggregate
+/// argument (a `Vec3`, a `Ray`, a reference into the path or the scene) passed to a call that is
+/// not inlined travels through the caller's local memory, and keeps the path state there; the
+/// traversal's stack stays in the callee's frame. A free flight casts the mesh's exit as it
+/// starts, so the trackers compare with an `f32`, as for the box: a lazy exit (the CPU's
+/// [`BoundaryShape`]) would carry its state and a call through every tracking loop. Both trace
+/// the same paths ([`crate::flight`]).
+#[derive(Clone, Copy, Debug)]
+pub struct DeviceBoundary<'a> {
+    pub bounds: Aabb,
+    pub nodes: &'a [BvhNode],
+    pub triangles: &'a [MeshTriangle],
+}
+
+impl<'a> DeviceBoundary<'a> {
+    /// The box `bounds`.
+    pub const fn box_(bounds: Aabb) -> Self {
+        Self {
+            bounds,
+            nodes: &[],
+            triangles: &[],
+        }
+    }
+
+    /// `mesh`, without its distance grid (the kernels cast every flight's exit).
+    pub fn mesh(mesh: &TriangleMesh<'a>) -> Self {
+        Self {
+            bounds: mesh.bounds,
+            nodes: mesh.nodes,
+            triangles: mesh.triangles,
+        }
+    }
+
+    #[inline(always)]
+    fn is_box(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
+    #[inline(always)]
+    fn as_mesh(&self) -> TriangleMesh<'a> {
+        TriangleMesh {
+            nodes: self.nodes,
+            triangles: self.triangles,
+            bounds: self.bounds,
+            distance: SurfaceDistance::NONE,
+        }
+    }
+
+    /// [`TriangleMesh::nearest`], out of line.
+    #[inline(always)]
+    fn nearest(&self, ray: &Ray, crossing: Crossing) -> Option<(f32, u32)> {
+        let (o, d) = (ray.origin, ray.dir);
+        let code = match crossing {
+            Crossing::Entering => 0,
+            Crossing::Leaving => 1,
+            Crossing::Any => 2,
+        };
+        let found = device_nearest(
+            self.nodes,
+            self.triangles,
+            o.x,
+            o.y,
+            o.z,
+            d.x,
+            d.y,
+            d.z,
+            code,
+        );
+        // The index's bits are `u32::MAX` where nothing was crossed.
+        let index = found as u32;
+        (index != u32::MAX).then_some((f32::from_bits((found >> 32) as u32), index))
+    }
+}
+
+/// [`TriangleMesh::nearest`] of the ray from `o` along `d` and crossing `crossing` (0 entering,
+/// 1 leaving, 2 any), packed: the distance's bits high, the triangle low (`u32::MAX`: none).
+/// Scalars in and out: an aggregate (a `Vec3`, a tuple, an array) would be passed through the
+/// caller's local memory.
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn device_nearest(
+    nodes: &[BvhNode],
+    triangles: &[MeshTriangle],
+    ox: f32,
+    oy: f32,
+    oz: f32,
+    dx: f32,
+    dy: f32,
+    dz: f32,
+    crossing: u8,
+) -> u64 {
+    let mesh = TriangleMesh {
+        nodes,
+        triangles,
+        bounds: Aabb::new(Vec3::ZERO, Vec3::ZERO),
+        distance: SurfaceDistance::NONE,
+    };
+    let ray = Ray::new(Vec3::new(ox, oy, oz), Vec3::new(dx, dy, dz));
+    let crossing = match crossing {
+        0 => Crossing::Entering,
+        1 => Crossing::Leaving,
+        _ => Crossing::Any,
+    };
+    match mesh.nearest(&ray, crossing) {
+        Some((t, i)) => (u64::from(t.to_bits()) << 32) | u64::from(i),
+        None => u64::from(u32::MAX),
+    }
+}
+
+impl Shape for DeviceBoundary<'_> {
+    const CONVEX: bool = false;
+
+    type Exit<'e>
+        = f32
+    where
+        Self: 'e;
+
+    #[inline(always)]
+    fn flight_exit<'e>(&'e self, ray: &'e Ray) -> f32 {
+        self.exit_distance(ray)
+    }
+
+    #[inline(always)]
+    fn convex(&self) -> bool {
+        self.is_box()
+    }
+
+    #[inline(always)]
+    fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+
+    #[inline(always)]
+    fn contains(&self, p: Vec3) -> bool {
+        if self.is_box() {
+            return Aabb::contains(&self.bounds, p);
+        }
+        let ray = Ray::new(p, crate::mesh::CONTAINS_DIRECTION);
+        self.as_mesh()
+            .contains_by(&ray, self.nearest(&ray, Crossing::Any))
+    }
+
+    #[inline(always)]
+    fn entry(&self, ray: &Ray) -> Option<BoxHit> {
+        if self.is_box() {
+            return Aabb::entry(&self.bounds, ray);
+        }
+        let (t, i) = self.nearest(ray, Crossing::Entering)?;
+        Some(self.as_mesh().hit(ray, t, i))
+    }
+
+    #[inline(always)]
+    fn exit(&self, ray: &Ray) -> BoxHit {
+        if self.is_box() {
+            return Aabb::exit(&self.bounds, ray);
+        }
+        self.as_mesh()
+            .exit_by(ray, self.nearest(ray, Crossing::Leaving))
+    }
+
+    #[inline(always)]
+    fn exit_distance(&self, ray: &Ray) -> f32 {
+        if self.is_box() {
+            return Aabb::exit_distance(&self.bounds, ray);
+        }
+        match self.nearest(ray, Crossing::Leaving) {
+            Some((t, _)) => t,
+            None => 0.0,
+        }
+    }
 }

@@ -13,9 +13,9 @@ use volpt_core::microfacet::Ggx;
 use volpt_core::path::{sample_pixel, trace};
 use volpt_core::shape::Shape;
 use volpt_core::{
-    Aabb, BoundaryShape, ConstantEnvironment, Estimator, HenyeyGreenstein, HomogeneousMedium,
-    NullBoundary, PathCounters, PathSettings, PathState, PerspectiveCamera, Ray, Rng,
-    RoughDielectric, SmoothDielectric, Spectrum, Vec2, Vec3, VolumeScene,
+    Aabb, BoundaryShape, ConstantEnvironment, DeviceBoundary, Estimator, HenyeyGreenstein,
+    HomogeneousMedium, NullBoundary, PathCounters, PathSettings, PathState, PerspectiveCamera, Ray,
+    Rng, RoughDielectric, SmoothDielectric, Spectrum, Vec2, Vec3, VolumeScene,
 };
 
 /// The mesh's buffers with a distance grid of 16 cells along the longest axis, so that the
@@ -451,6 +451,16 @@ fn box_and_mesh<B: volpt_core::Bsdf + Copy>(boundary: B, estimator: Estimator, s
         lights: volpt_core::Lights::NONE,
         settings,
     };
+    let as_run_time_device = |shape| VolumeScene {
+        bounds: shape,
+        lights: boxed.lights,
+        camera: boxed.camera,
+        medium: boxed.medium,
+        boundary,
+        phase: boxed.phase,
+        environment: boxed.environment,
+        settings,
+    };
     let (want, want_counters) = image(&boxed, 8);
     for (what, (got, got_counters)) in [
         ("mesh", image(&meshed, 8)),
@@ -461,6 +471,18 @@ fn box_and_mesh<B: volpt_core::Bsdf + Copy>(boundary: B, estimator: Estimator, s
         (
             "BoundaryShape::Mesh",
             image(&as_run_time(BoundaryShape::Mesh(buffers.mesh())), 8),
+        ),
+        // The GPU kernels' boundary, run here on the CPU.
+        (
+            "DeviceBoundary box",
+            image(&as_run_time_device(DeviceBoundary::box_(b)), 8),
+        ),
+        (
+            "DeviceBoundary mesh",
+            image(
+                &as_run_time_device(DeviceBoundary::mesh(&buffers.mesh())),
+                8,
+            ),
         ),
     ] {
         let differ = want.iter().zip(&got).filter(|(a, b)| a != b).count();
@@ -492,6 +514,73 @@ fn the_cube_mesh_renders_the_box_image_bit_for_bit() {
                 sigma_t,
             );
         }
+    }
+}
+
+/// The GPU kernels' boundary ([`DeviceBoundary`]: every flight casts its exit, a shadow ray's
+/// convexity asked at run time, the ray cast out of line) traces the CPU's paths (the distance
+/// grid's lazy exit) in a sphere and in a torus, where a ray crosses the mesh twice and shadow
+/// rays cross several chords: the same images and counters, bit for bit, in a thin and a dense
+/// medium, behind each boundary kind and with next-event estimation.
+#[test]
+fn the_kernels_mesh_boundary_traces_the_cpus_paths_in_a_sphere_and_a_torus() {
+    fn check<B: volpt_core::Bsdf + Copy + std::fmt::Debug>(
+        what: &str,
+        mesh: &IndexedMesh,
+        bsdf: B,
+    ) {
+        let buffers = built(mesh);
+        for sigma_t in [1.5, 30.0] {
+            for estimator in [Estimator::PathTracing, Estimator::NextEvent] {
+                let scene = |bounds| VolumeScene {
+                    camera: camera(),
+                    bounds,
+                    lights: volpt_core::Lights::NONE,
+                    medium: HomogeneousMedium {
+                        sigma_t,
+                        albedo: Spectrum::new(0.95, 0.8, 0.6),
+                    },
+                    boundary: bsdf,
+                    phase: HenyeyGreenstein { g: 0.3 },
+                    environment: ConstantEnvironment(Spectrum::ONE),
+                    settings: PathSettings {
+                        estimator,
+                        ..PathSettings::default()
+                    },
+                };
+                let cpu = scene(BoundaryShape::Mesh(buffers.mesh()));
+                let device = VolumeScene {
+                    bounds: DeviceBoundary::mesh(&buffers.mesh()),
+                    lights: cpu.lights,
+                    camera: cpu.camera,
+                    medium: cpu.medium,
+                    boundary: cpu.boundary,
+                    phase: cpu.phase,
+                    environment: cpu.environment,
+                    settings: cpu.settings,
+                };
+                let (want, want_counters) = image(&cpu, 4);
+                let (got, got_counters) = image(&device, 4);
+                assert!(want.iter().any(|p| p[0] > 0.0));
+                let differ = want.iter().zip(&got).filter(|(a, b)| a != b).count();
+                let case = format!("{what}, {bsdf:?}, sigma_t {sigma_t}, {estimator:?}");
+                assert_eq!(differ, 0, "{case}: {differ} pixels differ");
+                assert_eq!(want_counters, got_counters, "{case}");
+            }
+        }
+    }
+    for (what, mesh) in [("sphere", test_sphere()), ("torus", test_torus())] {
+        // Index-matched: next-event shadow rays cross the torus's chords.
+        check(what, &mesh, NullBoundary);
+        check(what, &mesh, SmoothDielectric { eta: 1.5 });
+        check(
+            what,
+            &mesh,
+            RoughDielectric {
+                eta: 1.33,
+                distribution: Ggx { alpha: 0.3 },
+            },
+        );
     }
 }
 

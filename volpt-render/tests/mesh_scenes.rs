@@ -1,10 +1,11 @@
 //! Mesh boundaries from scene files through the factory, on the CPU: a box written as a mesh of
 //! 24 triangles (each face split at its centre, so that it is not read as the box's 8 corners)
-//! renders the box scene's image bit for bit, and a mesh scene tells the GPU kernels it is not
-//! theirs.
+//! renders the box scene's image bit for bit, on the CPU's boundary and on the one a
+//! mesh-capable kernel rebuilds from the launch parameters (`DeviceBoundary`, run on the CPU).
 
 use std::path::Path;
 
+use volpt_core::SceneAbi;
 use volpt_render::{
     path_settings, render, with_scene, Image, RenderOptions, RenderScene, SceneVisitor,
 };
@@ -69,10 +70,13 @@ fn load(dir: &Path, name: &str, text: &str) -> SceneDescription {
     load_mitsuba(&path).expect("scene loads")
 }
 
+/// The scene's CPU image, the image of the scene rebuilt from its launch parameters as a
+/// `DeviceBoundary` scene (`SceneAbi::Kernel`), rendered on the CPU with "device addresses" that
+/// are the host's own slices, and whether the (box) kernels take the scene.
 struct Cpu;
 
 impl SceneVisitor for Cpu {
-    type Output = (Image, bool);
+    type Output = (Image, Image, bool);
     fn visit<S: RenderScene>(self, scene: &S) -> Self::Output {
         let options = RenderOptions {
             spp: 4,
@@ -80,7 +84,11 @@ impl SceneVisitor for Cpu {
             threads: None,
         };
         let (image, _) = render(scene, &options, &|_, _| {}).expect("render");
-        (image, scene.on_device())
+        let params = scene.to_params(&mut |values: &[f32]| values.as_ptr() as u64);
+        // SAFETY: every address is a slice of the description, alive for this whole visit.
+        let kernel = unsafe { <S::Kernel as SceneAbi>::from_params(&params) };
+        let (kernel_image, _) = render(&kernel, &options, &|_, _| {}).expect("render");
+        (image, kernel_image, scene.on_device())
     }
 }
 
@@ -100,14 +108,52 @@ fn a_box_written_as_a_mesh_renders_the_box_image_bit_for_bit() {
         assert!(boxed.boundary.mesh.is_none());
         assert_eq!(meshed.boundary.mesh.as_ref().unwrap().triangle_count(), 24);
         assert_eq!(boxed.boundary.bounds, meshed.boundary.bounds);
-        let (box_image, box_on_device) = with_scene(&boxed, path_settings(&boxed), Cpu);
-        let (mesh_image, mesh_on_device) = with_scene(&meshed, path_settings(&meshed), Cpu);
+        let (box_image, box_kernel, box_on_device) = with_scene(&boxed, path_settings(&boxed), Cpu);
+        let (mesh_image, mesh_kernel, mesh_on_device) =
+            with_scene(&meshed, path_settings(&meshed), Cpu);
         assert!(box_image.pixels.iter().any(|p| *p != box_image.pixels[0]));
         assert!(
             box_image.pixels == mesh_image.pixels,
             "{bsdf}: the mesh's image differs from the box's"
         );
+        assert!(
+            box_kernel.pixels == box_image.pixels,
+            "{bsdf}: the kernels' box scene differs from the host's"
+        );
+        assert!(
+            mesh_kernel.pixels == box_image.pixels,
+            "{bsdf}: the kernels' mesh scene differs from the box's"
+        );
         assert!(box_on_device, "the kernels render a box");
-        assert!(!mesh_on_device, "the kernels do not render a mesh");
+        assert!(!mesh_on_device, "the box kernels do not render a mesh");
+    }
+}
+
+/// A sphere mesh's BVH crosses the launch parameters: the scene rebuilt from them as a
+/// `DeviceBoundary` scene renders the CPU's image bit for bit (a lost mesh would render its
+/// bounding box), behind each boundary kind.
+#[test]
+fn a_sphere_mesh_crosses_the_launch_parameters_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let sphere = r#"<shape type="sphere"><float name="radius" value="0.5"/>"#;
+    let cube = r#"<shape type="cube"><transform name="to_world"><scale value="0.5"/></transform>"#;
+    for bsdf in [
+        r#"<bsdf type="null"/>"#,
+        r#"<bsdf type="dielectric"><float name="int_ior" value="1.33"/></bsdf>"#,
+        r#"<bsdf type="roughdielectric"><string name="distribution" value="ggx"/><float name="alpha" value="0.2"/></bsdf>"#,
+    ] {
+        let meshed = load(dir.path(), "sphere.xml", &scene(sphere, bsdf));
+        let boxed = load(dir.path(), "box.xml", &scene(cube, bsdf));
+        let (image, kernel, on_device) = with_scene(&meshed, path_settings(&meshed), Cpu);
+        let (box_image, _, _) = with_scene(&boxed, path_settings(&boxed), Cpu);
+        assert!(!on_device);
+        assert!(
+            image.pixels != box_image.pixels,
+            "{bsdf}: the sphere renders its box"
+        );
+        assert!(
+            kernel.pixels == image.pixels,
+            "{bsdf}: the sphere rebuilt from its parameters renders another image"
+        );
     }
 }

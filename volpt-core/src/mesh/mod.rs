@@ -141,7 +141,7 @@ impl<'a> TriangleMesh<'a> {
     /// plane of a triangle in an axis plane (as the box snaps it onto its face) and clamped into
     /// the mesh's bounds, and the outward normal.
     #[inline]
-    fn hit(&self, ray: &Ray, t: f32, i: u32) -> BoxHit {
+    pub(crate) fn hit(&self, ray: &Ray, t: f32, i: u32) -> BoxHit {
         let tri = &self.triangles[i as usize];
         let n = Vec3::from(tri.normal);
         let mut point = ray.at(t);
@@ -158,7 +158,36 @@ impl<'a> TriangleMesh<'a> {
             normal: n,
         }
     }
+
+    /// Whether `nearest`, the nearest crossing of `ray` (from a point along
+    /// [`CONTAINS_DIRECTION`]), leaves the mesh: the point is inside.
+    #[inline(always)]
+    pub(crate) fn contains_by(&self, ray: &Ray, nearest: Option<(f32, u32)>) -> bool {
+        match nearest {
+            Some((_, i)) => Vec3::from(self.triangles[i as usize].normal).dot(ray.dir) > 0.0,
+            None => false,
+        }
+    }
+
+    /// The exit of `ray` given `nearest`, its nearest leaving crossing: a ray from inside that
+    /// finds no surface to leave by (its origin a rounding error outside, at a vertex) leaves
+    /// where it stands, along its own direction.
+    #[inline(always)]
+    pub(crate) fn exit_by(&self, ray: &Ray, nearest: Option<(f32, u32)>) -> BoxHit {
+        match nearest {
+            Some((t, i)) => self.hit(ray, t, i),
+            None => BoxHit {
+                t: 0.0,
+                point: ray.origin,
+                normal: ray.dir,
+            },
+        }
+    }
 }
+
+/// The direction a point's inside test casts along: not along an axis, since a ray in a face's
+/// plane crosses nothing there.
+pub const CONTAINS_DIRECTION: Vec3 = Vec3::new(0.267_261_24, 0.534_522_5, 0.801_783_7);
 
 /// Where `ray` enters `node`'s box within `[0, t_max]`, if it does. An axis the ray runs parallel
 /// to gives `0 * inf` (NaN) for an origin on one of its planes: that axis then does not constrain,
@@ -329,12 +358,8 @@ impl Shape for TriangleMesh<'_> {
     /// Inside if the nearest crossing along a fixed direction leaves the mesh.
     #[inline]
     fn contains(&self, p: Vec3) -> bool {
-        // Not along an axis: a ray in a face's plane crosses nothing there.
-        let ray = Ray::new(p, Vec3::new(0.267_261_24, 0.534_522_5, 0.801_783_7));
-        match self.nearest(&ray, Crossing::Any) {
-            Some((_, i)) => Vec3::from(self.triangles[i as usize].normal).dot(ray.dir) > 0.0,
-            None => false,
-        }
+        let ray = Ray::new(p, CONTAINS_DIRECTION);
+        self.contains_by(&ray, self.nearest(&ray, Crossing::Any))
     }
 
     #[inline]
@@ -343,18 +368,10 @@ impl Shape for TriangleMesh<'_> {
         Some(self.hit(ray, t, i))
     }
 
-    /// A ray from inside that finds no surface to leave by (its origin a rounding error outside,
-    /// at a vertex) leaves where it stands, along its own direction.
+    /// See [`TriangleMesh::exit_by`].
     #[inline]
     fn exit(&self, ray: &Ray) -> BoxHit {
-        match self.nearest(ray, Crossing::Leaving) {
-            Some((t, i)) => self.hit(ray, t, i),
-            None => BoxHit {
-                t: 0.0,
-                point: ray.origin,
-                normal: ray.dir,
-            },
-        }
+        self.exit_by(ray, self.nearest(ray, Crossing::Leaving))
     }
 
     #[inline]

@@ -59,9 +59,9 @@ use volpt_scene::description::{
 
 /// What a backend can render: the CPU needs a [`Scene`] it can share between threads, a GPU backend
 /// also ships it to its kernels through the device ABI.
-pub trait RenderScene: Scene + Sync + SceneAbi {}
+pub trait RenderScene: Scene + Sync + SceneAbi<Kernel: Sync> {}
 
-impl<S: Scene + Sync + SceneAbi> RenderScene for S {}
+impl<S: Scene + Sync + SceneAbi<Kernel: Sync>> RenderScene for S {}
 
 /// A computation over a render-ready scene of any variant.
 pub trait SceneVisitor {
