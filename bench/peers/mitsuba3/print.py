@@ -32,8 +32,11 @@ mi.set_variant("cuda_ad_rgb")
 
 
 def delta_e(volpt, target, exr):
-    out = subprocess.run([volpt, "print", "delta-e", str(target), str(exr), "--flip-rows"],
-                         capture_output=True, text=True, check=True).stdout
+    run = subprocess.run([volpt, "print", "delta-e", str(target), str(exr), "--flip-rows"],
+                         capture_output=True, text=True)
+    if run.returncode != 0:
+        sys.exit(f"volpt print delta-e {target} {exr} failed: {run.stderr.strip()}")
+    out = run.stdout
     m = re.search(r"mean ΔE00 ([0-9.]+), p95 ([0-9.]+) over (\d+) texels \((\d+) not finite", out)
     if not m:
         sys.exit(f"unexpected output of volpt print delta-e: {out}")
@@ -53,7 +56,8 @@ def render(volpt, scene_toml, work, spp, seed):
     start = time.time()
     image = mi.render(scene, spp=spp, seed=seed)
     exr = work / f"{name}-mitsuba.exr"
-    mi.util.write_bitmap(str(exr), image)  # evaluates the render
+    # Written before volpt reads it: write_bitmap writes asynchronously by default.
+    mi.util.write_bitmap(str(exr), image, write_async=False)  # evaluates the render
     return exr, time.time() - start
 
 
