@@ -24,6 +24,7 @@ file. `--resolution N` becomes volpt's `--resolution NxN` for such scenes.
 import argparse
 import datetime
 import json
+import math
 import os
 import platform
 import re
@@ -41,9 +42,10 @@ import stats  # noqa: E402
 
 MD_HEADER = ("| scene | machine | peer variant | volpt backend | res | spp | Mitsuba 3 s | volpt s | speed-up "
              "| MSE Mitsuba 3 | MSE volpt | efficiency volpt / Mitsuba 3 "
-             "| rel. mean diff | global z (R,G,B) | worst block \\|z\\| | blocks \\|z\\|>3 | z of 1% bias | agree |\n"
+             "| rel. mean diff | global z (R,G,B) | worst block \\|z\\| | blocks \\|z\\|>3 | z of 1% bias | agree "
+             "| non-finite values Mitsuba 3 / volpt |\n"
              "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- "
-             "| --- |")
+             "| --- | --- |")
 
 
 def scene_name(path):
@@ -211,6 +213,10 @@ def run_scene(args, mit, path):
     h, w = imgs[0][1], imgs[0][2]
     if any((i[1], i[2]) != (h, w) for i in imgs):
         raise RuntimeError(f"image sizes differ: {[(i[1], i[2]) for i in imgs]}")
+    # NaN and Inf values of each renderer's images, counted before anything averages them away.
+    non_finite = [sum(1 for v in i[0] if not math.isfinite(v)) for i in imgs]
+    res["volpt"]["non_finite"] = sum(non_finite[:len(volpt_imgs)])
+    res["peer"]["non_finite"] = sum(non_finite[len(volpt_imgs):])
     agreement = stats.compare(*(i[0] for i in imgs), h, w, block=args.block)
     res["agreement"] = agreement
     # Timed = the renders after the warm-up.
@@ -231,7 +237,7 @@ def run_scene(args, mit, path):
            f"{fmt_ratio(res['efficiency_ratio'])} | {100 * a['relative_mean_difference']:+.3f}% | "
            f"{', '.join(f'{z:+.2f}' for z in a['global_z_rgb'])} | {a['worst_abs_z']:.2f} | "
            f"{100 * a['fraction_abs_z_above_3']:.2f}% | {min(a['z_of_1pct_bias']):.1f} | "
-           f"{'yes' if a['agree'] else '**no**'} |")
+           f"{'yes' if a['agree'] else '**no**'} | {res['peer']['non_finite']} / {res['volpt']['non_finite']} |")
     md = os.path.join(args.out, "results.md")
     new = not os.path.exists(md)
     with open(md, "a") as f:
