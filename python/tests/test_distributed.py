@@ -277,9 +277,11 @@ def test_a_compensation_renders_its_predictions_on_the_cluster(cluster, tmp_path
 
     local = volpt.compensate_print(target, MATERIALS, tmp_path / "local", render=here, **args)
     assert [it["mean"] for it in ray_result["iterations"]] == [it["mean"] for it in local["iterations"]]
-    # Two parts per half, two halves per prediction, from both nodes.
+    # Two parts per half, two halves per prediction, each rendered on a worker node of the cluster
+    # (which ones is Ray's choice: parts this small may all go to one).
     assert len(arrived) == 2 * 2 * len(ray_result["iterations"])
-    assert len({p.node_id for p in arrived}) == 2, arrived
+    workers = {n["NodeID"] for n in ray.nodes() if n["Alive"] and n["Resources"].get("CPU")}
+    assert {p.node_id for p in arrived} <= workers, (arrived, workers)
     for name in ["iterations.csv", *(f"slices/{p.name}" for p in (tmp_path / "local" / "slices").iterdir())]:
         assert (tmp_path / "ray" / name).read_bytes() == (tmp_path / "local" / name).read_bytes(), name
     with pytest.raises(volpt.SettingsError, match="render: not an option"):
