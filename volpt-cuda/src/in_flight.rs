@@ -144,24 +144,7 @@ impl CudaRenderer {
             Some(flight) if flight.key == key => flight,
             // Another render's paths (another view, size or range) are discarded.
             _ => {
-                let reused = self
-                    .buffers
-                    .lock()
-                    .unwrap_or_else(|e| e.into_inner())
-                    .take();
-                let mut buffers = match reused {
-                    Some(buffers) if buffers.film.len() == 3 * pixels as usize => buffers,
-                    _ => RenderBuffers::new(stream, pixels)?,
-                };
-                // The samples before the range continue on the device, as a render's do.
-                let resumed = samples.start > 0 && film.holds_samples();
-                buffers.zero(stream, !resumed)?;
-                buffers.holds = None;
-                if resumed {
-                    stream
-                        .memcpy_htod(film.flat_sums(), &mut buffers.film)
-                        .doing("copying the film to the GPU")?;
-                }
+                let (mut buffers, _) = self.buffers_for(film, &samples)?;
                 stream
                     .memset_zeros(&mut buffers.queue_state)
                     .doing("resetting the queue counters")?;

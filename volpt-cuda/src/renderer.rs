@@ -293,6 +293,38 @@ impl CudaRenderer {
         unsafe { self.place(scene, Some(grids)) }.map(drop)
     }
 
+    /// The device buffers of a render that adds `samples` to `film` (checked against the
+    /// camera's size): the last render's where they fit, with the counters zeroed, and the sums
+    /// of the samples before `samples` continuing on the device (as the CPU continues them),
+    /// unless there are none yet, as in a batch of several GPUs, whose film starts empty; and
+    /// whether they did continue.
+    pub(crate) fn buffers_for(
+        &self,
+        film: &Film,
+        samples: &Range<u32>,
+    ) -> Result<(RenderBuffers, bool), CudaError> {
+        let pixels = u64::from(film.width) * u64::from(film.height);
+        let reused = self
+            .buffers
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .take();
+        let mut buffers = match reused {
+            Some(buffers) if buffers.film.len() == 3 * pixels as usize => buffers,
+            _ => RenderBuffers::new(&self.stream, pixels)?,
+        };
+        let resumed = samples.start > 0 && film.holds_samples();
+        buffers.zero(&self.stream, !resumed)?;
+        // Until this render has ended, the film holds nothing a frame may show.
+        buffers.holds = None;
+        if resumed {
+            self.stream
+                .memcpy_htod(film.flat_sums(), &mut buffers.film)
+                .doing("copying the film to the GPU")?;
+        }
+        Ok((buffers, resumed))
+    }
+
     /// `scene`'s launch parameters: its grids where the volume policy puts them (taken from and
     /// left in the kept grids of the scene numbered `keep`, if any), everything else by value.
     /// The parameters are valid while the placer lives.
@@ -427,27 +459,7 @@ impl CudaRenderer {
         let (volumes, scene_params) = unsafe { self.place(scene, keep) }?;
 
         let pixels = width as u64 * height as u64;
-        let reused = self
-            .buffers
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .take();
-        let mut buffers = match reused {
-            Some(buffers) if buffers.film.len() == 3 * pixels as usize => buffers,
-            _ => RenderBuffers::new(stream, pixels)?,
-        };
-        // A resumed render: the sums of the samples before `samples` continue on the device (as
-        // the CPU continues them), unless there are none yet, as in a batch of several GPUs,
-        // whose film starts empty.
-        let resumed = samples.start > 0 && film.holds_samples();
-        buffers.zero(stream, !resumed)?;
-        // Until this render has ended, the film holds nothing a frame may show.
-        buffers.holds = None;
-        if resumed {
-            stream
-                .memcpy_htod(film.flat_sums(), &mut buffers.film)
-                .doing("copying the film to the GPU")?;
-        }
+        let (mut buffers, resumed) = self.buffers_for(film, &samples)?;
         let RenderBuffers {
             film: device_film,
             counters,
