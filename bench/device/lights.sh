@@ -45,6 +45,7 @@ for entry in "${SCENES[@]}"; do
     # shellcheck disable=SC2086
     if ! "$VOLPT" render "$file" $extra "${COMMON[@]}" --backend cuda -o "$OUT/$name-probe.exr" >"$OUT/$name-probe.log" 2>&1; then
         check "$name-gpu-refuses" grep -q "no lights besides the environment" "$OUT/$name-probe.log"
+        ANALYTIC_BACKEND=cpu
         continue
     fi
     for s in "${STRATEGIES[@]}"; do
@@ -63,7 +64,7 @@ done
 
 SPP=1024
 # The GPU's where it has lights, the CPU's otherwise.
-ANALYTIC_BACKEND=$("$VOLPT" render scenes/lights/sun-slab.xml --spp 1 --resolution 4x4 --backend cuda -o "$OUT/probe.exr" >/dev/null 2>&1 && echo cuda || echo cpu)
+ANALYTIC_BACKEND=${ANALYTIC_BACKEND:-cuda}
 if timeout "$T" "$VOLPT" render scenes/lights/sun-slab.xml --spp $SPP --seed 11 --resolution 16x16 --backend "$ANALYTIC_BACKEND" \
     --film "$OUT/sun-slab-gpu.vfilm" >"$OUT/sun-slab-analytic-render.log" 2>&1; then
     check "sun-slab-analytic-$ANALYTIC_BACKEND" python3 lights_analytic.py "$OUT/sun-slab-gpu.vfilm" $SPP
