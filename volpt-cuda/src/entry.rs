@@ -205,9 +205,9 @@ mod tests {
                 && refused.to_string().contains("naive-sk, regeneration-sk"),
             "{refused}"
         );
-        // A lit scene behind a dielectric has no lit kernel (the factory warns that the delta
-        // lights add nothing there).
-        let dielectric = volpt_core::VolumeScene {
+        // Behind a dielectric a delta sun adds nothing: the box kernel renders that scene
+        // exactly. A sun disc is seen there, and no lit kernel has a dielectric boundary.
+        let mut dielectric = volpt_core::VolumeScene {
             boundary: SmoothDielectric { eta: 1.5 },
             camera: lit.camera,
             bounds: lit.bounds,
@@ -217,6 +217,11 @@ mod tests {
             lights: lit.lights,
             settings: lit.settings,
         };
+        assert_eq!(
+            scene_entry(&dielectric, Strategy::RegenerationSk).unwrap(),
+            "regeneration_sk__homogeneous__smooth_dielectric__isotropic__constant"
+        );
+        dielectric.lights.sun = DirectionalLight::new(-Vec3::Z, 0.1, Vec3::ONE);
         assert!(matches!(
             scene_entry(&dielectric, Strategy::RegenerationSk),
             Err(CudaError::SetVariant { .. })
