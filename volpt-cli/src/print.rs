@@ -208,6 +208,7 @@ fn compensate(args: CompensateArgs) -> Result<()> {
         step: args.step,
         noise_ratio: (args.noise_ratio > 0.0).then_some(args.noise_ratio),
         update: args.update,
+        ..Options::default()
     };
     let terminal = Arc::new(Terminal::new(!args.quiet).interruptible(
         "\ninterrupted: writing the iterations finished so far (Ctrl-C again to quit now)",
