@@ -6,6 +6,7 @@
 mod common;
 
 use common::{TestRng, Z_MAX};
+use glam::DVec3;
 use volpt_core::mesh::build::{build, check_closed, BuildError, MeshBuffers};
 use volpt_core::mesh::distance::resolution_for;
 use volpt_core::mesh::primitives::{cuboid, sphere, torus, IndexedMesh};
@@ -628,6 +629,112 @@ fn the_distance_bound_never_exceeds_the_exit_and_spares_most_casts() {
     }
 }
 
+/// The distance from `p` to triangle `[a, b, c]` in f64, independently of the grid's code: the
+/// projection onto the plane where it falls inside, else the nearest of the three edges.
+fn triangle_distance_f64(p: DVec3, [a, b, c]: [DVec3; 3]) -> f64 {
+    let n = (b - a).cross(c - a);
+    let q = p - n * (p - a).dot(n) / n.length_squared();
+    let inside = [(a, b), (b, c), (c, a)]
+        .iter()
+        .all(|&(u, v)| (v - u).cross(q - u).dot(n) >= 0.0);
+    if inside {
+        return (p - q).length();
+    }
+    [(a, b), (b, c), (c, a)]
+        .iter()
+        .map(|&(u, v)| {
+            let t = ((p - u).dot(v - u) / (v - u).length_squared()).clamp(0.0, 1.0);
+            (p - (u + (v - u) * t)).length()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn surface_distance_f64((vertices, triangles): &IndexedMesh, p: DVec3) -> f64 {
+    triangles
+        .iter()
+        .map(|t| triangle_distance_f64(p, t.map(|i| Vec3::from(vertices[i as usize]).as_dvec3())))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Every value of the distance grid is a lower bound of the distance from its cell's centre to
+/// the surface (brute force over all triangles, f64; to f64 rounding), and so is the bound the
+/// lookup gives at random points (strictly);
+/// and the grid is tight: within the refined band it is the distance (to f32 rounding), and
+/// elsewhere less than a cell's diagonal below it. Shapes: the sphere, the torus, the box, a
+/// rotated box and an octahedron (large slanted triangles cross many cells).
+#[test]
+fn the_distance_grid_bounds_the_brute_force_distance_from_below_and_tightly() {
+    use volpt_core::mesh::distance::NEAR_CELLS;
+    let mut rng = TestRng::new(11);
+    let rotated = {
+        let (vertices, triangles) = cuboid(unit_box());
+        let (s, c) = (0.6f32.sin(), 0.6f32.cos());
+        let turn = |[x, y, z]: [f32; 3]| {
+            [
+                c * x - s * y,
+                s * x * 0.8 + c * y * 0.8 + 0.6 * z,
+                -0.6 * s * x - 0.6 * c * y + 0.8 * z,
+            ]
+        };
+        (vertices.into_iter().map(turn).collect(), triangles)
+    };
+    for (what, mesh, cells) in [
+        ("sphere", test_sphere(), 16),
+        ("torus", test_torus(), 20),
+        ("box", cuboid(unit_box()), 16),
+        ("rotated box", rotated, 12),
+        ("octahedron", sphere([0.0; 3], 1.0, 2, 4), 16),
+    ] {
+        let buffers = build(&mesh.0, &mesh.1).expect("a closed mesh builds");
+        let res = resolution_for(buffers.bounds, cells);
+        let buffers = buffers.with_distances(res);
+        let grid = buffers.mesh().distance;
+        let [rx, ry, rz] = grid.res;
+        let (diagonal, near) = (
+            f64::from(grid.cell.length()),
+            f64::from(grid.cell.max_element()) * NEAR_CELLS,
+        );
+        let mut worst_slack: f64 = 0.0;
+        for z in 0..rz {
+            for y in 0..ry {
+                for x in 0..rx {
+                    let centre =
+                        grid.min + (Vec3::new(x as f32, y as f32, z as f32) + 0.5) * grid.cell;
+                    let exact = surface_distance_f64(&mesh, centre.as_dvec3());
+                    let value = f64::from(grid.values[((z * ry + y) * rx + x) as usize]);
+                    // Two f64 computations of the same distance may differ in their last bits;
+                    // the lookup's margin (`at`, checked below) is far larger.
+                    assert!(
+                        value <= exact * (1.0 + 1e-12),
+                        "{what}: cell ({x}, {y}, {z}) holds {value}, beyond its distance {exact}"
+                    );
+                    let allowed = if exact < near {
+                        1e-6 * (1.0 + exact)
+                    } else {
+                        diagonal * 1.001
+                    };
+                    assert!(
+                        exact - value <= allowed,
+                        "{what}: cell ({x}, {y}, {z}) holds {value}, loose by {} (distance {exact})",
+                        exact - value
+                    );
+                    worst_slack = worst_slack.max(exact - value);
+                }
+            }
+        }
+        let b = buffers.bounds;
+        for _ in 0..2000 {
+            let p = b.min + (b.max - b.min) * Vec3::new(rng.f32(), rng.f32(), rng.f32());
+            let (bound, exact) = (grid.at(p), surface_distance_f64(&mesh, p.as_dvec3()));
+            assert!(
+                f64::from(bound) <= exact,
+                "{what}: bound {bound} at {p} beyond its distance {exact}"
+            );
+        }
+        eprintln!("{what}: {rx}x{ry}x{rz} cells, at most {worst_slack:.4} below the distance (cell diagonal {diagonal:.4})");
+    }
+}
+
 /// The white furnace inside the torus: albedo 1 behind an index-matched boundary under a constant
 /// environment of radiance 1 returns exactly 1 on average, with path tracing and with next-event
 /// estimation, whose shadow rays must cross every chord of the torus (one through the hole meets
@@ -664,5 +771,62 @@ fn the_furnace_in_a_torus_returns_the_light_with_and_without_next_event_estimati
         let z = (mean - 1.0) / (var / samples.len() as f64).sqrt();
         eprintln!("{estimator:?}: mean {mean} over {n} paths, z {z:.2}");
         assert!(z.abs() < Z_MAX, "{estimator:?}: mean {mean}, z {z}");
+    }
+}
+
+/// A BVH large enough that its top levels are built as separate subtrees and concatenated is
+/// well formed: from the root, every child's box lies in its parent's, every leaf's triangles in
+/// its box, every triangle is in exactly one leaf, and no leaf is deeper than the traversal's
+/// stack; and rays cast through it cross where the f64 brute force says.
+#[test]
+fn a_bvh_of_concatenated_subtrees_is_well_formed() {
+    use volpt_core::mesh::{BvhNode, MAX_BVH_DEPTH};
+    let mesh = sphere([0.1, -0.2, 0.0], 1.0, 140, 280);
+    assert!(
+        mesh.1.len() > 2 * (1 << 15),
+        "too small to be split into subtrees"
+    );
+    let buffers = build(&mesh.0, &mesh.1).expect("closed");
+    let nodes = &buffers.nodes;
+    let inside = |inner: ([f32; 3], [f32; 3]), outer: &BvhNode| {
+        (0..3).all(|k| inner.0[k] >= outer.min[k] && inner.1[k] <= outer.max[k])
+    };
+    let mut seen = vec![0u32; buffers.triangles.len()];
+    let mut stack = vec![(0u32, 1usize)];
+    while let Some((i, depth)) = stack.pop() {
+        let n = nodes[i as usize];
+        assert!(depth <= MAX_BVH_DEPTH, "node {i} at depth {depth}");
+        if n.count > 0 {
+            for t in n.first..n.first + n.count {
+                let v = buffers.triangles[t as usize].v;
+                let lo = [0, 1, 2].map(|k| v[0][k].min(v[1][k]).min(v[2][k]));
+                let hi = [0, 1, 2].map(|k| v[0][k].max(v[1][k]).max(v[2][k]));
+                assert!(inside((lo, hi), &n), "triangle {t} outside leaf {i}");
+                seen[t as usize] += 1;
+            }
+        } else {
+            for child in [i + 1, n.first] {
+                let c = nodes[child as usize];
+                assert!(
+                    inside((c.min, c.max), &n),
+                    "node {child} outside its parent {i}"
+                );
+                stack.push((child, depth + 1));
+            }
+        }
+    }
+    assert!(
+        seen.iter().all(|&n| n == 1),
+        "a triangle in no leaf or in two"
+    );
+    let shape = buffers.mesh();
+    let mut rng = TestRng::new(5);
+    for ray in chord_rays(&mut rng, 200) {
+        let walked = chord_walked(&shape, &ray).0;
+        let exact = chord_f64(&mesh, &ray).unwrap_or(0.0);
+        assert!(
+            (walked - exact).abs() < 1e-4,
+            "{ray:?}: chord {walked}, f64 {exact}"
+        );
     }
 }

@@ -15,7 +15,7 @@ use std::sync::Arc;
 
 use serde::{Serialize, Serializer};
 
-use volpt_core::mesh::build::{build, BuildError, MeshBuffers};
+use volpt_core::mesh::build::{build_with, BuildError, Fork, MeshBuffers};
 
 use crate::error::SceneError;
 
@@ -162,23 +162,29 @@ impl MeshDesc {
     }
 }
 
-/// `buffers` with their distance grid ([`volpt_core::mesh::distance`]), its slabs computed on
+/// `buffers` with their distance grid ([`volpt_core::mesh::distance`]), its slabs refined on
 /// every core.
 fn with_distances(mut buffers: MeshBuffers) -> MeshBuffers {
-    use volpt_core::mesh::distance::{distance_slab, resolution_for, DISTANCE_RESOLUTION};
+    use volpt_core::mesh::distance::{
+        refine_slab, resolution_for, surface_bound, DISTANCE_RESOLUTION,
+    };
     let res = resolution_for(buffers.bounds, DISTANCE_RESOLUTION);
-    let slab = (res[0] * res[1]) as usize;
-    let mut values = vec![0.0; slab * res[2] as usize];
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let slabs_per_thread = (res[2] as usize).div_ceil(threads);
     let mesh = buffers.mesh();
+    let mut values = surface_bound(&mesh, res);
+    let slab = (res[0] * res[1]) as usize;
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    // Interleaved slabs: the surface's cells, the costly ones, are spread over all threads.
+    let mut slabs: Vec<(usize, &mut [f32])> = values.chunks_mut(slab).enumerate().collect();
+    let mut shares: Vec<Vec<(usize, &mut [f32])>> = (0..threads).map(|_| Vec::new()).collect();
+    for (i, s) in slabs.drain(..).enumerate() {
+        shares[i % threads].push(s);
+    }
     std::thread::scope(|scope| {
-        for (chunk, out) in values.chunks_mut(slab * slabs_per_thread).enumerate() {
+        for share in shares {
             let mesh = &mesh;
             scope.spawn(move || {
-                for (i, out) in out.chunks_mut(slab).enumerate() {
-                    let z = chunk * slabs_per_thread + i;
-                    distance_slab(mesh, res, z as u32, out);
+                for (z, out) in share {
+                    refine_slab(mesh, res, z as u32, out);
                 }
             });
         }
@@ -205,9 +211,53 @@ pub fn load_mesh(path: &Path) -> Result<MeshBuffers, SceneError> {
     build_mesh(path, &soup)
 }
 
-/// Checks `soup` and builds its BVH; `path` names it in errors.
+/// Checks `soup` and builds its BVH, on every core; `path` names it in errors.
 pub fn build_mesh(path: &Path, soup: &TriangleSoup) -> Result<MeshBuffers, SceneError> {
-    build(&soup.vertices, &soup.triangles).map_err(|e| problem(path, MeshProblem::Geometry(e)))
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    build_with(&soup.vertices, &soup.triangles, &Threads::new(threads))
+        .map_err(|e| problem(path, MeshProblem::Geometry(e)))
+}
+
+/// Forks the BVH build onto scoped threads while any are left of the budget it was given
+/// (the host's cores), then builds on the calling thread.
+pub struct Threads {
+    spare: std::sync::atomic::AtomicUsize,
+}
+
+impl Threads {
+    /// A fork for `threads` threads in all, the calling one included.
+    pub fn new(threads: usize) -> Self {
+        Self {
+            spare: threads.saturating_sub(1).into(),
+        }
+    }
+}
+
+impl Fork for Threads {
+    fn join<A: Send, B: Send>(
+        &self,
+        a: impl FnOnce() -> A + Send,
+        b: impl FnOnce() -> B + Send,
+    ) -> (A, B) {
+        use std::sync::atomic::Ordering;
+        let taken = self
+            .spare
+            .fetch_update(Ordering::AcqRel, Ordering::Acquire, |n| n.checked_sub(1))
+            .is_ok();
+        if !taken {
+            return (a(), b());
+        }
+        let joined = std::thread::scope(|scope| {
+            let b = scope.spawn(b);
+            let a = a();
+            (a, b.join())
+        });
+        self.spare.fetch_add(1, Ordering::AcqRel);
+        match joined {
+            (a, Ok(b)) => (a, b),
+            (_, Err(panic)) => std::panic::resume_unwind(panic),
+        }
+    }
 }
 
 /// Reads a mesh file's vertices and triangles (by its extension), unchecked.

@@ -337,3 +337,28 @@ fn an_exported_mesh_scene_reads_back_as_the_same_mesh() {
     assert_eq!(triangle_set(a), triangle_set(b));
     assert_eq!(desc.boundary.bounds, back.boundary.bounds);
 }
+
+/// The BVH built on several threads is the serial build's, node for node and triangle for
+/// triangle: the subtrees are concatenated in the serial order (a mesh large enough that its
+/// top levels fork), whichever thread finishes first.
+#[test]
+fn the_threaded_bvh_build_is_the_serial_one() {
+    use volpt_core::mesh::build::{build, build_with};
+    use volpt_core::mesh::primitives::{sphere, torus};
+    use volpt_scene::mesh::Threads;
+    for (what, (vertices, triangles)) in [
+        ("sphere", sphere([0.1, 0.0, 0.0], 1.0, 140, 280)),
+        ("torus", torus([0.0; 3], 1.0, 0.3, 280, 140)),
+    ] {
+        assert!(triangles.len() > 2 * (1 << 15), "{what}: too small to fork");
+        let serial = build(&vertices, &triangles).expect("closed");
+        for threads in [2, 3, 8] {
+            let threaded =
+                build_with(&vertices, &triangles, &Threads::new(threads)).expect("closed");
+            assert!(
+                threaded == serial,
+                "{what}: {threads} threads build another BVH"
+            );
+        }
+    }
+}

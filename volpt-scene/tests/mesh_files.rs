@@ -299,3 +299,122 @@ fn hostile_mesh_files_are_refused_naming_the_fault() {
         MeshProblem::Format { .. }
     ));
 }
+
+/// The hostile cases the OBJ-based test leaves to other formats, and that errors name the edge or
+/// triangle at fault: a binary PLY whose face names a vertex past the last (the triangle and the
+/// index named), a NaN corner in a binary STL, an edge shared by three triangles (a second cube
+/// hinged on one edge: non-manifold, the edge named), the open edge and the two flipped
+/// triangles named by number.
+#[test]
+fn hostile_files_in_every_format_are_refused_naming_the_edge_or_triangle() {
+    // Binary PLY: triangle 7's second index is 8, of 8 vertices.
+    let mut ply = cube_ply_binary(false);
+    let header = ply_header("binary_little_endian", 8, 12).len();
+    let at = header + 8 * 13 + 7 * 13 + 1 + 4;
+    ply[at..at + 4].copy_from_slice(&8i32.to_le_bytes());
+    let problem = refused("index.ply", &ply);
+    assert!(
+        matches!(
+            problem,
+            MeshProblem::Geometry(BuildError::IndexOutOfRange {
+                triangle: 7,
+                index: 8,
+                vertices: 8
+            })
+        ),
+        "{problem}"
+    );
+    assert!(
+        problem.to_string().contains("triangle 7 names vertex 8"),
+        "{problem}"
+    );
+
+    // Binary STL with a NaN corner: every corner of triangle 3 that was corner 0's.
+    let mut stl = stl_binary(&triangles(), 12);
+    let corner = 84 + 3 * 50 + 12;
+    stl[corner..corner + 4].copy_from_slice(&f32::NAN.to_le_bytes());
+    let problem = refused("nan.stl", &stl);
+    assert!(
+        matches!(
+            problem,
+            MeshProblem::Geometry(BuildError::NonFiniteVertex { .. })
+        ),
+        "{problem}"
+    );
+    assert!(problem.to_string().contains("expected finite"), "{problem}");
+
+    // Non-manifold: the cube plus a second cube sharing the edge 3-7 (x = 1, y = 0.5), shifted
+    // by (2, 1, 0) so that only that edge is common; its corner 0 is the first cube's 3, its 4
+    // the first's 7, the rest new.
+    let mut corners = CORNERS.to_vec();
+    let shift = |c: [f32; 3]| [c[0] + 2.0, c[1] + 1.0, c[2]];
+    let second: Vec<i64> = (0..8)
+        .map(|i| match i {
+            0 => 4,
+            4 => 8,
+            _ => {
+                corners.push(shift(CORNERS[i]));
+                corners.len() as i64
+            }
+        })
+        .collect();
+    let mut faces: Vec<Vec<i64>> = QUADS
+        .iter()
+        .map(|q| q.iter().map(|&i| i as i64 + 1).collect())
+        .collect();
+    faces.extend(
+        QUADS
+            .iter()
+            .map(|q| q.iter().map(|&i| second[i as usize]).collect()),
+    );
+    let problem = refused("hinged.obj", obj(&corners, &faces).as_bytes());
+    assert!(
+        matches!(
+            problem,
+            MeshProblem::Geometry(BuildError::NonManifoldEdge {
+                from: 3,
+                to: 7,
+                triangles: 4
+            })
+        ),
+        "{problem}"
+    );
+    assert!(
+        problem.to_string().contains("edge 3-7 borders 4 triangles"),
+        "{problem}"
+    );
+
+    // The open edge and the flipped triangles, by number.
+    let quads: Vec<Vec<i64>> = QUADS
+        .iter()
+        .map(|q| q.iter().map(|&i| i as i64 + 1).collect())
+        .collect();
+    let problem = refused("open.obj", obj(&CORNERS, &quads[1..]).as_bytes());
+    let MeshProblem::Geometry(BuildError::OpenEdge { triangle, from, to }) = problem else {
+        panic!("{problem}")
+    };
+    assert!(
+        problem
+            .to_string()
+            .contains(&format!("edge {from}-{to} of triangle {triangle}")),
+        "{problem}"
+    );
+    let mut flipped = quads.clone();
+    flipped[4].reverse();
+    let problem = refused("flipped.obj", obj(&CORNERS, &flipped).as_bytes());
+    let MeshProblem::Geometry(BuildError::InconsistentOrientation { first, second, .. }) = problem
+    else {
+        panic!("{problem}")
+    };
+    // Quad 4 is fanned into triangles 8 and 9.
+    assert!(
+        first == 8 || first == 9 || second == 8 || second == 9,
+        "{problem}"
+    );
+    assert!(
+        problem
+            .to_string()
+            .contains(&format!("triangles {first} and {second}")),
+        "{problem}"
+    );
+}

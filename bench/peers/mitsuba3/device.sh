@@ -13,7 +13,10 @@
 # Mitsuba's LLVM backend is slow on these dense scenes), SCENES (names, default the seven grey
 # scenes; chromatic-cube and chromatic-slab name scenes/chromatic's media, which Mitsuba renders with
 # `volpathmis`; sun-slab, spot-fog and spot-fog-chromatic name scenes/lights' directional and spot
-# emitters: `SCENES="sun-slab spot-fog spot-fog-chromatic"`).
+# emitters: `SCENES="sun-slab spot-fog spot-fog-chromatic"`; mesh-sphere-smooth and mesh-torus-rough
+# name scenes/mesh-peers' triangle-mesh boundaries, issue 39: a smooth dielectric sphere mesh and a
+# rough dielectric torus holding a density grid; volpt renders meshes on the CPU unless its kernels
+# take them: `MODE=cpu SCENES="mesh-sphere-smooth mesh-torus-rough"`).
 # Everything lands under $OUT/peers: results.md (one Markdown row per scene and device), <name>.json,
 # the EXR images, the Mitsuba 3 XML each scene was rendered from, and the logs.
 #
@@ -96,6 +99,8 @@ scene_args() { # name -> file and -D parameters
         sun-slab) echo "bundle/scenes/lights/sun-slab.xml" ;;
         spot-fog) echo "bundle/scenes/lights/spot-fog.xml" ;;
         spot-fog-chromatic) echo "bundle/scenes/lights/spot-fog.xml -D sigma_t=0.25,0.5,1" ;;
+        mesh-sphere-smooth) echo "bundle/scenes/mesh-peers/sphere.xml" ;;
+        mesh-torus-rough) echo "bundle/scenes/mesh-peers/torus.xml" ;;
         *) echo "" ;;
     esac
 }

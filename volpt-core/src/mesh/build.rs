@@ -48,13 +48,13 @@ impl MeshBuffers {
     }
 
     /// These buffers with a distance grid of `res` cells over the mesh's box, computed here one
-    /// slab after another (a host with threads may compute the slabs,
-    /// [`super::distance::distance_slab`], in parallel and set `distances` itself).
+    /// slab after another (a host with threads may refine the slabs,
+    /// [`super::distance::refine_slab`], in parallel and set `distances` itself).
     pub fn with_distances(mut self, res: [u32; 3]) -> Self {
+        let mut values = super::distance::surface_bound(&self.mesh(), res);
         let slab = (res[0] * res[1]) as usize;
-        let mut values = alloc::vec![0.0; slab * res[2] as usize];
         for (z, out) in values.chunks_mut(slab).enumerate() {
-            super::distance::distance_slab(&self.mesh(), res, z as u32, out);
+            super::distance::refine_slab(&self.mesh(), res, z as u32, out);
         }
         self.distances = values;
         self.distance_res = res;
@@ -159,9 +159,44 @@ struct Prim {
     index: u32,
 }
 
+/// Runs two parts of the BVH build, on two threads where the host has them; [`Serial`] runs
+/// them one after the other. The BVH is the same either way.
+pub trait Fork: Sync {
+    fn join<A: Send, B: Send>(
+        &self,
+        a: impl FnOnce() -> A + Send,
+        b: impl FnOnce() -> B + Send,
+    ) -> (A, B);
+}
+
+/// Builds on the calling thread.
+pub struct Serial;
+
+impl Fork for Serial {
+    fn join<A: Send, B: Send>(
+        &self,
+        a: impl FnOnce() -> A + Send,
+        b: impl FnOnce() -> B + Send,
+    ) -> (A, B) {
+        (a(), b())
+    }
+}
+
+/// Subtrees of fewer triangles are built serially: forking them costs more than it saves.
+const FORK_MIN: usize = 1 << 15;
+
 /// Builds the BVH of the triangles `indices` over `vertices`, each triangle counter-clockwise
 /// seen from outside.
 pub fn build(vertices: &[[f32; 3]], indices: &[[u32; 3]]) -> Result<MeshBuffers, BuildError> {
+    build_with(vertices, indices, &Serial)
+}
+
+/// [`build`], its subtrees built in parallel by `fork`.
+pub fn build_with(
+    vertices: &[[f32; 3]],
+    indices: &[[u32; 3]],
+    fork: &impl Fork,
+) -> Result<MeshBuffers, BuildError> {
     if indices.is_empty() {
         return Err(BuildError::NoTriangles);
     }
@@ -200,8 +235,7 @@ pub fn build(vertices: &[[f32; 3]], indices: &[[u32; 3]]) -> Result<MeshBuffers,
             }
         })
         .collect();
-    let mut nodes = Vec::with_capacity(2 * prims.len() / LEAF_SIZE + 1);
-    build_node(&mut prims, 1, &mut nodes);
+    let mut nodes = build_tree(&mut prims, 1, fork);
     offset_leaves(&mut nodes);
     let order: Vec<u32> = prims.iter().map(|p| p.index).collect();
     let bounds = Aabb::new(nodes[0].min.into(), nodes[0].max.into());
@@ -258,24 +292,34 @@ fn check_indices(vertices: usize, indices: &[[u32; 3]]) -> Result<(), BuildError
 /// the mesh is closed, manifold and consistently oriented. Sorting the directed edges by their
 /// undirected key keeps this `O(n log n)` without a hash map.
 pub fn check_closed(indices: &[[u32; 3]]) -> Result<(), BuildError> {
-    // (low vertex, high vertex, runs from low to high, triangle)
-    let mut edges: Vec<(u32, u32, bool, usize)> = Vec::with_capacity(3 * indices.len());
+    // One integer per directed edge, so that the sort compares single words: from the top, the
+    // low vertex, the high vertex, whether it runs from low to high, the triangle.
+    let mut edges: Vec<u128> = Vec::with_capacity(3 * indices.len());
     for (triangle, t) in indices.iter().enumerate() {
         for k in 0..3 {
             let (from, to) = (t[k], t[(k + 1) % 3]);
-            edges.push((from.min(to), from.max(to), from < to, triangle));
+            let key = u128::from(from.min(to)) << 96 | u128::from(from.max(to)) << 64;
+            edges.push(key | u128::from(from < to) << 63 | triangle as u128);
         }
     }
     edges.sort_unstable();
-    for group in edges.chunk_by(|a, b| (a.0, a.1) == (b.0, b.1)) {
-        let (lo, hi, up, triangle) = group[0];
+    let unpack = |e: u128| {
+        (
+            (e >> 96) as u32,
+            (e >> 64) as u32,
+            e >> 63 & 1 == 1,
+            (e & (u128::from(u64::MAX) >> 1)) as usize,
+        )
+    };
+    for group in edges.chunk_by(|a, b| a >> 64 == b >> 64) {
+        let (lo, hi, up, triangle) = unpack(group[0]);
         let (from, to) = if up { (lo, hi) } else { (hi, lo) };
         match group {
             [_] => return Err(BuildError::OpenEdge { triangle, from, to }),
-            [a, b] if a.2 == b.2 => {
+            [a, b] if unpack(*a).2 == unpack(*b).2 => {
                 return Err(BuildError::InconsistentOrientation {
-                    first: a.3,
-                    second: b.3,
+                    first: unpack(*a).3,
+                    second: unpack(*b).3,
                     from,
                     to,
                 })
@@ -329,8 +373,54 @@ const EMPTY: Aabb = Aabb {
     max: Vec3::splat(f32::NEG_INFINITY),
 };
 
-/// Builds the subtree of `prims` (reordering them into leaf order) at `depth` and returns its
-/// node's index. Leaves are at most [`MAX_BVH_DEPTH`] deep, so the traversal's stack suffices.
+/// The nodes of the subtree of `prims` (reordering them into leaf order) at `depth`, its root
+/// first and its children's indices relative to it: large subtrees are split and their halves
+/// built by `fork`, then concatenated (the second child's index moved past the first's nodes).
+/// Leaves are at most [`MAX_BVH_DEPTH`] deep, so the traversal's stack suffices.
+fn build_tree(prims: &mut [Prim], depth: usize, fork: &impl Fork) -> Vec<BvhNode> {
+    if prims.len() < FORK_MIN {
+        let mut nodes = Vec::with_capacity(2 * prims.len() / LEAF_SIZE + 1);
+        build_node(prims, depth, &mut nodes);
+        return nodes;
+    }
+    let bounds = prims.iter().fold(EMPTY, |b, p| union(b, p.bounds));
+    let mut root = BvhNode {
+        min: bounds.min.into(),
+        max: bounds.max.into(),
+        ..BvhNode::default()
+    };
+    let split = if depth >= MAX_BVH_DEPTH {
+        None
+    } else {
+        sah_split(prims, bounds)
+    };
+    let Some(mid) = split else {
+        root.count = prims.len() as u32;
+        return alloc::vec![root];
+    };
+    let (left, right) = prims.split_at_mut(mid);
+    let (left, right) = fork.join(
+        || build_tree(left, depth + 1, fork),
+        || build_tree(right, depth + 1, fork),
+    );
+    root.first = 1 + left.len() as u32;
+    let mut nodes = Vec::with_capacity(1 + left.len() + right.len());
+    nodes.push(root);
+    let moved = |offset: u32| {
+        move |mut n: BvhNode| {
+            if n.count == 0 {
+                n.first += offset;
+            }
+            n
+        }
+    };
+    nodes.extend(left.into_iter().map(moved(1)));
+    nodes.extend(right.into_iter().map(moved(root.first)));
+    nodes
+}
+
+/// Builds the subtree of `prims` (reordering them into leaf order) at `depth` into `nodes`,
+/// children's indices relative to `nodes`' start, and returns its node's index.
 fn build_node(prims: &mut [Prim], depth: usize, nodes: &mut Vec<BvhNode>) -> u32 {
     let first = nodes.len() as u32;
     let bounds = prims.iter().fold(EMPTY, |b, p| union(b, p.bounds));
