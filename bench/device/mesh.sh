@@ -1,31 +1,32 @@
 #!/usr/bin/env bash
 # Mesh boundaries (issue 39) on the device host, with the stripped `volpt` binary only (no cargo).
-# What this checks:
+# The GPU traces meshes with kernels of their own (volpt_device::KernelSet::Mesh: naive-sk and
+# regeneration-sk; homogeneous and dense-grid media, every boundary and phase, a constant
+# environment); the box kernels compile no mesh code. What this checks:
 #   1. `volpt info` describes a mesh boundary (shape line);
-#   2. whether the GPU takes a mesh scene. Main's kernels trace boxes and refuse it with the message
-#      that says to render it on the CPU ("OK refused"); a binary whose kernels take
-#      `volpt_core::DeviceBoundary` (docs/gpu.md, "Mesh boundaries") renders it, and then 6-9 run;
-#   3. CPU, 16 cores: scenes/mesh-cube (homogeneous-cube's box as a 24-triangle mesh) renders
+#   2. the GPU takes a mesh scene ("GPU takes meshes"), and refuses a strategy without mesh
+#      kernels (streaming-sk) with the strategies that have them;
+#   3. CPU, 16 cores: scenes/mesh-cube (homogeneous-cube's box as a mesh) renders
 #      homogeneous-cube's image bit for bit, and its segments per second against the box's (the
 #      distance grid's work: issue target >= 0.8x); the same for cgg-logo (its box written as the
 #      same mesh, scenes/cgg-logo/mesh.xml);
 #   4. CPU: the sphere mesh scene (Mitsuba `sphere`, 16,128 triangles) renders, and its speed;
-#   5. GPU: homogeneous-cube renders on the GPU bit for bit as on the CPU (naive-sk, exact math):
-#      the box kernels after the ABI change (SceneParams carries a mesh block);
-#   only where the GPU takes meshes:
+#   5. GPU: homogeneous-cube renders on the GPU bit for bit as on the CPU (naive-sk, exact math);
 #   6. GPU naive-sk exact = CPU, bit for bit: mesh-cube (and = the box's image), the sphere, a
 #      torus (non-convex: generated here as torus.obj, 4,608 triangles) with next-event estimation
-#      through an index-matched boundary (shadow rays cross two chords);
-#   7. every strategy (fast math, another seed) against the CPU's torus: `volpt compare --independent`;
+#      through an index-matched boundary (shadow rays cross two chords); each log names a `mesh__`
+#      kernel;
+#   7. regeneration-sk (fast math, another seed) against the CPU's torus: `volpt compare --independent`;
 #   8. the analytic absorber on the GPU: albedo 0, index-matched sphere, GPU exact = CPU bit for bit
 #      (the CPU's image is exp(-sigma_t chord) by `cargo test -p volpt-core --test mesh`);
-#   9. GPU speed: homogeneous-cube box vs mesh-cube, cgg-logo box vs mesh (segments/s, regeneration-sk).
+#   9. GPU speed: homogeneous-cube box vs mesh-cube, cgg-logo box vs mesh (segments/s, regeneration-sk,
+#      fast math, 400x400 at 64 spp; issue target >= 0.8x).
 # Run from a bundle (bin/volpt beside scenes/) or a checkout with VOLPT=target/release/volpt:
 #   bash bench/device/mesh.sh            -> $OUT/mesh.txt
-# Expected on main (about 40 s): the shape line with 24 triangles, "OK refused", "identical" three
-# times (box vs mesh CPU twice, box CPU vs GPU once), two CPU mesh/box ratio lines (~0.6), the
-# sphere's segments/s. With mesh kernels (about 90 s): "GPU takes meshes", then "identical" for
-# each GPU check of 6 and 8, "OK" per strategy in 7, and two GPU mesh/box ratio lines.
+# Expected (about 60 s on an H200): the shape line, "GPU takes meshes", "OK refused streaming-sk",
+# "identical" for the CPU box vs mesh (twice), box CPU vs GPU, mesh-cube, sphere, torus and the
+# absorber, "OK torus regeneration-sk", the CPU ratio lines (~0.6), the sphere's segments/s, two GPU
+# mesh/box ratio lines, and no line starting with FAIL.
 set -uo pipefail
 cd "$(dirname "$0")"
 [ -d scenes ] || cd ../..
@@ -41,13 +42,20 @@ log "# $(date -u +%Y-%m-%dT%H:%MZ) $(nvidia-smi --query-gpu=name --format=csv,no
 # 1. info
 "$VOLPT" info scenes/mesh-cube/scene.xml 2>&1 | grep -E "^(shape|bounds|variant)" | tee -a "$OUT/mesh.txt"
 
-# 2. does the GPU take a mesh? (main: no, it refuses with the CPU message)
+# 2. the GPU takes a mesh (its mesh kernels), and refuses a strategy that has none
 gpu_meshes=0
-if "$VOLPT" render scenes/mesh-cube/scene.xml --backend cuda --spp 1 --resolution 16x16 -o "$OUT/probe.exr" >"$OUT/refused.log" 2>&1; then
+if RUST_LOG=volpt_cuda=info "$VOLPT" render scenes/mesh-cube/scene.xml --backend cuda --spp 1 --resolution 16x16 \
+    -o "$OUT/probe.exr" >"$OUT/probe.log" 2>&1; then
     gpu_meshes=1
-    log "GPU takes meshes"
-elif grep -q "trace box boundaries only" "$OUT/refused.log"; then
-    log "OK refused: $(grep -o 'the GPU kernels trace box boundaries only[^)]*)' "$OUT/refused.log" | head -n 1)"
+    log "GPU takes meshes: $(grep -o 'mesh__[a-z0-9_]*' "$OUT/probe.log" | head -n 1)"
+else
+    log "FAIL the GPU refuses a mesh: $(tail -n 2 "$OUT/probe.log")"
+fi
+if "$VOLPT" render scenes/mesh-cube/scene.xml --backend cuda --strategy streaming-sk --spp 1 --resolution 16x16 \
+    -o "$OUT/refused.exr" >"$OUT/refused.log" 2>&1; then
+    log "FAIL streaming-sk rendered a mesh (no mesh kernel of it exists)"
+elif grep -q "are those of naive-sk, regeneration-sk only" "$OUT/refused.log"; then
+    log "OK refused streaming-sk: $(grep -o 'the GPU kernels for a scene with a triangle-mesh boundary[^(]*' "$OUT/refused.log" | head -n 1)"
 else
     log "FAIL unexpected error: $(tail -n 2 "$OUT/refused.log")"
 fi
@@ -106,7 +114,8 @@ same "box CPU vs GPU naive-sk exact" "$OUT/box.exr" "$OUT/box-gpu.exr"
 [ "$gpu_meshes" = 1 ] || exit 0
 
 # 6. GPU naive-sk exact = CPU on meshes
-"$VOLPT" render scenes/mesh-cube/scene.xml "${gpu_exact[@]}" -o "$OUT/mesh-gpu.exr" >"$OUT/mesh-gpu.log" 2>&1 || log "FAIL mesh-cube GPU render"
+RUST_LOG=volpt_cuda=info "$VOLPT" render scenes/mesh-cube/scene.xml "${gpu_exact[@]}" -o "$OUT/mesh-gpu.exr" >"$OUT/mesh-gpu.log" 2>&1 || log "FAIL mesh-cube GPU render"
+grep -q "mesh__naive_sk__" "$OUT/mesh-gpu.log" || log "FAIL mesh-cube's GPU log names no mesh__naive_sk kernel"
 same "mesh-cube GPU vs box CPU" "$OUT/box.exr" "$OUT/mesh-gpu.exr"
 "$VOLPT" render scenes/mesh-sphere/scene.xml "${gpu_exact[@]}" -o "$OUT/sphere-gpu.exr" >"$OUT/sphere-gpu.log" 2>&1 || log "FAIL sphere GPU render"
 same "sphere CPU vs GPU naive-sk exact" "$OUT/sphere.exr" "$OUT/sphere-gpu.exr"
@@ -141,9 +150,8 @@ torus=(scenes/mesh-sphere/torus.xml -D boundary=null -D sigma_t=3)
 "$VOLPT" render "${torus[@]}" "${gpu_exact[@]}" -o "$OUT/torus-gpu.exr" >"$OUT/torus-gpu.log" 2>&1 || log "FAIL torus GPU render"
 same "torus CPU vs GPU naive-sk exact" "$OUT/torus.exr" "$OUT/torus-gpu.exr"
 
-# 7. every strategy, fast math, against the CPU (statistically)
-for s in naive-sk regeneration-sk regeneration-warp-sk regeneration-block-sk regeneration-2p-sk \
-         streaming-sk streaming-sorted-sk sorting-sk naive-mk streaming-mk; do
+# 7. regeneration-sk, fast math, against the CPU (statistically)
+for s in regeneration-sk; do
     "$VOLPT" render "${torus[@]}" --backend cuda --strategy "$s" --spp "$SPP" --resolution "${RES}x${RES}" --seed 2 \
         -o "$OUT/torus-$s.exr" >"$OUT/torus-$s.log" 2>&1 || { log "FAIL torus $s render"; continue; }
     if "$VOLPT" compare "$OUT/torus.exr" "$OUT/torus-$s.exr" --independent >"$OUT/compare-torus-$s.log" 2>&1; then
@@ -167,5 +175,9 @@ for pair in "homogeneous-cube/scene.xml mesh-cube/scene.xml" "cgg-logo/scene.xml
     "$VOLPT" render "scenes/$2" "${gpu_speed[@]}" -o "$OUT/speed-mesh.exr" >"$OUT/speed-mesh.log" 2>&1 || log "FAIL $2 GPU speed render"
     box=$(seg "$OUT/speed-box.log")
     mesh=$(seg "$OUT/speed-mesh.log")
-    log "GPU segments/s $1 ${box:-?} M vs $2 ${mesh:-?} M, ratio $(python3 -c "print(f'{float(\"${mesh:-0}\")/float(\"${box:-1}\"):.3f}')" 2>/dev/null)"
+    # The default schedule (no --strategy: regeneration-sk with at most 64 registers) on the mesh.
+    "$VOLPT" render "scenes/$2" --backend cuda --spp 64 --resolution 400x400 --seed 1 -o "$OUT/speed-mesh-default.exr" \
+        >"$OUT/speed-mesh-default.log" 2>&1 || log "FAIL $2 GPU default-schedule render"
+    capped=$(seg "$OUT/speed-mesh-default.log")
+    log "GPU segments/s $1 ${box:-?} M vs $2 ${mesh:-?} M, ratio $(python3 -c "print(f'{float(\"${mesh:-0}\")/float(\"${box:-1}\"):.3f}')" 2>/dev/null); mesh with the default schedule (<= 64 registers) ${capped:-?} M"
 done

@@ -22,11 +22,12 @@ from ptx_cut import entries
 def kernels(path):
     text = open(path).read()
     # Names numbered or hashed module-wide, which differ when another kernel of the module changes
-    # or the checkout moves: other crates' symbols carry a hash of the crate's path (`Cs<hash>_`),
-    # constants an `anon_$_<hash>`, and local depots, call sequences and switch tables a counter.
+    # (or one is added before it) or the checkout moves: other crates' symbols carry a hash of the crate's path (`Cs<hash>_`),
+    # constants an `anon_$_<hash>`, and local depots, call sequences, switch tables and basic-block
+    # labels (`$L__BB<function>_<block>`) a counter.
     for pattern, by in [(r"Cs[0-9A-Za-z]+_(?=[0-9])", "Cs_"), (r"anon_\$_[0-9a-f]+_\$_", "anon_$_"),
                         (r"__local_depot\d+", "__local_depot"), (r"callseq \d+", "callseq"),
-                        (r"(switch_\$_table_\$_\w+?)\d+\b", r"\1")]:
+                        (r"(switch_\$_table_\$_\w+?)\d+\b", r"\1"), (r"\$L__BB\d+_", "$L__BB_")]:
         text = re.sub(pattern, by, text)
     lines = text.split("\n")
     return {name: lines[first:end + 1] for name, first, end in entries(lines)}

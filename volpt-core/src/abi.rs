@@ -26,7 +26,7 @@ use crate::grid::{Grid, GridLayout, GridLookup, GridMapping, GridPlacement, Texe
 use crate::light::{Lights, LightsParams};
 use crate::mesh::{BvhNode, MeshTriangle, SurfaceDistance, TriangleMesh};
 use crate::path::{Estimator, PathSettings, Roulette};
-use crate::scene::{Scene, VolumeScene};
+use crate::scene::{Lit, Scene, VolumeScene};
 use crate::shape::{BoundaryShape, DeviceBoundary, Shape};
 use crate::{Bsdf, Environment, Medium, PhaseFunction};
 use crate::{Vec2, Vec3};
@@ -400,10 +400,11 @@ pub trait SceneAbi: Scene + Sized {
     fn names() -> [&'static str; 4];
     fn to_params(&self, upload: &mut Upload<'_>) -> Self::Params;
 
-    /// Whether the kernels can render this scene: not one whose boundary is a mesh. The
-    /// parameters carry a mesh's BVH, but the kernels rebuild every scene as a box scene
-    /// (`volpt_device::launch::Scene`): a kernel that takes [`SceneAbi::Kernel`] instead traces
-    /// meshes too, at the price of registers in every box kernel (docs/gpu.md, meshes).
+    /// Whether the box kernels can render this scene: not one whose boundary is a mesh. The
+    /// parameters carry a mesh's BVH, but the box kernels rebuild every scene as a box scene;
+    /// the mesh kernels (`volpt_device::KernelSet::Mesh`), of [`SceneAbi::Kernel`] types, trace
+    /// meshes too (a run-time branch there would cost every box kernel registers: docs/gpu.md,
+    /// meshes).
     fn on_device(&self) -> bool;
 
     /// This scene rebuilt from its parameters with its boundary a [`DeviceBoundary`], the shape a
@@ -617,5 +618,30 @@ where
                 settings: PathSettings::from(&p.settings),
             }
         }
+    }
+}
+
+/// A scene with its lights travels as the scene does (its parameters always carry them).
+impl<S: SceneAbi> SceneAbi for Lit<S> {
+    type Params = S::Params;
+
+    fn names() -> [&'static str; 4] {
+        S::names()
+    }
+
+    type Kernel = Lit<S::Kernel>;
+
+    fn on_device(&self) -> bool {
+        self.0.on_device()
+    }
+
+    fn to_params(&self, upload: &mut Upload<'_>) -> Self::Params {
+        self.0.to_params(upload)
+    }
+
+    #[inline(always)]
+    unsafe fn from_params(p: &Self::Params) -> Self {
+        // SAFETY: forwarded to the caller.
+        Lit(unsafe { S::from_params(p) })
     }
 }

@@ -63,7 +63,7 @@ pub use mesh::{BvhNode, MeshTriangle, TriangleMesh};
 pub use path::{Estimator, PathCounters, PathOf, PathSettings, PathState, Roulette};
 pub use phase::{HenyeyGreenstein, Isotropic, PhaseFunction};
 pub use rng::Rng;
-pub use scene::{Scene, VolumeScene, WithShape};
+pub use scene::{Lit, Scene, VolumeScene, WithShape};
 pub use shape::{BoundaryShape, DeviceBoundary, Shape};
 pub use spectral::{HeroChannel, SpectralState};
 

@@ -10,7 +10,8 @@
 //!
 //! A scene holds at most one light of each kind ([`Lights`]): fixed slots keep the kernels free of
 //! an indexed array (which a GPU would place in local memory), and a light that is off costs one
-//! branch per scattering event.
+//! branch per scattering event. Whether a scene type traces them at all is the type's
+//! ([`Scene::LIGHTS`]): the GPU's box kernels compile without them, its lit kernels with them.
 
 use bytemuck::{Pod, Zeroable};
 
@@ -74,7 +75,7 @@ impl DirectionalLight {
 
     #[inline(always)]
     pub fn is_on(&self) -> bool {
-        ENABLED && self.radiance.max_element() > 0.0
+        self.radiance.max_element() > 0.0
     }
 
     /// Whether the light is a single direction (reached only by next-event estimation).
@@ -179,7 +180,7 @@ impl SpotLight {
 
     #[inline(always)]
     pub fn is_on(&self) -> bool {
-        ENABLED && self.intensity.max_element() > 0.0
+        self.intensity.max_element() > 0.0
     }
 
     /// Whether the light shines in every direction (Mitsuba's `point`).
@@ -365,19 +366,30 @@ pub(crate) fn sample_spot(spot: &SpotLight, p: Vec3) -> Option<LightSample> {
     })
 }
 
-/// Whether this build traces the lights besides the environment: the CPU's does, the GPU
-/// kernels' not yet. Sampled in the index-matched kernels, the lights raised those kernels'
-/// registers (smoke's from 80 to 128, 158 before each light was sampled in its turn) and cost
-/// grey scenes without lights up to 41% under regeneration-sk and 4-5% under the defaults
-/// (H200, 2026-11-29, `bench/results/2026-11-29-h200-session11`). Until that cost is gone the
-/// kernels compile without them, exactly as before the lights, and the GPU refuses a scene with a
-/// light on (`volpt_cuda::CudaError::Lights`).
-pub const ENABLED: bool = !cfg!(target_arch = "nvptx64");
+/// Whether paths of `scene` reach any of its lights besides the environment: any light that is on
+/// behind an index-matched boundary; behind a dielectric one only a sun with extent, by escaping
+/// into its disc (a delta light adds nothing there, and draws no random number). A scene whose
+/// paths reach none renders exactly as without its lights: the GPU's box kernels render it.
+pub fn reached<S: Scene>(scene: &S) -> bool {
+    let lights = scene.lights();
+    if S::Bsdf::IS_NULL {
+        lights.any()
+    } else {
+        lights.sun.is_on() && !lights.sun.is_delta()
+    }
+}
 
-/// Next-event estimation's light slots: the environment, the sun, the point or spot; the
-/// environment's alone where the build has no lights ([`ENABLED`]), so that the GPU's loop is
-/// the straight code of one sample.
-pub(crate) const SLOTS: u32 = if ENABLED { 3 } else { 1 };
+/// Next-event estimation's light slots in a scene of type `S`: the environment, the sun, the point
+/// or spot; the environment's alone where the type has no lights ([`Scene::LIGHTS`]), so that the
+/// loop of an unlit kernel is the straight code of one sample.
+#[inline(always)]
+pub(crate) const fn slots<S: Scene>() -> u32 {
+    if S::LIGHTS {
+        3
+    } else {
+        1
+    }
+}
 
 /// Slot `slot`'s sample for next-event estimation from a collision at `p` (0: the environment's,
 /// where `environment`; 1: the sun's; 2: the point or spot's; `None` for a light that is off or
@@ -435,7 +447,7 @@ impl From<crate::environment::LightSample> for LightSample {
 #[inline(always)]
 pub(crate) fn escaped_sun<S: Scene>(scene: &S, path: &PathOf<S>) -> Spectrum {
     let sun = &scene.lights().sun;
-    if !sun.is_on() || !sun.sees(path.ray.dir) {
+    if !S::LIGHTS || !sun.is_on() || !sun.sees(path.ray.dir) {
         return Spectrum::ZERO;
     }
     let light = path.spectral.weight(path.throughput) * sun.radiance;

@@ -414,7 +414,7 @@ pub fn scatter<S: Scene>(scene: &S, path: &mut PathOf<S>, p: Vec3, albedo: Optio
     let phase = collision_phase(scene, p);
     // The scene's other lights are sampled behind an index-matched boundary whatever the
     // estimator: a delta light is reached by no other strategy.
-    let lights = S::Bsdf::IS_NULL && scene.lights().any();
+    let lights = S::Bsdf::IS_NULL && S::LIGHTS && scene.lights().any();
     if (next_event || lights) && !next_event_estimate(scene, path, p, &phase, next_event) {
         return;
     }
@@ -459,7 +459,7 @@ fn next_event_estimate<S: Scene>(
     // One loop over the lights and one body: one copy of ratio tracking in the kernels. Each
     // light is sampled in its turn: samples drawn before the loop would all stay live through its
     // ratio tracking (smoke's kernel took 158 registers instead of 80 so).
-    for slot in 0..light::SLOTS {
+    for slot in 0..const { light::slots::<S>() } {
         let Some(light) = light::sample(scene, path, p, slot, environment) else {
             continue;
         };

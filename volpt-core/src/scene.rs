@@ -22,6 +22,11 @@ pub trait Scene {
     type Environment: Environment;
     type Shape: Shape;
 
+    /// Whether this scene type traces the lights besides the environment ([`Scene::lights`]): a
+    /// property of the type, so that a GPU kernel of a type without them compiles none of their
+    /// code; a scene type with them samples those that are on (a run-time branch).
+    const LIGHTS: bool = true;
+
     fn camera(&self) -> &PerspectiveCamera;
     /// The boundary's geometry.
     fn shape(&self) -> &Self::Shape;
@@ -71,6 +76,14 @@ impl<M: Medium, B: Bsdf, P: PhaseFunction, E: Environment, S: Shape> Scene
     type Phase = P;
     type Environment = E;
     type Shape = S;
+
+    /// On the CPU, yes; in a GPU kernel, only as [`Lit`]`<VolumeScene>`: the box kernels
+    /// (`volpt_device::KernelSet::Box`) are of this type and compile without the lights, exactly
+    /// as before there were any. Sampled at run time in every kernel, the lights raised their
+    /// registers (smoke's index-matched kernel from 80 to 158) and cost grey scenes without lights
+    /// up to 41% under regeneration-sk (H200, 2026-11-29, `bench/results/2026-11-29-h200-session11`);
+    /// a scene with a light on gets a kernel of the lit set instead.
+    const LIGHTS: bool = !cfg!(target_arch = "nvptx64");
 
     #[inline]
     fn camera(&self) -> &PerspectiveCamera {
@@ -125,6 +138,8 @@ impl<S: Scene, Sh: Shape> Scene for WithShape<'_, S, Sh> {
     type Environment = S::Environment;
     type Shape = Sh;
 
+    const LIGHTS: bool = S::LIGHTS;
+
     #[inline]
     fn camera(&self) -> &PerspectiveCamera {
         self.scene.camera()
@@ -156,5 +171,62 @@ impl<S: Scene, Sh: Shape> Scene for WithShape<'_, S, Sh> {
     #[inline]
     fn settings(&self) -> &PathSettings {
         self.scene.settings()
+    }
+}
+
+/// `scene` with the lights besides the environment, as a type: its [`Scene::LIGHTS`] is true
+/// wherever it is compiled. The GPU's lit kernels (`volpt_device::KernelSet::Lit`) are of this
+/// type; the box kernels, of the plain [`VolumeScene`], compile without the lights.
+#[derive(Clone, Copy, Debug)]
+pub struct Lit<S>(pub S);
+
+impl<S: Scene> Scene for Lit<S> {
+    type Medium = S::Medium;
+    type Bsdf = S::Bsdf;
+    type Phase = S::Phase;
+    type Environment = S::Environment;
+    type Shape = S::Shape;
+
+    const LIGHTS: bool = true;
+
+    #[inline(always)]
+    fn camera(&self) -> &PerspectiveCamera {
+        self.0.camera()
+    }
+    #[inline(always)]
+    fn shape(&self) -> &S::Shape {
+        self.0.shape()
+    }
+    #[inline(always)]
+    fn bounds(&self) -> Aabb {
+        self.0.bounds()
+    }
+    #[inline(always)]
+    fn medium(&self) -> &S::Medium {
+        self.0.medium()
+    }
+    #[inline(always)]
+    fn boundary(&self) -> &S::Bsdf {
+        self.0.boundary()
+    }
+    #[inline(always)]
+    fn phase(&self) -> &S::Phase {
+        self.0.phase()
+    }
+    #[inline(always)]
+    fn environment(&self) -> &S::Environment {
+        self.0.environment()
+    }
+    #[inline(always)]
+    fn lights(&self) -> &Lights {
+        self.0.lights()
+    }
+    #[inline(always)]
+    fn settings(&self) -> &PathSettings {
+        self.0.settings()
+    }
+    #[inline(always)]
+    fn background(&self, dir: Vec3) -> Spectrum {
+        self.0.background(dir)
     }
 }

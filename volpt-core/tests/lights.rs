@@ -357,3 +357,125 @@ fn a_spot_light_in_a_chromatic_medium_gives_each_channels_single_scattering_inte
         assert_mean(&m[c], expected, &format!("channel {c}"));
     }
 }
+
+/// `S` as a type without the lights besides the environment ([`Scene::LIGHTS`] false), as the
+/// GPU's box kernels see every scene (there, `VolumeScene` is such a type).
+#[derive(Clone, Copy)]
+struct Unlit<S>(S);
+
+impl<S: Scene> Scene for Unlit<S> {
+    type Medium = S::Medium;
+    type Bsdf = S::Bsdf;
+    type Phase = S::Phase;
+    type Environment = S::Environment;
+    type Shape = S::Shape;
+    const LIGHTS: bool = false;
+    fn camera(&self) -> &PerspectiveCamera {
+        self.0.camera()
+    }
+    fn shape(&self) -> &S::Shape {
+        self.0.shape()
+    }
+    fn medium(&self) -> &S::Medium {
+        self.0.medium()
+    }
+    fn boundary(&self) -> &S::Bsdf {
+        self.0.boundary()
+    }
+    fn phase(&self) -> &S::Phase {
+        self.0.phase()
+    }
+    fn environment(&self) -> &S::Environment {
+        self.0.environment()
+    }
+    fn lights(&self) -> &Lights {
+        self.0.lights()
+    }
+    fn settings(&self) -> &PathSettings {
+        self.0.settings()
+    }
+}
+
+/// Every pixel's radiance sum over `spp` samples (the CPU's and naive-sk's per-pixel loop) and
+/// the paths' segments.
+fn image<S: Scene>(scene: &S, spp: u32) -> (Vec<[f64; 3]>, u64) {
+    let camera = scene.camera();
+    let mut counters = volpt_core::path::PathCounters::default();
+    let mut sums = Vec::new();
+    for py in 0..camera.height {
+        for px in 0..camera.width {
+            let mut sum = [0.0; 3];
+            volpt_core::path::sample_pixel(scene, (px, py), 0..spp, 5, &mut sum, &mut counters);
+            sums.push(sum);
+        }
+    }
+    (sums, counters.segments)
+}
+
+/// A spot in fog behind an index-matched boundary, a sun with extent above it, a grey
+/// environment, multiple scattering: every light and the environment matter.
+fn fog<B>(
+    boundary: B,
+    lights: Lights,
+) -> VolumeScene<HomogeneousMedium, B, HenyeyGreenstein, ConstantEnvironment> {
+    VolumeScene {
+        camera: camera(),
+        bounds: Aabb::new(Vec3::splat(-1.5), Vec3::splat(1.5)),
+        medium: HomogeneousMedium {
+            sigma_t: 1.2,
+            albedo: Spectrum::splat(0.8),
+        },
+        boundary,
+        phase: HenyeyGreenstein { g: 0.3 },
+        environment: ConstantEnvironment(Spectrum::splat(0.2)),
+        lights,
+        settings: PathSettings {
+            estimator: Estimator::NextEvent,
+            ..PathSettings::default()
+        },
+    }
+}
+
+fn sun_and_spot(sun_radius: f32) -> Lights {
+    Lights {
+        sun: DirectionalLight::new(Vec3::new(0.2, -1.0, 0.3), sun_radius, Spectrum::splat(3.0)),
+        spot: SpotLight::spot(
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(0.0, -1.0, 0.0),
+            Spectrum::splat(2.0),
+            50f32.to_radians(),
+            20f32.to_radians(),
+        ),
+    }
+}
+
+/// The switch the GPU's kernel sets rest on: a scene type without lights (the box kernels')
+/// renders a lit scene exactly as the same scene without its lights (same paths, same random
+/// numbers), so its kernels need no light code; the lit type (`volpt_core::Lit`, the lit
+/// kernels') renders the CPU's image of the lit scene bit for bit, and that image differs.
+#[test]
+fn a_scene_type_without_lights_renders_the_scene_as_without_them_and_the_lit_type_as_the_cpu() {
+    let lit = fog(NullBoundary, sun_and_spot(0.3));
+    let dark = fog(NullBoundary, Lights::NONE);
+    let (lit_image, lit_segments) = image(&lit, 8);
+    let (dark_image, dark_segments) = image(&dark, 8);
+    assert_ne!(lit_image, dark_image, "the lights must show");
+    assert_eq!(image(&Unlit(lit), 8), (dark_image, dark_segments));
+    assert_eq!(image(&volpt_core::Lit(lit), 8), (lit_image, lit_segments));
+    assert!(volpt_core::light::reached(&lit));
+    assert!(!volpt_core::light::reached(&dark));
+}
+
+/// Behind a dielectric boundary a delta light adds nothing and draws no random number, so the
+/// box kernels render such a scene exactly (`volpt_core::light::reached` is false); a sun with
+/// extent is reached by escaping paths, and needs the lights.
+#[test]
+fn a_delta_light_behind_a_dielectric_renders_as_without_lights_and_a_sun_disc_does_not() {
+    let boundary = volpt_core::SmoothDielectric { eta: 1.33 };
+    let delta = fog(boundary, sun_and_spot(0.0));
+    assert!(!volpt_core::light::reached(&delta));
+    assert_eq!(image(&delta, 8), image(&fog(boundary, Lights::NONE), 8));
+    let disc = fog(boundary, sun_and_spot(0.3));
+    assert!(volpt_core::light::reached(&disc));
+    assert_ne!(image(&disc, 8).0, image(&fog(boundary, Lights::NONE), 8).0);
+}

@@ -34,15 +34,27 @@ pub enum CudaError {
     #[error(transparent)]
     Empty(#[from] volpt_film::NothingToRender),
     #[error(
-        "the GPU kernels trace box boundaries only: a triangle-mesh boundary renders on the CPU \
-         (--backend cpu)"
+        "the GPU kernels trace lights besides the environment or a triangle-mesh boundary, not \
+         both: this scene renders on the CPU (--backend cpu)"
     )]
-    MeshBoundary,
+    LightsAndMesh,
+    /// A scene that needs a kernel set ([`volpt_device::KernelSet`]) rendered with a strategy
+    /// that set has no kernels for.
     #[error(
-        "the GPU kernels have no lights besides the environment yet: a scene with a sun, point or \
-         spot light renders on the CPU (--backend cpu)"
+        "the GPU kernels for a scene with {what} are those of {strategies} only, not {strategy}: \
+         choose one of those (--strategy), or auto"
     )]
-    Lights,
+    SetStrategy {
+        what: &'static str,
+        strategy: volpt_device::Strategy,
+        strategies: String,
+    },
+    /// A scene that needs a kernel set of a variant the set does not cover.
+    #[error(
+        "the GPU kernels for a scene with {what} do not cover this scene's parts ({variant}): it \
+         renders on the CPU (--backend cpu)"
+    )]
+    SetVariant { what: &'static str, variant: String },
     #[error(transparent)]
     Volume(#[from] volpt_gpu_mem::GpuMemError),
     #[error("CUDA driver call failed while {doing}: {source}")]

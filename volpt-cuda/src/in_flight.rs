@@ -21,7 +21,7 @@ use volpt_device::launch::{Scheduling, Stage, Tile, Wavefront, BLOCK_SIZE, SLOT_
 use volpt_device::LaunchParams;
 use volpt_film::{Film, RenderOptions, RenderStats};
 
-use crate::entry::entry_name;
+use crate::entry::scene_entry;
 use crate::error::{CudaError, Doing};
 use crate::renderer::{
     ByValue, FilmHeld, RenderBuffers, Schedule, DEFAULT_REFILL_AT, WAVEFRONT_BATCH,
@@ -116,7 +116,7 @@ impl CudaRenderer {
         };
         let (width, height) = (scene.camera().width, scene.camera().height);
         film.check_pass((width, height), &samples)?;
-        let name = entry_name::<S>(strategy);
+        let name = scene_entry(scene, strategy)?;
         let kernel = self.kernel(&name, schedule.max_registers)?;
         let stream = self.stream();
         // SAFETY: the caller's contract; `volumes` is dropped before this returns.

@@ -2,7 +2,8 @@
 //!
 //! The scene's grids are copied to device memory once per render, the film (`f64` sums, as on the
 //! CPU) lives on the device for the whole render, and only the final sums come back. The kernel is
-//! the scene type's own ([`entry_name`]), so the GPU simulates exactly the effects the CPU would.
+//! the scene type's own ([`scene_entry`]: in the kernel set its lights or mesh need), so the GPU
+//! simulates exactly the effects the CPU would.
 
 use std::cell::Cell;
 use std::collections::HashMap;
@@ -25,7 +26,7 @@ use volpt_device::{LaunchParams, Math, Strategy};
 use volpt_film::{Film, Image, RenderOptions, RenderStats};
 use volpt_gpu_mem::{ResidentGrids, VolumePlacer, VolumePolicy};
 
-use crate::entry::{entry_name, single_kernel_ptx};
+use crate::entry::{scene_entry, single_kernel_ptx};
 use crate::error::{CudaError, Doing};
 use crate::kernels::{self, KernelPack};
 
@@ -274,12 +275,19 @@ impl CudaRenderer {
             .map_err(|_| CudaError::MissingKernel(entry.to_owned()))
     }
 
-    /// Compiles the kernel that a render of `S` under `schedule` launches, which the first such
-    /// render would do (several GPUs do it at once, before their render starts).
-    pub fn load_kernel<S: SceneAbi>(&self, schedule: impl Into<Schedule>) -> Result<(), CudaError> {
+    /// Compiles the kernel that a render of `scene` under `schedule` launches, which the first
+    /// such render would do (several GPUs do it at once, before their render starts).
+    pub fn load_kernel<S: SceneAbi>(
+        &self,
+        scene: &S,
+        schedule: impl Into<Schedule>,
+    ) -> Result<(), CudaError> {
         let schedule = schedule.into();
-        self.kernel(&entry_name::<S>(schedule.strategy), schedule.max_registers)
-            .map(drop)
+        self.kernel(
+            &scene_entry(scene, schedule.strategy)?,
+            schedule.max_registers,
+        )
+        .map(drop)
     }
 
     /// Places the grids of the scene numbered `grids` on this GPU now, where the next
@@ -336,12 +344,6 @@ impl CudaRenderer {
         scene: &S,
         keep: Option<u64>,
     ) -> Result<(VolumePlacer, S::Params), CudaError> {
-        if !scene.on_device() {
-            return Err(CudaError::MeshBoundary);
-        }
-        if scene.lights().any() {
-            return Err(CudaError::Lights);
-        }
         // SAFETY: the grids are `scene`'s, borrowed by the caller for as long as it holds the
         // placer.
         let mut volumes = unsafe { VolumePlacer::new(self.stream.clone(), self.volumes) }?;
@@ -450,7 +452,7 @@ impl CudaRenderer {
         film.check_pass((width, height), &samples)?;
         let schedule = schedule.into();
         let strategy = schedule.strategy;
-        let name = entry_name::<S>(strategy);
+        let name = scene_entry(scene, strategy)?;
         let kernel = self.kernel(&name, schedule.max_registers)?;
         let stream = &self.stream;
 

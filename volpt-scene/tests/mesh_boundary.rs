@@ -362,3 +362,56 @@ fn the_threaded_bvh_build_is_the_serial_one() {
         }
     }
 }
+
+/// The warnings `f` logs, captured.
+fn warnings_of<T>(f: impl FnOnce() -> T) -> (T, String) {
+    use std::sync::{Arc, Mutex};
+    #[derive(Clone, Default)]
+    struct Buffer(Arc<Mutex<Vec<u8>>>);
+    impl std::io::Write for Buffer {
+        fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
+            self.0.lock().unwrap().extend_from_slice(b);
+            Ok(b.len())
+        }
+        fn flush(&mut self) -> std::io::Result<()> {
+            Ok(())
+        }
+    }
+    let buffer = Buffer::default();
+    let writer = buffer.clone();
+    let subscriber = tracing_subscriber::fmt()
+        .with_max_level(tracing::Level::WARN)
+        .with_writer(move || writer.clone())
+        .with_ansi(false)
+        .finish();
+    let value = tracing::subscriber::with_default(subscriber, f);
+    let text = String::from_utf8_lossy(&buffer.0.lock().unwrap()).into_owned();
+    (value, text)
+}
+
+/// Mitsuba 3 shades an `obj` or `ply` with interpolated vertex normals unless `face_normals` is
+/// true; volpt refracts at the triangles' own normals, so the loader says so where the two would
+/// render different surfaces, naming the shape, and is silent with `face_normals="true"`.
+#[test]
+fn a_mesh_mitsuba_would_shade_with_vertex_normals_is_named_in_a_warning() {
+    for (face_normals, warned) in [
+        ("", true),
+        ("<boolean name=\"face_normals\" value=\"true\"/>", false),
+    ] {
+        let (dir, path) = scene_file(&mitsuba(
+            &format!("<string name=\"filename\" value=\"octahedron.ply\"/>{face_normals}"),
+            "ply",
+        ));
+        std::fs::write(dir.path().join("octahedron.ply"), octahedron_ply()).unwrap();
+        let (desc, warnings) = warnings_of(|| load_mitsuba(&path));
+        desc.expect("scene loads");
+        assert_eq!(
+            warnings.contains("interpolated vertex normals"),
+            warned,
+            "face_normals {face_normals:?}: {warnings}"
+        );
+        if warned {
+            assert!(warnings.contains("<shape type=\"ply\">"), "{warnings}");
+        }
+    }
+}

@@ -164,8 +164,13 @@ pub fn calibrate<S: SceneAbi>(
             seconds_per_mpath: best.as_secs_f64() / (pixels * spp as u64) as f64 * 1e6,
         })
     };
+    // A scene with a light on or a mesh boundary has kernels for its set's strategies only.
+    let set = volpt_device::KernelSet::of_scene(scene);
+    let timed = TIMED
+        .into_iter()
+        .filter(|s| set.is_none_or(|set| set.strategies().contains(s)));
     let mut measurements = Vec::new();
-    for strategy in TIMED {
+    for strategy in timed {
         measurements.push(time(strategy.into())?);
     }
     let winner = fastest(&measurements).strategy.clone();

@@ -726,6 +726,30 @@ fn schedule(gpu: &GpuOptions) -> Result<Option<Schedule>, Error> {
     }
 }
 
+/// Refuses `strategy` for a scene whose kernel set ([`volpt_device::KernelSet`]: a light on, a
+/// mesh boundary) has no kernel of it, naming the strategies that have one; `auto` chooses among
+/// those ([`auto::calibrate`]).
+fn refuse_strategy_without_kernels<S: RenderScene>(
+    scene: &S,
+    strategy: Strategy,
+) -> Result<(), Error> {
+    match volpt_device::KernelSet::of_scene(scene) {
+        Some(set) if !set.strategies().contains(&strategy) => Err(Error::conflict(
+            StrategyChoice::KEY,
+            strategy,
+            BackendKind::KEY,
+            BackendKind::Cuda.name(),
+            format!(
+                "the GPU kernels for a scene with {} are those of {} only",
+                set.what(),
+                volpt_cuda::entry::strategy_names(set)
+            ),
+        )
+        .or_use(StrategyChoice::KEY, auto::DEFAULT.strategy)),
+        _ => Ok(()),
+    }
+}
+
 /// One render, handed the monomorphised scene by the factory.
 struct Render<'a> {
     backend: &'a Backend,
@@ -806,6 +830,10 @@ impl SceneVisitor for Render<'_> {
             }
         };
 
+        for schedule in schedules.iter().flatten() {
+            refuse_strategy_without_kernels(scene, schedule.strategy)?;
+        }
+
         // Several devices: batches from one queue, added in batch order.
         let devices: Vec<multi::Device<'_>> = match &backend.0 {
             Inner::CpuDevices(n) => (0..*n)
@@ -851,7 +879,7 @@ impl SceneVisitor for Render<'_> {
                         .filter_map(|(renderer, schedule)| {
                             let schedule = (*schedule)?;
                             Some(threads.spawn(move || {
-                                renderer.load_kernel::<S>(schedule)?;
+                                renderer.load_kernel(scene, schedule)?;
                                 // SAFETY: as the batches' renders below.
                                 unsafe { renderer.keep_grids(scene, grids) }
                             }))

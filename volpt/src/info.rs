@@ -102,11 +102,12 @@ pub fn describe(
             None => "box: one slab test per crossing".to_owned(),
             Some(mesh) => format!(
                 "closed triangle mesh from {}: {} triangles, BVH of {} nodes (bounds: its \
-                 bounding box); one ray cast per crossing; renders on the CPU (the GPU kernels \
-                 trace boxes)",
+                 bounding box); one ray cast per crossing; on the GPU by the mesh kernels \
+                 ({}; homogeneous and dense-grid media under a constant environment)",
                 mesh.source,
                 mesh.triangle_count(),
-                mesh.buffers.nodes.len()
+                mesh.buffers.nodes.len(),
+                volpt_cuda::entry::strategy_names(volpt_device::KernelSet::Mesh)
             ),
         },
     );

@@ -9,7 +9,6 @@
 use bytemuck::{Pod, Zeroable};
 
 pub use volpt_core::abi::SceneAbi;
-pub use volpt_core::VolumeScene as Scene;
 
 use crate::Strategy;
 

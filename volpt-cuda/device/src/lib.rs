@@ -9,6 +9,9 @@
 //! - [`export_kernels!`]: exports the kernels of every strategy for one scene type. The workspace's
 //!   kernels crate invokes it for every variant of the registry; a library user invokes it for a
 //!   scene of their own parts (see `docs/extending.md`).
+//! - [`KernelSet`]: the box kernels, and the limited sets of kernels for lights and for meshes
+//!   ([`kernel_set`]; [`export_set_kernels!`] exports them), so that the box kernels of scenes
+//!   without either compile none of their code.
 //! - [`selftest`]: kernels that test the strategies' collective building blocks, texture lookups
 //!   and `volpt_core::math` against the CPU.
 //! - [`tone`]: the viewer's tone mapping (exposure, sRGB, 8 bits) on the GPU, beside the film.
@@ -23,6 +26,7 @@
 #[cfg(feature = "clap")]
 extern crate std;
 
+pub mod kernel_set;
 pub mod launch;
 mod math;
 pub mod order;
@@ -35,6 +39,7 @@ pub mod nvptx;
 #[cfg(target_arch = "nvptx64")]
 pub mod strategy;
 
+pub use kernel_set::KernelSet;
 pub use launch::LaunchParams;
 pub use math::Math;
 pub use strategies::Strategy;

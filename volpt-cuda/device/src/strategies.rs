@@ -34,9 +34,10 @@ macro_rules! strategies {
     };
 }
 
-/// The kernels of every strategy for one scene type `VolumeScene<M, B, P, E>`, exported as
-/// `<kernel function>__<m>__<b>__<p>__<e>`: the names must be the parts' `Component::NAME`s, which is how
-/// the host finds the entry point of a scene type.
+/// The kernels of every strategy for one scene type `VolumeScene<M, B, P, E>` (the box kernels,
+/// [`crate::kernel_set::BoxScene`]), exported as `<kernel function>__<m>__<b>__<p>__<e>`: the names
+/// must be the parts' `Component::NAME`s, which is how the host finds the entry point of a scene
+/// type.
 ///
 /// ```text
 /// volpt_device::export_kernels!(my_fog: MyFog, index_matched: NullBoundary,
@@ -47,8 +48,26 @@ macro_rules! export_kernels {
     ($m:ident: $mt:ty, $b:ident: $bt:ty, $p:ident: $pt:ty, $e:ident: $et:ty $(,)?) => {
         $crate::strategies! { $crate::export_kernels { @each ($m: $mt, $b: $bt, $p: $pt, $e: $et) } }
     };
-    (@each ($m:ident: $mt:ty, $b:ident: $bt:ty, $p:ident: $pt:ty, $e:ident: $et:ty)
-     kernels [$($s:ident)*] strategies $strategies:tt) => {$(
+    (@each $variant:tt kernels [$($s:ident)*] strategies $strategies:tt) => {$(
+        $crate::export_kernel! { plain $s BoxScene $variant }
+    )*};
+}
+
+/// One kernel: kernel function `$s` for scene type `kernel_set::$scene<M, B, P, E>`, exported as
+/// `<kernel function>__<m>__<b>__<p>__<e>` (`plain`, the box kernels) or with its kernel set's
+/// prefix before it (`lit__...`, `mesh__...`).
+#[doc(hidden)]
+#[macro_export]
+macro_rules! export_kernel {
+    (plain $s:ident $scene:ident ($m:ident: $mt:ty, $b:ident: $bt:ty, $p:ident: $pt:ty, $e:ident: $et:ty)) => {
+        $crate::export_kernel! { @entry concat!(stringify!($s), "__", stringify!($m), "__", stringify!($b),
+            "__", stringify!($p), "__", stringify!($e)), $s $scene ($mt, $bt, $pt, $et) }
+    };
+    ($set:ident $s:ident $scene:ident ($m:ident: $mt:ty, $b:ident: $bt:ty, $p:ident: $pt:ty, $e:ident: $et:ty)) => {
+        $crate::export_kernel! { @entry concat!(stringify!($set), "__", stringify!($s), "__", stringify!($m),
+            "__", stringify!($b), "__", stringify!($p), "__", stringify!($e)), $s $scene ($mt, $bt, $pt, $et) }
+    };
+    (@entry $name:expr, $s:ident $scene:ident ($mt:ty, $bt:ty, $pt:ty, $et:ty)) => {
         const _: () = {
             /// The launch parameters come by value: they live in the kernel's constant bank, where
             /// every instruction can read them, instead of ~40 registers held across the path loop.
@@ -56,23 +75,22 @@ macro_rules! export_kernels {
             /// # Safety
             /// The grid, map and buffer addresses in `lp` must be device allocations that stay
             /// alive until the kernel ends, sized for this launch and scene type.
-            #[export_name = concat!(stringify!($s), "__", stringify!($m), "__", stringify!($b),
-                "__", stringify!($p), "__", stringify!($e))]
+            #[export_name = $name]
             pub unsafe extern "ptx-kernel" fn kernel(
                 lp: $crate::LaunchParams<
-                    <$crate::launch::Scene<$mt, $bt, $pt, $et> as $crate::launch::SceneAbi>::Params,
+                    <$crate::kernel_set::$scene<$mt, $bt, $pt, $et> as $crate::launch::SceneAbi>::Params,
                 >,
             ) {
                 // SAFETY: the grid and map addresses in `lp` are device allocations the host keeps
                 // alive.
                 let scene = unsafe {
-                    <$crate::launch::Scene<$mt, $bt, $pt, $et> as $crate::launch::SceneAbi>::from_params(&lp.scene)
+                    <$crate::kernel_set::$scene<$mt, $bt, $pt, $et> as $crate::launch::SceneAbi>::from_params(&lp.scene)
                 };
                 // SAFETY: `lp`'s buffers are sized for this launch.
                 unsafe { $crate::strategy::$s(&scene, &lp) }
             }
         };
-    )*};
+    };
 }
 
 macro_rules! define_strategy {

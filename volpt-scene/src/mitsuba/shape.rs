@@ -126,10 +126,25 @@ pub(crate) fn boundary(
             ));
         }
     }
-    // Shading details that do not change the geometry (vertex normals are not read yet).
+    // Mitsuba 3 shades an `obj` or `ply` with vertex normals unless `face_normals` is true: the
+    // file's, or where it has none, smoothed ones it computes (`Mesh::recompute_vertex_normals`).
+    // volpt refracts at each triangle's own normal (`face_normals`), a different surface.
+    let face_normals = match p.find(&["faceNormals", "face_normals"])? {
+        Some(arg) => arg.boolean()?,
+        None => false,
+    };
+    if matches!(kind, "obj" | "ply") && !face_normals {
+        tracing::warn!(
+            "{}, line {}: {}: Mitsuba 3 shades this mesh with interpolated vertex normals \
+             (face_normals is false); volpt refracts at each triangle's own normal, so the two \
+             render different surfaces: set face_normals=\"true\" for the surface volpt renders",
+            el.file.display(),
+            el.line,
+            el.describe()
+        );
+    }
+    // Shading details that do not change the geometry.
     p.ignore(&[
-        "faceNormals",
-        "face_normals",
         "maxSmoothAngle",
         "flipTexCoords",
         "flip_tex_coords",
