@@ -183,8 +183,9 @@ fn mesh_exit_distance(mesh: &TriangleMesh<'_>, ray: &Ray) -> f32 {
 /// The boundary as a kernel that traces meshes rebuilds it from the launch parameters
 /// ([`crate::abi::DeviceShape::Kernel`]): the box, and a mesh's BVH nodes and triangles (none for
 /// a box), so that one kernel serves both and a box pays a test of a launch parameter (`nodes`
-/// empty) per question. The kernels do not take it yet: it costs every box kernel registers
-/// (docs/gpu.md, meshes); the CPU renders it to check that it traces the CPU's paths.
+/// empty) per question. The mesh kernels take it (`volpt_device::KernelSet::Mesh`), the box
+/// kernels not: it costs a kernel registers (docs/gpu.md, kernel sets); the CPU renders it to
+/// check that it traces the CPU's paths.
 ///
 /// A mesh's ray cast is one out-of-line function of scalars ([`device_nearest`]): an aggregate
 /// argument (a `Vec3`, a `Ray`, a reference into the path or the scene) passed to a call that is
