@@ -19,8 +19,11 @@
 #    under 120 s (issue 40's target: <= 60 s); the lead records T and the per-iteration lines.
 # 3. The worked example's three 96 x 96 targets (examples/print: lines, photo, gradient) on the
 #    GPU, 100 layers, for bench/peers/mitsuba3/print.py (the Mitsuba 3 cross-check): records
-#    under $OUT/<target>/, each with print.toml and naive.toml. Expected: three summary lines,
-#    best mean below naive on each.
+#    under $OUT/<target>/, each with print.toml and naive.toml, predicted from 1024 samples per
+#    texel with the noise control at 0.1 (up to 16384): the record's means then measure the
+#    print, not the predictions' noise (docs/printing.md, "Noise floor"). And $OUT/white/: a
+#    uniform white 96 x 96 target's naive print (one prediction), the noise floor's reference.
+#    Expected: four summary lines, best mean below naive on each of the three.
 set -uo pipefail
 cd "$(dirname "$0")"
 OUT=${OUT:-$PWD/out/print}
@@ -33,17 +36,20 @@ log() { echo "== $*" | tee -a "$OUT/summary.txt"; }
 log "date $(date -u +%Y-%m-%dT%H:%MZ) $(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null)"
 [ -f "$EXAMPLES/materials.toml" ] || { log "FAIL no $EXAMPLES/materials.toml (the tracked tree)"; exit 2; }
 
-# The synthetic target: fine bars over the left half, a hue gradient on the right (8-bit RGB PNG).
-target() { # target SIZE FILE
-    python3 - "$1" "$2" <<'PY'
+# The synthetic target: fine bars over the left half, a hue gradient on the right (8-bit RGB PNG);
+# with a third argument `white`, a uniform white one.
+target() { # target SIZE FILE [white]
+    python3 - "$1" "$2" "${3:-}" <<'PY'
 import struct, sys, zlib
-n, path = int(sys.argv[1]), sys.argv[2]
+n, path, white = int(sys.argv[1]), sys.argv[2], sys.argv[3] == "white"
 bars = [(200, 60, 60), (60, 120, 200), (240, 220, 120)]
 rows = b""
 for y in range(n):
     row = bytearray(b"\x00")
     for x in range(n):
-        if x < n // 2:
+        if white:
+            row += bytes((255, 255, 255))
+        elif x < n // 2:
             row += bytes(bars[([1, 1, 2, 2, 4, 4, 4][x % 7] + x // 7) % 3])
         else:
             t = y / n
@@ -104,7 +110,10 @@ grep "iteration [0-9]*:" "$OUT/thesis-cuda.log" | sed 's/^/   /' | tee -a "$OUT/
 
 # 3. The worked example's targets, for the Mitsuba 3 cross-check.
 for name in lines photo gradient; do
-    compensate "$name" "$EXAMPLES/$name.png" --layers 100 --colour-layers 40 --spp 64 \
-        --max-spp 1024 --iterations 10 --backend cuda
+    compensate "$name" "$EXAMPLES/$name.png" --layers 100 --colour-layers 40 --spp 1024 \
+        --max-spp 16384 --noise-ratio 0.1 --iterations 10 --backend cuda
 done
+target 96 "$OUT/white96.png" white
+compensate white "$OUT/white96.png" --layers 100 --colour-layers 40 --spp 1024 --iterations 1 \
+    --backend cuda
 log "failures $failures"

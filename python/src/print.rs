@@ -9,7 +9,7 @@ use std::sync::Arc;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use volpt::BackendKind;
-use volpt_print::compensate::{CompensateError, Iteration, Options};
+use volpt_print::compensate::{CompensateError, Iteration, Options, Update};
 use volpt_print::job::{run_on, Job, JobError, Renderer};
 use volpt_print::predict::PredictError;
 
@@ -80,7 +80,8 @@ fn summary<'py>(py: Python<'py>, it: &Iteration) -> PyResult<Bound<'py, PyDict>>
 #[pyfunction]
 #[pyo3(signature = (target, materials, out, *, layers=100, colour_layers=40, voxel_size=None,
                     spp=16, max_spp=volpt_print::predict::RenderPredictor::MAX_SPP,
-                    iterations=None, step=None, noise_ratio=Some(0.25), ior=Some(1.5), seed=0,
+                    iterations=None, step=None, noise_ratio=Some(0.25), update="cross-talk",
+                    ior=Some(1.5), seed=0,
                     backend=None, render=None, progress=None, iteration=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn compensate_print<'py>(
@@ -96,6 +97,7 @@ pub fn compensate_print<'py>(
     iterations: Option<usize>,
     step: Option<f64>,
     noise_ratio: Option<f64>,
+    update: &str,
     ior: Option<f32>,
     seed: u32,
     backend: Option<Bound<'py, PyAny>>,
@@ -120,6 +122,15 @@ pub fn compensate_print<'py>(
             "render and backend: expected one of them (render renders every prediction itself)",
         ));
     }
+    let update = match update {
+        "cross-talk" => Update::CrossTalk,
+        "per-texel" => Update::PerTexel,
+        _ => {
+            return Err(SettingsError::new_err(format!(
+                "update: expected \"cross-talk\" or \"per-texel\", found {update:?}"
+            )))
+        }
+    };
     let iteration = iteration.map(Bound::unbind);
     let render = render.map(Bound::unbind);
     // No backend named: a GPU where one is usable, else the CPU (volpt::Backend::open_preferred).
@@ -144,6 +155,7 @@ pub fn compensate_print<'py>(
         max_iterations: iterations.unwrap_or(defaults.max_iterations),
         step: step.unwrap_or(defaults.step),
         noise_ratio,
+        update,
         ..defaults
     };
     let kind = backend

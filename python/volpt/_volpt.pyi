@@ -49,6 +49,7 @@ def compensate_print(
     iterations: Optional[int] = None,
     step: Optional[float] = None,
     noise_ratio: Optional[float] = 0.25,
+    update: str = "cross-talk",
     ior: Optional[float] = 1.5,
     seed: int = 0,
     backend: Union[str, Backend, None] = None,
@@ -65,7 +66,9 @@ def compensate_print(
     named cyan, magenta, yellow, black and white; optionally ``voxel_size``). Noise control: a
     prediction whose noise (the mean CIEDE2000 of one standard error) exceeds ``noise_ratio``
     times the update's step is made again with four times the samples, up to ``max_spp``
-    (``None`` turns it off). ``ior`` is the resin surface's (``None``: no surface).
+    (``None`` turns it off). ``update``: ``"cross-talk"`` corrects the aims through the print's
+    cross-texel response fitted from its predictions, ``"per-texel"`` each texel by its own error.
+    ``ior`` is the resin surface's (``None``: no surface).
 
     Writes into ``out``: target.png, prediction.png, comparison.png, iteration_NN/prediction.png
     and delta_e.png, iterations.csv, delta_e.svg and the best print's slice stack (slices/).

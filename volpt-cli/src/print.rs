@@ -9,7 +9,7 @@ use std::sync::Arc;
 use anyhow::Result;
 use clap::{Args, Subcommand};
 use volpt::{Backend, BackendOptions, Observer};
-use volpt_print::compensate::Options;
+use volpt_print::compensate::{Options, Update};
 use volpt_print::job::{run, Job};
 use volpt_print::predict::RenderPredictor;
 
@@ -25,9 +25,11 @@ pub enum PrintCommand {
     Compensate(CompensateArgs),
     /// The CIEDE2000 between a target PNG and a rendered image of the print (an OpenEXR, linear
     /// RGB, one pixel a texel: `volpt render print.toml`, or another renderer's image of the
-    /// record's scene): mean and 95th percentile, non-finite pixels left out and counted.
+    /// record's scene): mean and 95th percentile, non-finite pixels left out and counted. The
+    /// target may be an OpenEXR too: two renders of one scene with independent seeds measure
+    /// the noise floor (docs/printing.md).
     DeltaE {
-        /// The target (PNG, sRGB).
+        /// The target (PNG, sRGB; or OpenEXR, linear RGB).
         target: PathBuf,
         /// The rendered image (OpenEXR), the target's size.
         image: PathBuf,
@@ -77,6 +79,10 @@ pub struct CompensateArgs {
     /// fraction of the update's step (step times the mean CIEDE2000); 0 turns the control off.
     #[arg(long, default_value_t = Options::default().noise_ratio.unwrap_or(0.0))]
     noise_ratio: f64,
+    /// How the update corrects the aims: `cross-talk` through the print's cross-texel response,
+    /// fitted from its predictions; `per-texel` each texel by its own error (docs/printing.md).
+    #[arg(long, default_value = "cross-talk", value_parser = parse_update)]
+    update: Update,
     /// The resin surface's index of refraction (a smooth dielectric); 1 renders no surface.
     #[arg(long, default_value_t = 1.5)]
     ior: f32,
@@ -94,6 +100,15 @@ pub struct CompensateArgs {
     /// No progress bar or per-iteration lines; the summary alone.
     #[arg(short, long)]
     quiet: bool,
+}
+
+/// An update's name.
+fn parse_update(s: &str) -> Result<Update, String> {
+    match s {
+        "cross-talk" => Ok(Update::CrossTalk),
+        "per-texel" => Ok(Update::PerTexel),
+        _ => Err(format!("expected cross-talk or per-texel, found {s:?}")),
+    }
 }
 
 /// `X,Y,Z` as three numbers.
@@ -118,7 +133,22 @@ pub fn run_command(command: PrintCommand) -> Result<()> {
 
 fn delta_e(target: &std::path::Path, image: &std::path::Path, flip_rows: bool) -> Result<()> {
     use volpt_print::colour::{ciede2000, LinearRgb};
-    let target = volpt_print::target::Target::read(target)?;
+    let exr = |path: &std::path::Path| {
+        path.extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+    };
+    let target = if exr(target) {
+        let image = volpt::read_exr(target, "the reference image")?;
+        volpt_print::target::Target {
+            texels: (0..image.height)
+                .flat_map(|y| (0..image.width).map(move |x| (x, y)))
+                .map(|(x, y)| LinearRgb(image.pixel(x, y).map(f64::from)))
+                .collect(),
+            size: [image.width, image.height],
+        }
+    } else {
+        volpt_print::target::Target::read(target)?
+    };
     let rendered = volpt::read_exr(image, "the rendered image")?;
     let [w, h] = target.size;
     if [rendered.width, rendered.height] != [w, h] {
@@ -134,8 +164,8 @@ fn delta_e(target: &std::path::Path, image: &std::path::Path, flip_rows: bool) -
         let row = if flip_rows { h - 1 - y } else { y };
         for x in 0..w {
             let p = LinearRgb(rendered.pixel(x, row).map(f64::from));
-            if p.0.iter().all(|v| v.is_finite()) {
-                let t = target.texels[(x + w * y) as usize];
+            let t = target.texels[(x + w * y) as usize];
+            if p.0.iter().chain(&t.0).all(|v| v.is_finite()) {
                 delta_e.push(ciede2000(p.to_lab(), t.to_lab()));
             }
         }
@@ -177,6 +207,7 @@ fn compensate(args: CompensateArgs) -> Result<()> {
         max_iterations: args.iterations,
         step: args.step,
         noise_ratio: (args.noise_ratio > 0.0).then_some(args.noise_ratio),
+        update: args.update,
         ..Options::default()
     };
     let terminal = Arc::new(Terminal::new(!args.quiet).interruptible(

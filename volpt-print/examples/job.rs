@@ -2,21 +2,23 @@
 //! command line's crate: for measuring inks, layer counts and loop options on the CPU.
 //!
 //! ```sh
-//! cargo run --release -p volpt-print --example job -- TARGET.png M.toml OUT LAYERS COLOUR_LAYERS SPP MAX_SPP ITERATIONS [IOR]
+//! cargo run --release -p volpt-print --example job -- TARGET.png M.toml OUT LAYERS COLOUR_LAYERS SPP MAX_SPP ITERATIONS [IOR [UPDATE]]
 //! ```
 
 use std::sync::Arc;
 
 use volpt::{Backend, Quiet};
+use volpt_print::compensate::Update;
 use volpt_print::job::{run, Job};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let (Some([target, materials, out, layers, colour, spp, max_spp, iterations]), ior) =
-        (args.first_chunk::<8>(), args.get(8))
+    let (Some([target, materials, out, layers, colour, spp, max_spp, iterations]), ior, update) =
+        (args.first_chunk::<8>(), args.get(8), args.get(9))
     else {
         return Err(
-            "expected TARGET.png M.toml OUT LAYERS COLOUR_LAYERS SPP MAX_SPP ITERATIONS [IOR]"
+            "expected TARGET.png M.toml OUT LAYERS COLOUR_LAYERS SPP MAX_SPP ITERATIONS \
+                    [IOR [cross-talk|per-texel]]"
                 .into(),
         );
     };
@@ -31,6 +33,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let ior: f32 = ior.parse()?;
         job.ior = (ior != 1.0).then_some(ior);
     }
+    job.options.update = match update.map(String::as_str) {
+        None | Some("cross-talk") => Update::CrossTalk,
+        Some("per-texel") => Update::PerTexel,
+        Some(other) => {
+            return Err(format!("expected cross-talk or per-texel, found {other}").into())
+        }
+    };
     let backend = Backend::cpu();
     let outcome = run(&job, &backend, Arc::new(Quiet), |k, it| {
         eprintln!(

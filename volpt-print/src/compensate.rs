@@ -3,7 +3,10 @@
 //! against the target, correct the colours the layers under each texel aim for, halftone again,
 //! and repeat until the error stops falling or the iteration budget ends.
 //!
-//! **Update**: a fixed-point (Landweber) correction in linear RGB,
+//! **Update** ([`Options::update`]): by default through the print's cross-texel response,
+//! fitted from the predictions ([`Update::CrossTalk`], [`crate::crosstalk`]: the aims that
+//! minimise the mean CIEDE2000 of a linear model of the print around the best iteration);
+//! or per texel ([`Update::PerTexel`]): a fixed-point (Landweber) correction in linear RGB,
 //! `aim_{k+1} = clamp(aim_k + step * (target - prediction_k), 0, 1)`, per texel, starting from
 //! the naive assignment `aim_0 = target`. It is the per-texel additive correction of the aimed
 //! colour by the predicted error that Elek et al. iterate. Why it converges, and monotonically on
@@ -12,8 +15,9 @@
 //! blur with eigenvalues in (0, 1] and `0 < step <= 1` every eigenmode shrinks by
 //! `|1 - step lambda| < 1` at every step, so the residual falls monotonically, and the fixed
 //! point is the aim whose prediction is the target (where it is reachable: the clamp to the
-//! printable range stops the rest). Halftoning adds at most 1/L of quantisation per ink and
-//! texel (see [`crate::halftone`]), which bounds how close the loop gets.
+//! printable range stops the rest); it is the cross-talk update's special case `K = I`.
+//! Halftoning adds at most 1/L of quantisation per ink and texel (see [`crate::halftone`]),
+//! which bounds how close the loop gets.
 //!
 //! **Stopping**: an iteration that does not lower the best mean CIEDE2000 so far (by
 //! [`Options::min_improvement`]) is not built on: the next update starts again from the best
@@ -43,6 +47,7 @@ use thiserror::Error;
 use volpt::metrics::quantile;
 
 use crate::colour::{ciede2000, Lab, LinearRgb};
+use crate::crosstalk::Response;
 use crate::halftone::{naive_mix, Halftone};
 use crate::print::VoxelPrint;
 use volpt_scene::material::MaterialDesc;
@@ -104,7 +109,23 @@ pub struct Options {
     /// A prediction's noise (see the module docs) may be at most this fraction of the update's
     /// step, `step * mean`; `None` takes every prediction as it comes.
     pub noise_ratio: Option<f64>,
+    /// How the aims are corrected.
+    pub update: Update,
 }
+
+/// The update's model of the print.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Update {
+    /// Each texel's aim corrected by its own error (the module docs).
+    PerTexel,
+    /// The aims corrected through the print's cross-texel response, fitted from the predictions
+    /// ([`crate::crosstalk`]).
+    #[default]
+    CrossTalk,
+}
+
+/// Projected-gradient steps of one cross-talk update ([`Response::update`]).
+const CROSS_TALK_STEPS: usize = 200;
 
 impl Default for Options {
     fn default() -> Self {
@@ -114,6 +135,7 @@ impl Default for Options {
             min_improvement: 1e-3,
             backtracks: 2,
             noise_ratio: Some(0.25),
+            update: Update::default(),
         }
     }
 }
@@ -349,7 +371,28 @@ pub fn compensate<P: Predictor>(
             step *= 0.5;
         }
         let from = &iterations[best.as_ref().expect("set above").0];
-        aims = update(&from.aims, target, &from.prediction, step);
+        aims = match options.update {
+            Update::PerTexel => update(&from.aims, target, &from.prediction, step),
+            Update::CrossTalk => {
+                let samples: Vec<_> = iterations
+                    .iter()
+                    .map(|i| (&i.aims[..], &i.prediction[..]))
+                    .collect();
+                let response = Response::fit(&samples, [width, height]);
+                let minimum = response.update(
+                    &from.aims,
+                    &from.prediction,
+                    &target_lab,
+                    [width, height],
+                    CROSS_TALK_STEPS,
+                );
+                from.aims
+                    .iter()
+                    .zip(minimum)
+                    .map(|(a, m)| LinearRgb([0, 1, 2].map(|c| a.0[c] + step * (m.0[c] - a.0[c]))))
+                    .collect()
+            }
+        };
     }
     let (best, print) = best.ok_or(CompensateError::Interrupted)?;
     Ok(Compensation {

@@ -8,6 +8,7 @@
 //! - [`slices`]: slice stacks (one PNG per layer and `materials.toml`), written and read.
 //! - [`halftone`]: the printer's naive ink mix and its 3D ordered dithering into voxels.
 //! - [`compensate`]: the scattering compensation loop, against a [`compensate::Predictor`].
+//! - [`crosstalk`]: its update through the print's cross-texel response, fitted from its predictions.
 //! - [`predict`]: the real predictor, a volpt render of the print from straight above.
 //! - [`target`]: a compensation's target image, read from a PNG.
 //! - [`record`]: a compensation's record (predictions, ΔE maps and plot, the slice stack).
@@ -16,6 +17,7 @@
 
 pub mod colour;
 pub mod compensate;
+pub mod crosstalk;
 pub mod error;
 pub mod halftone;
 pub mod job;

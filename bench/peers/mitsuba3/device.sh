@@ -126,12 +126,12 @@ compare() { # label backend res spp machine
 
 if [ "$MODE" = print ]; then
     RECORDS=$RES_DIR/print
-    if [ ! -f "$RECORDS/lines/print.toml" ]; then
+    if [ ! -f "$RECORDS/white/naive.toml" ]; then
         OUT=$RECORDS bash bundle/print.sh >"$RES_DIR/print-sh.log" 2>&1
         log "bundle/print.sh: $(tail -n 1 "$RECORDS/summary.txt" 2>/dev/null)"
     fi
-    "$PY" bench/peers/mitsuba3/print.py --volpt "$VOLPT" --spp "${PRINT_SPP:-256}" --fine lines \
-        "$RECORDS/lines" "$RECORDS/photo" "$RECORDS/gradient" 2>"$RES_DIR/print-mitsuba.log" \
+    "$PY" bench/peers/mitsuba3/print.py --volpt "$VOLPT" --spp "${PRINT_SPP:-4096}" --fine lines \
+        --uniform "$RECORDS/white" "$RECORDS/lines" "$RECORDS/photo" "$RECORDS/gradient" 2>"$RES_DIR/print-mitsuba.log" \
         | tee -a "$RES_DIR/device-summary.txt"
     status=${PIPESTATUS[0]}
     log "print: $([ "$status" = 0 ] && echo PASS || echo "FAIL (status $status; $RES_DIR/print-mitsuba.log)")"

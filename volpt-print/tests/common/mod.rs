@@ -52,12 +52,19 @@ impl Rng {
 /// real predictor renders the print). A texel's column colour is the mean of its voxels' ink
 /// colours (each ink's palette colour, in linear RGB) weighted by depth, `rho^k` for the voxel
 /// `k` layers down, normalised over the print's depth; the image is that column colour blurred
-/// by a separable binomial kernel of `radius` (weights C(2r, r + d) / 4^r, edges clamped). The
-/// kernel's spectrum is cos^(2r), in [0, 1], and the depth weights sum to 1: a linear, symmetric
-/// transport of norm at most 1, on which the loop's update contracts.
+/// by a separable binomial kernel of `radius` (weights C(2r, r + d) / 4^r, edges clamped), but
+/// for a share `own` of it that stays at its texel. The kernel's spectrum is cos^(2r), in [0, 1],
+/// and the depth weights sum to 1: a linear, symmetric transport of norm at most 1, on which the
+/// loop's update contracts. With `own` > 0 it is a print's point spread in miniature: a sharp
+/// part (light remitted near where it entered) over a wide tail (light that wandered). With
+/// `absorption` > 0 the tail is not the blurred colour but `exp(-absorption * blur(1 - colour))`:
+/// light that wandered through inked columns absorbed along its way (Beer-Lambert), so a white
+/// texel beside ink darkens more than in proportion to it, as in a real print (not linear).
 pub struct BlurModel {
     pub rho: f64,
     pub radius: usize,
+    pub own: f64,
+    pub absorption: f64,
 }
 
 impl Predictor for BlurModel {
@@ -107,8 +114,23 @@ impl Predictor for BlurModel {
             }
             out
         };
-        let blurred = blur(&blur(&column, [1, 0]), [0, 1]);
-        Ok(blurred.into_iter().map(LinearRgb).collect())
+        let tail = if self.absorption > 0.0 {
+            let ink: Vec<[f64; 3]> = column.iter().map(|c| c.map(|v| 1.0 - v)).collect();
+            let blurred = blur(&blur(&ink, [1, 0]), [0, 1]);
+            blurred
+                .into_iter()
+                .map(|u| u.map(|v| (-self.absorption * v).exp()))
+                .collect()
+        } else {
+            blur(&blur(&column, [1, 0]), [0, 1])
+        };
+        Ok(tail
+            .into_iter()
+            .zip(&column)
+            .map(|(b, c)| {
+                LinearRgb([0, 1, 2].map(|ch| self.own * c[ch] + (1.0 - self.own) * b[ch]))
+            })
+            .collect())
     }
 }
 
