@@ -45,11 +45,12 @@ fn descriptions() -> Vec<SceneDescription> {
     descs
 }
 
-/// "Uploads" to the host itself: values stay where they are, grids in the bricked layout are
-/// rewritten into buffers it keeps, as the CUDA backend's placer does in pinned memory.
+/// "Uploads" to the host itself: values stay where they are, grids in the bricked layout and
+/// sparse grids' flat copies are written into buffers it keeps, as the CUDA backend's placer
+/// does in device or pinned memory.
 struct HostUploader {
     layout: GridLayout,
-    bricked: Vec<Vec<f32>>,
+    buffers: Vec<Vec<f32>>,
 }
 
 impl Uploader for HostUploader {
@@ -82,7 +83,20 @@ impl Uploader for HostUploader {
             texture: 0,
         };
         // The vector's heap buffer does not move when the vector does.
-        self.bricked.push(bricked);
+        self.buffers.push(bricked);
+        placed
+    }
+
+    /// As the GPU's uploader: the flat copy, the only sparse layout the kernels read.
+    fn sparse(&mut self, data: &[f32], res: [u32; 3], _channels: u32) -> PlacedGrid {
+        let flat = volpt_core::sparse::flatten(data, res).expect("a small test grid");
+        let placed = PlacedGrid {
+            address: flat.as_ptr() as u64,
+            len: flat.len() as u64,
+            layout: GridLayout::SparseFlat,
+            texture: 0,
+        };
+        self.buffers.push(flat);
         placed
     }
 }
@@ -100,7 +114,7 @@ impl SceneVisitor for RoundTrip {
     fn visit<S: RenderScene>(self, scene: &S) -> Self::Output {
         let mut uploader = HostUploader {
             layout: self.layout,
-            bricked: Vec::new(),
+            buffers: Vec::new(),
         };
         let params = scene.to_params(&mut uploader);
         // SAFETY: every address is a slice of the description or of `uploader`, alive for this
@@ -133,8 +147,9 @@ fn every_variant_with_bricked_grids_renders_bit_for_bit() {
 }
 
 /// Grids in the sparse layout (stored bricks and a brick table, `volpt_core::GridLayout::Sparse`)
-/// travel to the device as they are and are read by the device code exactly as the dense grids
-/// they came from; they select the any-layout medium, as bricked storage does.
+/// travel to the device as their flat copy (`GridLayout::SparseFlat`, what the GPU's uploader
+/// places) and are read by the device code exactly as the dense grids they came from; they
+/// select the any-layout medium, as bricked storage does.
 #[test]
 fn every_variant_with_sparse_grids_renders_bit_for_bit() {
     let mut descs = descriptions();

@@ -59,6 +59,21 @@ pub trait Uploader {
             texture: 0,
         }
     }
+
+    /// Places sparse grid `data` of `res` samples of `channels` channels ([`GridLayout::Sparse`], checked by
+    /// [`crate::sparse::parts`]). By default as it is, through [`Uploader::values`]: the CPU's
+    /// uploaders, whose renders read the two-level table. A GPU's uploader must place it as
+    /// [`GridLayout::SparseFlat`] ([`crate::sparse::flatten`]), the only sparse layout the
+    /// kernels read, or fail.
+    fn sparse(&mut self, data: &[f32], res: [u32; 3], channels: u32) -> PlacedGrid {
+        let _ = (res, channels);
+        PlacedGrid {
+            address: self.values(data),
+            len: data.len() as u64,
+            layout: GridLayout::Sparse,
+            texture: 0,
+        }
+    }
 }
 
 impl<F: FnMut(&[f32]) -> u64> Uploader for F {
@@ -268,15 +283,10 @@ impl GridParams {
         placement: GridPlacement,
     ) -> Self {
         // A sparse grid is already laid out for the any-layout reads (the factory gives it no
-        // other), and its table and bricks travel as they are: it is small by construction.
+        // other): the uploader places its bricks and table, or their flat copy.
         let placed = if grid.layout == GridLayout::Sparse {
             debug_assert_eq!(placement, GridPlacement::AnyLayout);
-            PlacedGrid {
-                address: upload.values(grid.data),
-                len: grid.data.len() as u64,
-                layout: GridLayout::Sparse,
-                texture: 0,
-            }
+            upload.sparse(grid.data, grid.res, C as u32)
         } else {
             debug_assert_eq!(grid.layout, GridLayout::Dense);
             upload.grid(grid.data, grid.res, C as u32, placement, grid.texel)

@@ -85,8 +85,13 @@ pub enum GridLayout {
     /// ([`crate::sparse`]) that gives every brick of the box the slot of the stored brick it
     /// reads. Slot 0 is the background brick, one value everywhere; a uniform region (empty, or a
     /// tile) costs one table entry per 128^3 block, and reads like any other region, so the lookup
-    /// has no extra branch ([`Grid::sparse`]).
+    /// has no extra branch ([`Grid::sparse`]). The GPU's kernels do not read this table: they
+    /// read its flat copy, [`GridLayout::SparseFlat`].
     Sparse,
+    /// A sparse grid's stored bricks followed by a one-level table, the slot of every brick of
+    /// the box ([`crate::sparse::flatten`]): one dependent read per corner where the two-level
+    /// table takes two. What a GPU renderer uploads a [`GridLayout::Sparse`] grid as.
+    SparseFlat,
 }
 
 /// Samples along each edge of a brick of [`GridLayout::Bricked`].
@@ -101,7 +106,7 @@ impl GridLayout {
         let samples = match self {
             GridLayout::Dense => res.map(u64::from),
             GridLayout::Bricked => res.map(|r| u64::from(r.div_ceil(BRICK)) * u64::from(BRICK)),
-            GridLayout::Sparse => return None,
+            GridLayout::Sparse | GridLayout::SparseFlat => return None,
         };
         samples
             .iter()
@@ -110,13 +115,15 @@ impl GridLayout {
 
     /// The sample index (before multiplying by the channel count) of `(x, y, z)` in a grid of
     /// `res` samples. Arithmetic is `u32`, as the lookup's: a grid's padded sample count must be
-    /// below 2^32 ([`GridLayout::values`]). A [`GridLayout::Sparse`] grid's index depends on its
-    /// brick table: this is its index in the box's bricked layout, and [`Grid::sample`] reads it.
+    /// below 2^32 ([`GridLayout::values`]). A sparse grid's index depends on its brick table:
+    /// this is its index in the box's bricked layout, and [`Grid::sample`] reads it.
     #[inline]
     pub fn index(self, res: [u32; 3], x: u32, y: u32, z: u32) -> u32 {
         match self {
             GridLayout::Dense => dense_index(res, x, y, z),
-            GridLayout::Bricked | GridLayout::Sparse => bricked_index(res, x, y, z),
+            GridLayout::Bricked | GridLayout::Sparse | GridLayout::SparseFlat => {
+                bricked_index(res, x, y, z)
+            }
         }
     }
 
@@ -126,6 +133,7 @@ impl GridLayout {
             GridLayout::Dense => 0,
             GridLayout::Bricked => 1,
             GridLayout::Sparse => 2,
+            GridLayout::SparseFlat => 3,
         }
     }
 
@@ -133,6 +141,7 @@ impl GridLayout {
         match n {
             1 => GridLayout::Bricked,
             2 => GridLayout::Sparse,
+            3 => GridLayout::SparseFlat,
             _ => GridLayout::Dense,
         }
     }
@@ -160,7 +169,19 @@ fn bricked_index(res: [u32; 3], x: u32, y: u32, z: u32) -> u32 {
 #[inline(always)]
 fn sparse_index(data: &[f32], res: [u32; 3], x: u32, y: u32, z: u32) -> u32 {
     let brick = [x >> BRICK_SHIFT, y >> BRICK_SHIFT, z >> BRICK_SHIFT];
-    let slot = crate::sparse::slot(data, res, brick);
+    in_brick(crate::sparse::slot(data, res, brick), x, y, z)
+}
+
+/// [`sparse_index`] of a [`GridLayout::SparseFlat`] grid: the slot from the one-level table.
+#[inline(always)]
+fn flat_index(data: &[f32], res: [u32; 3], x: u32, y: u32, z: u32) -> u32 {
+    let brick = [x >> BRICK_SHIFT, y >> BRICK_SHIFT, z >> BRICK_SHIFT];
+    in_brick(crate::sparse::flat_slot(data, res, brick), x, y, z)
+}
+
+/// The sample index of `(x, y, z)` in stored brick `slot`.
+#[inline(always)]
+fn in_brick(slot: u32, x: u32, y: u32, z: u32) -> u32 {
     let mask = BRICK - 1;
     let inner = (((z & mask) << BRICK_SHIFT) + (y & mask)) << BRICK_SHIFT | (x & mask);
     (slot << (3 * BRICK_SHIFT)) | inner
@@ -255,6 +276,10 @@ impl<'a, const C: usize> Grid<'a, C> {
     pub fn samples(&self) -> &'a [f32] {
         match self.layout {
             GridLayout::Sparse => &self.data[..crate::sparse::stored_values(self.data, self.res)],
+            GridLayout::SparseFlat => {
+                let table = crate::sparse::bricks(self.res).iter().product::<u32>() as usize;
+                &self.data[..self.data.len() - table]
+            }
             _ => self.data,
         }
     }
@@ -263,6 +288,7 @@ impl<'a, const C: usize> Grid<'a, C> {
     pub fn sample(&self, x: u32, y: u32, z: u32) -> [f32; C] {
         let i = match self.layout {
             GridLayout::Sparse => sparse_index(self.data, self.res, x, y, z),
+            GridLayout::SparseFlat => flat_index(self.data, self.res, x, y, z),
             layout => layout.index(self.res, x, y, z),
         } as usize
             * C;
@@ -297,9 +323,20 @@ impl<'a, const C: usize> Grid<'a, C> {
         match self.layout {
             GridLayout::Dense => self.interpolate(p, dense_index, self.lookup, None),
             GridLayout::Bricked => self.interpolate(p, bricked_index, self.lookup, None),
+            // Not in the kernels: a GPU renderer uploads sparse grids flat, and this arm's
+            // second table read cost every any-layout kernel registers (`crate::sparse`).
+            #[cfg(not(target_arch = "nvptx64"))]
             GridLayout::Sparse => self.interpolate(
                 p,
                 |res, x, y, z| sparse_index(self.data, res, x, y, z),
+                self.lookup,
+                None,
+            ),
+            #[cfg(target_arch = "nvptx64")]
+            GridLayout::Sparse => [0.0; C],
+            GridLayout::SparseFlat => self.interpolate(
+                p,
+                |res, x, y, z| flat_index(self.data, res, x, y, z),
                 self.lookup,
                 None,
             ),
@@ -314,9 +351,20 @@ impl<'a, const C: usize> Grid<'a, C> {
         match self.layout {
             GridLayout::Dense => self.interpolate(p, dense_index, self.lookup, Some(bits)),
             GridLayout::Bricked => self.interpolate(p, bricked_index, self.lookup, Some(bits)),
+            // Not in the kernels: a GPU renderer uploads sparse grids flat, and this arm's
+            // second table read cost every any-layout kernel registers (`crate::sparse`).
+            #[cfg(not(target_arch = "nvptx64"))]
             GridLayout::Sparse => self.interpolate(
                 p,
                 |res, x, y, z| sparse_index(self.data, res, x, y, z),
+                self.lookup,
+                Some(bits),
+            ),
+            #[cfg(target_arch = "nvptx64")]
+            GridLayout::Sparse => [0.0; C],
+            GridLayout::SparseFlat => self.interpolate(
+                p,
+                |res, x, y, z| flat_index(self.data, res, x, y, z),
                 self.lookup,
                 Some(bits),
             ),
@@ -890,13 +938,22 @@ mod tests {
                 let a = Grid::<1>::new(&one, res, mapping);
                 let b = Grid::<1>::sparse(&sparse, res, mapping);
                 assert_eq!(b.samples().len(), slots * 512);
+                let flat = crate::sparse::flatten(&sparse, res).unwrap();
+                let c = Grid {
+                    data: &flat,
+                    layout: GridLayout::SparseFlat,
+                    ..b
+                };
+                assert_eq!(c.samples(), b.samples());
                 let (min, extent) = (bounds.min, bounds.extent());
                 let mut nonzero = 0;
                 for i in 0..4000u32 {
                     let u = Vec3::new(hash(3 * i), hash(3 * i + 1), hash(3 * i + 2)) * 1.1 - 0.05;
                     let p = min + u * extent;
                     assert_eq!(a.lookup(p)[0].to_bits(), b.lookup(p)[0].to_bits(), "{p:?}");
+                    assert_eq!(a.lookup(p)[0].to_bits(), c.lookup(p)[0].to_bits(), "{p:?}");
                     assert_eq!(a.lookup(p), AnyLayout::lookup(&b, p));
+                    assert_eq!(a.lookup(p), AnyLayout::lookup(&c, p));
                     nonzero += usize::from(a.lookup(p)[0] > 0.0);
                 }
                 assert!(nonzero > 100, "{res:?}: {nonzero} lookups inside the ball");
@@ -906,10 +963,17 @@ mod tests {
             let mapping = GridMapping::cell_centred(bounds, res);
             let a = Grid::<3>::new(&three, res, mapping);
             let b = Grid::<3>::sparse(&sparse3, res, mapping);
+            let flat3 = crate::sparse::flatten(&sparse3, res).unwrap();
+            let c = Grid {
+                data: &flat3,
+                layout: GridLayout::SparseFlat,
+                ..b
+            };
             for i in 0..2000u32 {
                 let u = Vec3::new(hash(3 * i), hash(3 * i + 1), hash(3 * i + 2));
                 let p = min_plus(bounds, u);
                 assert_eq!(a.lookup(p), b.lookup(p), "{p:?}");
+                assert_eq!(a.lookup(p), c.lookup(p), "{p:?}");
             }
         }
     }

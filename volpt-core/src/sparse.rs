@@ -24,6 +24,15 @@
 //! [`parts`] checks every invariant the lookup relies on; [`TablePlan`] (host side) builds a
 //! table from regions painted in order, in time and memory proportional to the regions and the
 //! blocks they touch, not to the bricks they cover.
+//!
+//! The GPU reads a *flat* copy instead ([`flatten`], [`GridLayout::SparseFlat`]): the stored
+//! bricks followed by one slot per brick of the box, so that each corner of a lookup costs one
+//! dependent read of the table, not two. The second read's code was what the any-layout kernels
+//! paid for in registers and spills (6-18% of their time on the bricked and sparse scenes,
+//! `bench/results/2026-11-29-h200-session12`), whether a grid was sparse or not. A flat table
+//! costs 4 bytes per brick of the box, so it is made only up to [`FLAT_MAX`] entries.
+//!
+//! [`GridLayout::SparseFlat`]: crate::grid::GridLayout::SparseFlat
 
 use core::fmt;
 
@@ -76,6 +85,30 @@ pub fn slot(data: &[f32], res: [u32; 3], brick: [u32; 3]) -> u32 {
     // A uniform block's one fine entry stands for each of its bricks: a select, not a branch.
     let within = if entry & UNIFORM != 0 { 0 } else { within };
     data[coarse - (entry & !UNIFORM) as usize + within as usize].to_bits()
+}
+
+/// Entries of a flat table ([`flatten`]) that a GPU renderer makes: 2^28 (1 GiB), a box of
+/// 5120^3 samples. Keeps the flat lookup's arithmetic in `u32` and the copy a fraction of a
+/// second; a larger box of tiles renders on the CPU, which reads the two-level table.
+pub const FLAT_MAX: u64 = 1 << 28;
+
+/// Entries of the flat table of a grid of `res` samples, one per brick of the box (`None`: more
+/// than [`FLAT_MAX`]).
+pub fn flat_len(res: [u32; 3]) -> Option<u64> {
+    let n = bricks(res).iter().map(|&b| u64::from(b)).product::<u64>();
+    (n <= FLAT_MAX).then_some(n)
+}
+
+/// The slot of the stored brick that brick `brick` of a [`GridLayout::SparseFlat`] grid of
+/// `res` samples reads: its entry of the table at the end of `data`.
+///
+/// [`GridLayout::SparseFlat`]: crate::grid::GridLayout::SparseFlat
+#[inline(always)]
+pub fn flat_slot(data: &[f32], res: [u32; 3], brick: [u32; 3]) -> u32 {
+    let [nx, ny, nz] = bricks(res);
+    let table = data.len() - (nx * ny * nz) as usize;
+    let [bx, by, bz] = brick;
+    data[table + ((bz * ny + by) * nx + bx) as usize].to_bits()
 }
 
 /// What a block of the coarse table is.
@@ -243,6 +276,48 @@ pub fn parts(data: &[f32], res: [u32; 3], channels: u32) -> Result<Parts, TableE
 
 #[cfg(feature = "alloc")]
 pub use plan::{BrickTable, TablePlan};
+
+/// The flat copy of sparse grid `data` of `res` samples (valid: [`parts`]): its stored bricks,
+/// then the slot of every brick of the box, x fastest, as [`flat_slot`] reads them. `None` if
+/// the box has more than [`FLAT_MAX`] bricks. Time proportional to the box's bricks: a uniform
+/// block's are filled from its one entry, row by row.
+#[cfg(feature = "alloc")]
+pub fn flatten(data: &[f32], res: [u32; 3]) -> Option<alloc::vec::Vec<f32>> {
+    let len = flat_len(res)?;
+    let stored = stored_values(data, res);
+    let mut flat = alloc::vec::Vec::with_capacity(stored + len as usize);
+    flat.extend_from_slice(&data[..stored]);
+    let table = flat.len();
+    flat.resize(table + len as usize, 0.0);
+    let [nx, ny, nz] = bricks(res);
+    let [bx, by, bz] = blocks(res);
+    for (kz, ky, kx) in
+        (0..bz).flat_map(|z| (0..by).flat_map(move |y| (0..bx).map(move |x| (z, y, x))))
+    {
+        let uniform = match block(data, res, [kx, ky, kz]) {
+            Block::Uniform(slot) => Some(slot),
+            Block::Mixed => None,
+        };
+        let lo = [kx, ky, kz].map(|v| v * BLOCK);
+        let hi = [(kx + 1) * BLOCK, (ky + 1) * BLOCK, (kz + 1) * BLOCK];
+        let hi = [hi[0].min(nx), hi[1].min(ny), hi[2].min(nz)];
+        for z in lo[2]..hi[2] {
+            for y in lo[1]..hi[1] {
+                let row = table + ((z * ny + y) * nx) as usize;
+                let entries = &mut flat[row + lo[0] as usize..row + hi[0] as usize];
+                match uniform {
+                    Some(slot) => entries.fill(f32::from_bits(slot)),
+                    None => {
+                        for (x, e) in (lo[0]..hi[0]).zip(entries) {
+                            *e = f32::from_bits(slot(data, res, [x, y, z]));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    Some(flat)
+}
 
 #[cfg(feature = "alloc")]
 mod plan {
@@ -560,6 +635,43 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The flat copy's one-level table gives every brick the slot the two-level table gives it,
+    /// uniform blocks (filled from one entry) and blocks cut by the box's faces included; the
+    /// stored bricks come first, unchanged.
+    #[test]
+    fn the_flat_table_reads_every_brick_as_the_two_level_table() {
+        for (res, n) in [([1, 1, 1], 3), ([300, 130, 257], 40), ([512, 8, 700], 200)] {
+            let b = bricks(res);
+            let (data, _) = build(res, &regions(b, n));
+            let flat = flatten(&data, res).unwrap();
+            let stored = stored_values(&data, res);
+            assert_eq!(flat.len() as u64, stored as u64 + flat_len(res).unwrap());
+            assert_eq!(flat[..stored], data[..stored]);
+            for z in 0..b[2] {
+                for y in 0..b[1] {
+                    for x in 0..b[0] {
+                        assert_eq!(
+                            flat_slot(&flat, res, [x, y, z]),
+                            slot(&data, res, [x, y, z]),
+                            "{res:?} ({x}, {y}, {z})"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    /// A box of more than [`FLAT_MAX`] bricks has no flat copy (the GPU refuses it); the
+    /// largest box within it has one.
+    #[test]
+    fn a_flat_table_has_at_most_flat_max_entries() {
+        let side: u32 = 8 << 9; // 512 bricks
+        assert_eq!(flat_len([side, side, 2 * side]), Some(FLAT_MAX));
+        assert_eq!(flat_len([side, side, 2 * side + 1]), None);
+        let (data, _) = build([16384; 3], &[([0; 3], [512; 3], 3)]);
+        assert!(flatten(&data, [16384; 3]).is_none());
     }
 
     /// A region of 4096^3 samples (an OpenVDB root tile) in a box of 16384^3: 2^21 coarse

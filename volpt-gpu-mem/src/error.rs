@@ -76,6 +76,12 @@ pub enum GpuMemError {
          memory: drop one of them"
     )]
     TextureInHostMemory { memory: crate::policy::VolumeMemory },
+    #[error(
+        "a sparse volume whose box has {bricks} bricks of 8^3 samples: the GPU reads a table of \
+         one entry per brick, at most {max} (a box of 5120^3 samples); render it on the CPU \
+         (--backend cpu), which reads its two-level table"
+    )]
+    SparseTableTooLarge { bricks: u64, max: u64 },
     #[error("CUDA driver call failed while {doing} ({} volume): {source}", crate::policy::human_bytes(*.bytes))]
     Driver {
         doing: &'static str,

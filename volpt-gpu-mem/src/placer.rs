@@ -45,7 +45,7 @@ impl fmt::Display for Placed {
         let layout = match self.layout {
             GridLayout::Dense => "dense",
             GridLayout::Bricked => "bricked",
-            GridLayout::Sparse => "sparse",
+            GridLayout::Sparse | GridLayout::SparseFlat => "sparse",
         };
         if let PlacedIn::Texture(texel) = self.memory {
             let texel = match texel {
@@ -267,12 +267,24 @@ impl VolumePlacer {
                 );
                 GridLayout::Dense
             }
-            // Not a policy: a sparse grid arrives laid out (`GridParams::new` uploads it as values).
-            GridLayout::Sparse => GridLayout::Dense,
+            // Not a policy: a sparse grid arrives laid out (`Uploader::sparse`).
+            GridLayout::Sparse | GridLayout::SparseFlat => GridLayout::Dense,
             layout => layout,
         };
+        self.place_as(values, res, channels, layout)
+    }
+
+    /// [`VolumePlacer::place`] in `layout`: dense or flat sparse values as they are, or
+    /// rewritten into bricks.
+    fn place_as(
+        &mut self,
+        values: &[f32],
+        res: [u32; 3],
+        channels: u32,
+        layout: GridLayout,
+    ) -> Result<PlacedGrid, GpuMemError> {
         let len = match layout {
-            GridLayout::Dense | GridLayout::Sparse => values.len(),
+            GridLayout::Dense | GridLayout::Sparse | GridLayout::SparseFlat => values.len(),
             GridLayout::Bricked => values_in(layout, res, channels).unwrap_or(0) as usize,
         };
         let bytes = len as u64 * 4;
@@ -378,7 +390,9 @@ impl VolumePlacer {
     fn copy_to_device(&mut self, grid: &Grid<'_>) -> Result<u64, GpuMemError> {
         let bytes = grid.len as u64 * 4;
         let copied = match grid.layout {
-            GridLayout::Dense | GridLayout::Sparse => self.stream.clone_htod(grid.values),
+            GridLayout::Dense | GridLayout::Sparse | GridLayout::SparseFlat => {
+                self.stream.clone_htod(grid.values)
+            }
             GridLayout::Bricked => {
                 let host = bricked(grid.values, grid.res, grid.channels)
                     .ok_or(GpuMemError::OutOfHostMemory { bytes })?;
@@ -487,7 +501,7 @@ impl Grid<'_> {
     /// Writes the grid in its layout into `out` (of `len` values).
     fn write_into(&self, out: &mut [f32]) {
         match self.layout {
-            GridLayout::Dense | GridLayout::Sparse => {
+            GridLayout::Dense | GridLayout::Sparse | GridLayout::SparseFlat => {
                 const CHUNK: usize = 1 << 20;
                 out.par_chunks_mut(CHUNK)
                     .zip(self.values.par_chunks(CHUNK))
@@ -571,6 +585,60 @@ impl Uploader for VolumePlacer {
                 failed
             }
         }
+    }
+
+    fn sparse(&mut self, data: &[f32], res: [u32; 3], channels: u32) -> PlacedGrid {
+        let failed = PlacedGrid {
+            address: 0,
+            len: 0,
+            layout: GridLayout::SparseFlat,
+            texture: 0,
+        };
+        if self.error.is_some() {
+            return failed;
+        }
+        let key = GridKey {
+            values: (data.as_ptr() as usize, data.len()),
+            res,
+            channels,
+            placement: GridPlacement::AnyLayout,
+            texel: TexelFormat::F32,
+        };
+        if let Some(placed) = self.kept(&key) {
+            return placed;
+        }
+        match self.place_sparse(data, res, channels) {
+            Ok(placed) => {
+                self.keep(key, placed);
+                placed
+            }
+            Err(e) => {
+                self.error = Some(e);
+                failed
+            }
+        }
+    }
+}
+
+impl VolumePlacer {
+    /// [`Uploader::sparse`]: the grid's flat copy ([`volpt_core::sparse::flatten`]), placed as
+    /// the policy says as any other grid of its size (the kernels read no other sparse layout).
+    fn place_sparse(
+        &mut self,
+        data: &[f32],
+        res: [u32; 3],
+        channels: u32,
+    ) -> Result<PlacedGrid, GpuMemError> {
+        let flat = volpt_core::sparse::flatten(data, res).ok_or_else(|| {
+            GpuMemError::SparseTableTooLarge {
+                bricks: volpt_core::sparse::bricks(res)
+                    .iter()
+                    .map(|&b| u64::from(b))
+                    .product(),
+                max: volpt_core::sparse::FLAT_MAX,
+            }
+        })?;
+        self.place_as(&flat, res, channels, GridLayout::SparseFlat)
     }
 }
 
