@@ -172,7 +172,14 @@ gpu_speed=(--backend cuda --strategy regeneration-sk --spp 64 --resolution 400x4
 for pair in "homogeneous-cube/scene.xml mesh-cube/scene.xml" "cgg-logo/scene.xml cgg-logo/mesh.xml"; do
     set -- $pair
     "$VOLPT" render "scenes/$1" "${gpu_speed[@]}" -o "$OUT/speed-box.exr" >"$OUT/speed-box.log" 2>&1 || log "FAIL $1 GPU speed render"
-    "$VOLPT" render "scenes/$2" "${gpu_speed[@]}" -o "$OUT/speed-mesh.exr" >"$OUT/speed-mesh.log" 2>&1 || log "FAIL $2 GPU speed render"
+    if ! "$VOLPT" render "scenes/$2" "${gpu_speed[@]}" -o "$OUT/speed-mesh.exr" >"$OUT/speed-mesh.log" 2>&1; then
+        # A variant outside the mesh kernels (cgg-logo's texture grid) is a typed refusal, not a failure.
+        if grep -q "do not cover this scene's parts" "$OUT/speed-mesh.log"; then
+            log "not covered by the mesh kernels on the GPU (it renders on the CPU): $2"
+            continue
+        fi
+        log "FAIL $2 GPU speed render"
+    fi
     box=$(seg "$OUT/speed-box.log")
     mesh=$(seg "$OUT/speed-mesh.log")
     # The default schedule (no --strategy: regeneration-sk with at most 64 registers) on the mesh.
