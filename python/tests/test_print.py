@@ -66,6 +66,25 @@ def test_the_record_equals_the_command_line_s(tmp_path, volpt_bin):
     assert [float(r.split(",")[1]) for r in rows] == pytest.approx([it["mean"] for it in its], abs=1e-6)
 
 
+def test_update_chooses_the_command_line_s_update_and_refuses_others(tmp_path, volpt_bin):
+    target = write_png(tmp_path / "target.png", 10, 8, bars)
+    args = dict(layers=8, colour_layers=4, spp=4, iterations=2, seed=5)
+    volpt.compensate_print(target, MATERIALS, tmp_path / "py", **args, update="per-texel")
+    run_cli(
+        volpt_bin, "print", "compensate", target, "--materials", MATERIALS, "-o", tmp_path / "cli",
+        "--layers", 8, "--colour-layers", 4, "--spp", 4, "--iterations", 2, "--seed", 5,
+        "--update", "per-texel", "--quiet",
+    )
+    volpt.compensate_print(target, MATERIALS, tmp_path / "cross", **args)
+    py, cli, cross = tmp_path / "py", tmp_path / "cli", tmp_path / "cross"
+    csv = "iterations.csv"
+    assert (py / csv).read_bytes() == (cli / csv).read_bytes()
+    # The default is the other update: the same first prediction, different aims after it.
+    assert (py / csv).read_bytes() != (cross / csv).read_bytes()
+    with pytest.raises(volpt.SettingsError, match='"cross-talk" or "per-texel"'):
+        volpt.compensate_print(target, MATERIALS, tmp_path / "bad", **args, update="sideways")
+
+
 def test_bad_files_and_arguments_raise_clear_errors(tmp_path):
     target = write_png(tmp_path / "target.png", 4, 4, bars)
     soot = tmp_path / "soot.toml"
