@@ -557,9 +557,6 @@ impl Uploader for VolumePlacer {
             layout: GridLayout::Dense,
             texture: 0,
         };
-        if self.error.is_some() {
-            return failed;
-        }
         let key = GridKey {
             values: (values.as_ptr() as usize, values.len()),
             res,
@@ -567,24 +564,11 @@ impl Uploader for VolumePlacer {
             placement,
             texel,
         };
-        if let Some(placed) = self.kept(&key) {
-            return placed;
-        }
-        let placed = match placement {
-            GridPlacement::Texture => self.texture(values, res, channels, texel),
-            GridPlacement::AnyLayout => self.place(values, res, channels, true),
-            GridPlacement::Dense => self.place(values, res, channels, false),
-        };
-        match placed {
-            Ok(placed) => {
-                self.keep(key, placed);
-                placed
-            }
-            Err(e) => {
-                self.error = Some(e);
-                failed
-            }
-        }
+        self.place_once(key, failed, |placer| match placement {
+            GridPlacement::Texture => placer.texture(values, res, channels, texel),
+            GridPlacement::AnyLayout => placer.place(values, res, channels, true),
+            GridPlacement::Dense => placer.place(values, res, channels, false),
+        })
     }
 
     fn sparse(&mut self, data: &[f32], res: [u32; 3], channels: u32) -> PlacedGrid {
@@ -594,9 +578,6 @@ impl Uploader for VolumePlacer {
             layout: GridLayout::SparseFlat,
             texture: 0,
         };
-        if self.error.is_some() {
-            return failed;
-        }
         let key = GridKey {
             values: (data.as_ptr() as usize, data.len()),
             res,
@@ -604,10 +585,28 @@ impl Uploader for VolumePlacer {
             placement: GridPlacement::AnyLayout,
             texel: TexelFormat::F32,
         };
+        self.place_once(key, failed, |placer| {
+            placer.place_sparse(data, res, channels)
+        })
+    }
+}
+
+impl VolumePlacer {
+    /// The grid `key` names, placed by `place` once and kept; after an earlier failure, or when
+    /// `place` fails (its error kept for the render to report), `failed`.
+    fn place_once(
+        &mut self,
+        key: GridKey,
+        failed: PlacedGrid,
+        place: impl FnOnce(&mut Self) -> Result<PlacedGrid, GpuMemError>,
+    ) -> PlacedGrid {
+        if self.error.is_some() {
+            return failed;
+        }
         if let Some(placed) = self.kept(&key) {
             return placed;
         }
-        match self.place_sparse(data, res, channels) {
+        match place(self) {
             Ok(placed) => {
                 self.keep(key, placed);
                 placed
@@ -618,9 +617,7 @@ impl Uploader for VolumePlacer {
             }
         }
     }
-}
 
-impl VolumePlacer {
     /// [`Uploader::sparse`]: the grid's flat copy ([`volpt_core::sparse::flatten`]), placed as
     /// the policy says as any other grid of its size (the kernels read no other sparse layout).
     fn place_sparse(
