@@ -289,18 +289,15 @@ pub fn flatten(data: &[f32], res: [u32; 3]) -> Option<alloc::vec::Vec<f32>> {
     flat.extend_from_slice(&data[..stored]);
     let table = flat.len();
     flat.resize(table + len as usize, 0.0);
-    let [nx, ny, nz] = bricks(res);
-    let [bx, by, bz] = blocks(res);
-    for (kz, ky, kx) in
-        (0..bz).flat_map(|z| (0..by).flat_map(move |y| (0..bx).map(move |x| (z, y, x))))
-    {
-        let uniform = match block(data, res, [kx, ky, kz]) {
+    let bricks = bricks(res);
+    let [nx, ny, _] = bricks;
+    let last = blocks(res).map(|b| b - 1);
+    plan::for_blocks([0; 3], last, |b| {
+        let uniform = match block(data, res, b) {
             Block::Uniform(slot) => Some(slot),
             Block::Mixed => None,
         };
-        let lo = [kx, ky, kz].map(|v| v * BLOCK);
-        let hi = [(kx + 1) * BLOCK, (ky + 1) * BLOCK, (kz + 1) * BLOCK];
-        let hi = [hi[0].min(nx), hi[1].min(ny), hi[2].min(nz)];
+        let (lo, hi, _) = plan::clip([0; 3], bricks, b, bricks);
         for z in lo[2]..hi[2] {
             for y in lo[1]..hi[1] {
                 let row = table + ((z * ny + y) * nx) as usize;
@@ -315,7 +312,7 @@ pub fn flatten(data: &[f32], res: [u32; 3]) -> Option<alloc::vec::Vec<f32>> {
                 }
             }
         }
-    }
+    });
     Some(flat)
 }
 
@@ -330,7 +327,7 @@ mod plan {
     /// The part of a box of bricks `[lo, hi)` inside block `b` of a box of `bricks` bricks per
     /// axis, and whether that is the block's every brick (blocks at the box's far faces are cut
     /// by it).
-    fn clip(
+    pub(super) fn clip(
         lo: [u32; 3],
         hi: [u32; 3],
         b: [u32; 3],
@@ -354,7 +351,7 @@ mod plan {
         (0..3).all(|a| lo[a] < hi[a]).then_some((lo, hi))
     }
 
-    fn for_blocks(first: [u32; 3], last: [u32; 3], mut f: impl FnMut([u32; 3])) {
+    pub(super) fn for_blocks(first: [u32; 3], last: [u32; 3], mut f: impl FnMut([u32; 3])) {
         for z in first[2]..=last[2] {
             for y in first[1]..=last[1] {
                 for x in first[0]..=last[0] {
