@@ -22,6 +22,11 @@ pub trait Shape {
     /// leaves it reaches the environment, and a shadow ray needs one exit.
     const CONVEX: bool;
 
+    /// Whether a hit's shading normal may differ from its geometric one ([`BoxHit::shading`]):
+    /// only then does the path step check a scattered direction's side against both
+    /// (`path::shading_normal`), so a shape without vertex normals carries no such test.
+    const SHADING_NORMALS: bool = false;
+
     /// [`Shape::CONVEX`] for this shape: a shape chosen at run time ([`BoundaryShape`]) knows only
     /// then. A compile-time constant for every other shape.
     #[inline(always)]
@@ -100,6 +105,7 @@ pub enum BoundaryShape<'a> {
 
 impl Shape for BoundaryShape<'_> {
     const CONVEX: bool = false;
+    const SHADING_NORMALS: bool = true;
 
     type Exit<'e>
         = LazyExit<'e>
@@ -211,7 +217,8 @@ impl<'a> DeviceBoundary<'a> {
         }
     }
 
-    /// `mesh`, without its distance grid (the kernels cast every flight's exit).
+    /// `mesh`, without its distance grid (the kernels cast every flight's exit) and without
+    /// vertex normals: the GPU refuses a mesh that has them (`volpt_cuda`'s kernel sets).
     pub fn mesh(mesh: &TriangleMesh<'a>) -> Self {
         Self {
             bounds: mesh.bounds,
@@ -230,6 +237,7 @@ impl<'a> DeviceBoundary<'a> {
         TriangleMesh {
             nodes: self.nodes,
             triangles: self.triangles,
+            normals: &[],
             bounds: self.bounds,
             distance: SurfaceDistance::NONE,
         }
@@ -281,6 +289,7 @@ fn device_nearest(
     let mesh = TriangleMesh {
         nodes,
         triangles,
+        normals: &[],
         bounds: Aabb::new(Vec3::ZERO, Vec3::ZERO),
         distance: SurfaceDistance::NONE,
     };

@@ -69,12 +69,19 @@ pub enum Crossing {
 
 pub use distance::SurfaceDistance;
 
+/// A triangle's unit vertex normals at its three corners, in its vertices' order.
+pub type CornerNormals = [[f32; 3]; 3];
+
 /// A closed triangle mesh, its BVH and its distance grid, borrowed from memory the caller keeps
 /// (host or device).
 #[derive(Clone, Copy, Debug)]
 pub struct TriangleMesh<'a> {
     pub nodes: &'a [BvhNode],
     pub triangles: &'a [MeshTriangle],
+    /// Each triangle's vertex normals (in `triangles`' order), which the boundary's BSDF scatters
+    /// about, interpolated ([`TriangleMesh::hit`]); empty: each triangle's own normal (Mitsuba's
+    /// `face_normals`).
+    pub normals: &'a [CornerNormals],
     pub bounds: Aabb,
     /// Lets a free flight that cannot reach the surface skip the ray cast.
     pub distance: SurfaceDistance<'a>,
@@ -139,7 +146,7 @@ impl<'a> TriangleMesh<'a> {
 
     /// The hit record of a crossing of triangle `i` at distance `t`: the point, snapped onto the
     /// plane of a triangle in an axis plane (as the box snaps it onto its face) and clamped into
-    /// the mesh's bounds, and the outward normal.
+    /// the mesh's bounds, the outward normal, and the shading normal ([`Self::shading_normal`]).
     #[inline]
     pub(crate) fn hit(&self, ray: &Ray, t: f32, i: u32) -> BoxHit {
         let tri = &self.triangles[i as usize];
@@ -152,10 +159,16 @@ impl<'a> TriangleMesh<'a> {
         } else if n.x == 0.0 && n.y == 0.0 {
             point.z = tri.offset * n.z;
         }
+        let point = point.max(self.bounds.min).min(self.bounds.max);
+        let shading = match self.normals.get(i as usize) {
+            Some(corners) => shading_normal(tri, corners, point),
+            None => n,
+        };
         BoxHit {
             t,
-            point: point.max(self.bounds.min).min(self.bounds.max),
+            point,
             normal: n,
+            shading,
         }
     }
 
@@ -180,8 +193,31 @@ impl<'a> TriangleMesh<'a> {
                 t: 0.0,
                 point: ray.origin,
                 normal: ray.dir,
+                shading: ray.dir,
             },
         }
+    }
+}
+
+/// Phong's interpolated normal (Phong 1975) of `tri` at `p`, a point on it: its corners' normals
+/// weighted by `p`'s barycentric coordinates (clamped to the triangle, as a point a rounding error
+/// outside it is on its edge), normalised. A normal that does not lie in the geometric normal's
+/// hemisphere (strongly bent corner normals, or degenerate ones) would put the two sides of the
+/// surface on one side: the geometric normal is used there.
+#[inline]
+pub fn shading_normal(tri: &MeshTriangle, corners: &CornerNormals, p: Vec3) -> Vec3 {
+    let n = Vec3::from(tri.normal);
+    let [a, b, c] = tri.v.map(Vec3::from);
+    let twice_area = (b - a).cross(c - a).dot(n);
+    let w0 = ((b - p).cross(c - p).dot(n) / twice_area).clamp(0.0, 1.0);
+    let w1 = ((c - p).cross(a - p).dot(n) / twice_area).clamp(0.0, 1.0);
+    let w2 = (1.0 - w0 - w1).max(0.0);
+    let [n0, n1, n2] = corners.map(Vec3::from);
+    let s = crate::math::normalize(n0 * w0 + n1 * w1 + n2 * w2);
+    if s.dot(n) > 0.0 {
+        s
+    } else {
+        n
     }
 }
 
@@ -339,6 +375,7 @@ fn intersect(
 
 impl Shape for TriangleMesh<'_> {
     const CONVEX: bool = false;
+    const SHADING_NORMALS: bool = true;
 
     type Exit<'e>
         = crate::flight::LazyExit<'e>
