@@ -111,6 +111,18 @@ pub fn describe(
             ),
         },
     );
+    if let Some(mesh) = &desc.boundary.mesh {
+        field(
+            "normals",
+            if mesh.buffers.normals.is_empty() {
+                "each triangle's own (face normals)".to_owned()
+            } else {
+                "interpolated vertex normals (Phong), on the CPU only: the GPU kernels refract at \
+                 the triangles' own normals (face_normals=\"true\")"
+                    .to_owned()
+            },
+        );
+    }
     field("boundary", desc.boundary.bsdf.to_string());
     field("density", format!("{}, scale {}", m.density, m.scale));
     field(

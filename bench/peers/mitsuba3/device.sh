@@ -17,7 +17,9 @@
 # name scenes/mesh-peers' triangle-mesh boundaries, issue 39: a smooth dielectric sphere mesh and a
 # rough dielectric torus holding a density grid: `MODE=cpu SCENES="mesh-sphere-smooth
 # mesh-torus-rough"`; on the GPU the sphere alone, `MODE=gpu SCENES=mesh-sphere-smooth`: volpt's
-# mesh kernels have no environment map).
+# mesh kernels have no environment map); mesh-sphere-shaded is the sphere with smooth vertex
+# normals, which volpt renders on the CPU only (`MODE=cpu`, or compare.py `--backend cpu --variant
+# cuda_ad_rgb`).
 # Everything lands under $OUT/peers: results.md (one Markdown row per scene and device), <name>.json,
 # the EXR images, the Mitsuba 3 XML each scene was rendered from, and the logs.
 #
@@ -101,6 +103,7 @@ scene_args() { # name -> file and -D parameters
         spot-fog) echo "bundle/scenes/lights/spot-fog.xml" ;;
         spot-fog-chromatic) echo "bundle/scenes/lights/spot-fog.xml -D sigma_t=0.25,0.5,1" ;;
         mesh-sphere-smooth) echo "bundle/scenes/mesh-peers/sphere.xml" ;;
+        mesh-sphere-shaded) echo "bundle/scenes/mesh-peers/sphere.xml -D face_normals=false" ;;
         mesh-torus-rough) echo "bundle/scenes/mesh-peers/torus.xml" ;;
         *) echo "" ;;
     esac
