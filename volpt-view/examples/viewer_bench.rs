@@ -272,7 +272,8 @@ async fn main() {
     let mut tick = tokio::time::interval(Duration::from_micros(16_667));
     let mut sent: Vec<([f64; 3], Instant)> = Vec::new();
     let (mut frames, mut move_latency, mut widths) = (0u32, Vec::new(), Vec::new());
-    let (mut render, mut tonemap, mut encode, mut bytes) = (vec![], vec![], vec![], vec![]);
+    let (mut setup, mut render, mut tonemap, mut encode, mut bytes) =
+        (vec![], vec![], vec![], vec![], vec![]);
     let mut angle = 0.6;
     loop {
         tokio::select! {
@@ -296,6 +297,7 @@ async fn main() {
                     move_latency.push(at.elapsed().as_secs_f64() * 1e3);
                 }
                 widths.push(format!("{}x{}", h["width"], h["height"]));
+                setup.push(h["setup_ms"].as_f64().unwrap_or(0.0));
                 render.push(h["render_ms"].as_f64().unwrap_or(0.0));
                 tonemap.push(h["tonemap_ms"].as_f64().unwrap_or(0.0));
                 encode.push(h["encode_ms"].as_f64().unwrap_or(0.0));
@@ -318,6 +320,10 @@ async fn main() {
         .iter()
         .map(|(h, _)| h["render_ms"].as_f64().unwrap_or(0.0))
         .collect();
+    let first_setup: Vec<f64> = first_frames
+        .iter()
+        .map(|(h, _)| h["setup_ms"].as_f64().unwrap_or(0.0))
+        .collect();
     let first_encode: Vec<f64> = first_frames
         .iter()
         .map(|(h, _)| {
@@ -330,6 +336,7 @@ async fn main() {
         "repeat_identical": repeat_identical,
         "still_move_to_frame_ms_median": median(latency.clone()),
         "still_move_to_frame_ms_all": latency,
+        "still_first_frame_setup_ms_median": median(first_setup),
         "still_first_frame_render_ms_median": median(first_render),
         "still_first_frame_tonemap_encode_ms_median": median(first_encode),
         "still_frames_per_s": f64::from(still_frames) / still_s,
@@ -337,7 +344,7 @@ async fn main() {
         "orbit_frames_per_s": f64::from(frames) / orbit_s,
         "orbit_move_to_frame_ms_median": median(move_latency),
         "orbit_resolution": common,
-        "orbit_render_ms_mean": mean(&render), "orbit_tonemap_ms_mean": mean(&tonemap),
+        "orbit_setup_ms_mean": mean(&setup), "orbit_render_ms_mean": mean(&render), "orbit_tonemap_ms_mean": mean(&tonemap),
         "orbit_encode_ms_mean": mean(&encode), "orbit_jpeg_bytes_mean": mean(&bytes),
     });
     println!("{report}");
