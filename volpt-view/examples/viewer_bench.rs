@@ -182,7 +182,10 @@ async fn main() {
         .next()
         .expect("usage: viewer_bench WS_URL [SECONDS | --snapshot FILE]");
     let mode = args.next();
-    let (mut ws, _) = tokio_tungstenite::connect_async(&url)
+    // Messages go out at once, as a browser's do (TCP_NODELAY): with Nagle's algorithm, a move
+    // sent right after an ack waits for the server's delayed ACK of that ack (40 ms on Linux)
+    // whenever the server has nothing to send: the frames it would send wait for the move.
+    let (mut ws, _) = tokio_tungstenite::connect_async_with_config(&url, None, true)
         .await
         .expect("connecting");
     let hello: Value = match ws.next().await {
@@ -271,6 +274,8 @@ async fn main() {
     let end = started + Duration::from_secs_f64(seconds);
     let mut tick = tokio::time::interval(Duration::from_micros(16_667));
     let mut sent: Vec<([f64; 3], Instant)> = Vec::new();
+    // The frames' numbers: a gap is frames the server made that this client never got.
+    let mut ids: Vec<u64> = Vec::new();
     let (mut frames, mut move_latency, mut widths) = (0u32, Vec::new(), Vec::new());
     let (mut setup, mut render, mut tonemap, mut encode, mut bytes) =
         (vec![], vec![], vec![], vec![], vec![]);
@@ -289,6 +294,7 @@ async fn main() {
                 let Some((h, size, _)) = frame else { break };
                 if h["interactive"] != true { continue; }
                 frames += 1;
+                ids.push(h["frame"].as_u64().unwrap_or(0));
                 let shown = vec3(&h["view"]["origin"]);
                 // The move this frame shows: the server echoes the origin as f32.
                 if let Some((_, at)) = sent.iter().rev().find(|(o, _)| {
@@ -342,6 +348,11 @@ async fn main() {
         "still_frames_per_s": f64::from(still_frames) / still_s,
         "still_spp_after": last_still["spp"], "still_paths_per_s": last_still["paths_per_s"],
         "orbit_frames_per_s": f64::from(frames) / orbit_s,
+        "orbit_moves_sent": sent.len(),
+        "orbit_frames_made_not_received": match (ids.first(), ids.last()) {
+            (Some(first), Some(last)) => (last - first + 1).saturating_sub(ids.len() as u64),
+            _ => 0,
+        },
         "orbit_move_to_frame_ms_median": median(move_latency),
         "orbit_resolution": common,
         "orbit_setup_ms_mean": mean(&setup), "orbit_render_ms_mean": mean(&render), "orbit_tonemap_ms_mean": mean(&tonemap),

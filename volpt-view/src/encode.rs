@@ -18,12 +18,27 @@ pub use volpt::tone::tone_map;
 /// jpeg-encoder chooses). A frame of several MCU rows is encoded in horizontal strips on several
 /// threads, joined by restart markers ([`restart_strips`]).
 pub fn jpeg(rgb: &[u8], width: u32, height: u32, quality: u8) -> Result<Vec<u8>, ViewError> {
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get().min(MAX_THREADS));
-    jpeg_in_strips(rgb, width, height, quality, threads)
+    jpeg_in_strips(rgb, width, height, quality, jpeg_threads())
 }
 
 /// Threads a frame's JPEG uses at most: the host's other cores render and send.
 const MAX_THREADS: usize = 8;
+/// Sets the threads a frame's JPEG uses (1: one encoder, no restart markers), for measurements.
+pub const JPEG_THREADS_VARIABLE: &str = "VOLPT_VIEW_JPEG_THREADS";
+
+/// [`JPEG_THREADS_VARIABLE`]'s number where it holds one, else the cores up to [`MAX_THREADS`].
+fn jpeg_threads() -> usize {
+    static THREADS: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *THREADS.get_or_init(|| {
+        std::env::var(JPEG_THREADS_VARIABLE)
+            .ok()
+            .and_then(|v| v.parse::<usize>().ok())
+            .filter(|&n| n >= 1)
+            .unwrap_or_else(|| {
+                std::thread::available_parallelism().map_or(1, |n| n.get().min(MAX_THREADS))
+            })
+    })
+}
 /// Pixels a strip has at least: smaller frames are not worth a thread.
 const MIN_STRIP_PIXELS: usize = 1 << 16;
 
