@@ -7,7 +7,10 @@
 #   MODE=gpu bash bench/peers/mitsuba3/device.sh   # only the GPU rows; MODE=cpu only the CPU rows
 #   MODE=print bash bench/peers/mitsuba3/device.sh # issue 40: compensated prints against naive ones,
 #                                                  # rendered by Mitsuba 3 (bundle/print.sh's records;
-#                                                  # it runs first if they are missing), print.py
+#                                                  # it runs first if they are missing), print.py;
+#                                                  # PRINT_STEPS and PRINT_TARGETS pass to print.sh
+#                                                  # (PRINT_STEPS=3 PRINT_TARGETS=lines: the fine
+#                                                  # target alone), PRINT_SPP to print.py
 #
 # Settings: GPU_RES/GPU_SPP (default 400/100, the thesis settings), CPU_RES/CPU_SPP (default 100/64:
 # Mitsuba's LLVM backend is slow on these dense scenes), SCENES (names, default the seven grey
@@ -131,7 +134,8 @@ if [ "$MODE" = print ]; then
         log "bundle/print.sh: $(tail -n 1 "$RECORDS/summary.txt" 2>/dev/null)"
     fi
     "$PY" bench/peers/mitsuba3/print.py --volpt "$VOLPT" --spp "${PRINT_SPP:-4096}" --fine lines \
-        --uniform "$RECORDS/white" "$RECORDS/lines" "$RECORDS/photo" "$RECORDS/gradient" 2>"$RES_DIR/print-mitsuba.log" \
+        --uniform "$RECORDS/white" $(for t in ${PRINT_TARGETS:-lines photo gradient}; do echo "$RECORDS/$t"; done) \
+        2>"$RES_DIR/print-mitsuba.log" \
         | tee -a "$RES_DIR/device-summary.txt"
     status=${PIPESTATUS[0]}
     log "print: $([ "$status" = 0 ] && echo PASS || echo "FAIL (status $status; $RES_DIR/print-mitsuba.log)")"
