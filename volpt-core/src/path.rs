@@ -333,7 +333,7 @@ fn advance<S: Scene, const DEFER_SCATTER: bool>(scene: &S, path: &mut PathOf<S>)
                 scatter(scene, path, p, None);
             }
             FreeFlight::Escaped => {
-                let exit = scene.shape().exit(&path.ray);
+                let exit = scene.shape().escaped_exit(&path.ray, &t_exit);
                 interact_with_boundary(scene, path, exit)
             }
             FreeFlight::OutOfSteps => path.truncate(Truncation::TrackingSteps),

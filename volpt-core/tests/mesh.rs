@@ -830,3 +830,65 @@ fn a_bvh_of_concatenated_subtrees_is_well_formed() {
         );
     }
 }
+
+/// The BVH walk (its stack, the far children skipped once a nearer crossing is known, the
+/// cheap rejections before the edge functions) finds the crossing a scan of every triangle in
+/// order finds: the same distance to the bit and a triangle of the same plane, for every kind of
+/// crossing, from outside, from inside and from points on the surface, in the sphere and the
+/// torus. The scan is the same mesh with one leaf holding every triangle.
+#[test]
+fn the_bvh_walk_finds_what_a_scan_of_every_triangle_finds() {
+    use volpt_core::mesh::{BvhNode, Crossing, TriangleMesh};
+    let mut rng = TestRng::new(13);
+    for (what, mesh) in [("sphere", test_sphere()), ("torus", test_torus())] {
+        let buffers = built(&mesh);
+        let walked = buffers.mesh();
+        let leaf = [BvhNode {
+            min: walked.bounds.min.to_array(),
+            first: 0,
+            max: walked.bounds.max.to_array(),
+            count: walked.triangles.len() as u32,
+        }];
+        let scan = TriangleMesh {
+            nodes: &leaf,
+            ..walked
+        };
+        let mut found = 0;
+        for ray in chord_rays(&mut rng, 3000) {
+            let inside = Vec3::new(
+                rng.range(-0.6, 0.6) as f32,
+                rng.range(-0.6, 0.6) as f32,
+                rng.range(-0.3, 0.3) as f32,
+            );
+            let on_surface = walked
+                .entry(&ray)
+                .map(|hit| Ray::new(hit.point, rng.unit_vector()));
+            let rays = [
+                Some(ray),
+                Some(Ray::new(inside, rng.unit_vector())),
+                on_surface,
+            ];
+            for ray in rays.into_iter().flatten() {
+                for crossing in [Crossing::Entering, Crossing::Leaving, Crossing::Any] {
+                    let (want, got) =
+                        (scan.nearest(&ray, crossing), walked.nearest(&ray, crossing));
+                    let plane = |(t, i): (f32, u32)| {
+                        let tri = walked.triangles[i as usize];
+                        (
+                            t.to_bits(),
+                            tri.normal.map(f32::to_bits),
+                            tri.offset.to_bits(),
+                        )
+                    };
+                    assert_eq!(
+                        want.map(plane),
+                        got.map(plane),
+                        "{what} {crossing:?} {ray:?}"
+                    );
+                    found += got.is_some() as u32;
+                }
+            }
+        }
+        assert!(found > 10_000, "{what}: {found} crossings found");
+    }
+}

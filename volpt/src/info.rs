@@ -103,7 +103,7 @@ pub fn describe(
             Some(mesh) => format!(
                 "closed triangle mesh from {}: {} triangles, BVH of {} nodes (bounds: its \
                  bounding box); one ray cast per crossing; on the GPU by the mesh kernels \
-                 ({}; homogeneous and dense-grid media under a constant environment)",
+                 ({}; homogeneous and dense-grid media)",
                 mesh.source,
                 mesh.triangle_count(),
                 mesh.buffers.nodes.len(),

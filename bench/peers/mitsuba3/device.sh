@@ -19,8 +19,8 @@
 # emitters: `SCENES="sun-slab spot-fog spot-fog-chromatic"`; mesh-sphere-smooth and mesh-torus-rough
 # name scenes/mesh-peers' triangle-mesh boundaries, issue 39: a smooth dielectric sphere mesh and a
 # rough dielectric torus holding a density grid: `MODE=cpu SCENES="mesh-sphere-smooth
-# mesh-torus-rough"`; on the GPU the sphere alone, `MODE=gpu SCENES=mesh-sphere-smooth`: volpt's
-# mesh kernels have no environment map).
+# mesh-torus-rough"`, and on the GPU the same (`MODE=gpu`; the torus's environment map has mesh
+# kernels since session 13).
 # Everything lands under $OUT/peers: results.md (one Markdown row per scene and device), <name>.json,
 # the EXR images, the Mitsuba 3 XML each scene was rendered from, and the logs.
 #

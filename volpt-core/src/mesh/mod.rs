@@ -25,6 +25,8 @@ pub mod distance;
 #[cfg(feature = "alloc")]
 pub mod primitives;
 
+use core::mem::MaybeUninit;
+
 use bytemuck::{Pod, Zeroable};
 
 use crate::geometry::{Aabb, BoxHit, Ray};
@@ -37,7 +39,9 @@ pub const MAX_BVH_DEPTH: usize = 64;
 
 /// A node of the BVH: its box, and either its two children (`count` 0: the first child follows
 /// the node, the second is node `first`) or its triangles (`count` > 0: `first..first + count`).
-#[repr(C)]
+///
+/// Aligned to 16 bytes, so that a GPU reads each half (box corner and index) in one load.
+#[repr(C, align(16))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct BvhNode {
     pub min: [f32; 3],
@@ -92,7 +96,11 @@ impl<'a> TriangleMesh<'a> {
         let sheared = ShearedRay::new(ray);
         let mut best_t = f32::INFINITY;
         let mut best = None;
-        let mut stack = [0u32; MAX_BVH_DEPTH];
+        // The far children still to visit, each with its entry distance (bits high, node low):
+        // one popped once a nearer crossing was found is skipped, as its slab test would skip it
+        // now. Uninitialised (zeroing it would be 256 bytes of local-memory stores per cast on
+        // a GPU); only entries below `depth` are read.
+        let mut stack = [MaybeUninit::<u64>::uninit(); MAX_BVH_DEPTH];
         let mut depth = 0usize;
         let mut node = 0u32;
         loop {
@@ -100,12 +108,10 @@ impl<'a> TriangleMesh<'a> {
             let mut next = None;
             if n.count > 0 {
                 for i in n.first..n.first + n.count {
-                    if let Some(t) = intersect(&self.triangles[i as usize], ray, &sheared, crossing)
-                    {
-                        if t < best_t {
-                            best_t = t;
-                            best = Some((t, i));
-                        }
+                    let tri = &self.triangles[i as usize];
+                    if let Some(t) = intersect(tri, ray, &sheared, crossing, best_t) {
+                        best_t = t;
+                        best = Some((t, i));
                     }
                 }
             } else {
@@ -114,9 +120,14 @@ impl<'a> TriangleMesh<'a> {
                 let tb = slab(&self.nodes[b as usize], ray, inv, best_t);
                 next = match (ta, tb) {
                     (Some(ta), Some(tb)) => {
-                        let (near, far) = if ta <= tb { (a, b) } else { (b, a) };
+                        let ((near, _), (far, t_far)) = if ta <= tb {
+                            ((a, ta), (b, tb))
+                        } else {
+                            ((b, tb), (a, ta))
+                        };
                         if depth < MAX_BVH_DEPTH {
-                            stack[depth] = far;
+                            stack[depth] =
+                                MaybeUninit::new(u64::from(t_far.to_bits()) << 32 | u64::from(far));
                             depth += 1;
                         }
                         Some(near)
@@ -128,11 +139,17 @@ impl<'a> TriangleMesh<'a> {
             }
             node = match next {
                 Some(next) => next,
-                None if depth > 0 => {
+                None => loop {
+                    if depth == 0 {
+                        return best;
+                    }
                     depth -= 1;
-                    stack[depth]
-                }
-                None => return best,
+                    // SAFETY: every entry below `depth` was written by a push.
+                    let entry = unsafe { stack[depth].assume_init() };
+                    if f32::from_bits((entry >> 32) as u32) <= best_t {
+                        break entry as u32;
+                    }
+                },
             };
         }
     }
@@ -305,36 +322,55 @@ fn edge_function(a: (f32, f32), b: (f32, f32)) -> f32 {
 }
 
 /// The distance at which `ray` crosses `tri` in the direction `crossing` asks for, if it does,
-/// at a distance >= 0 (see the module documentation).
+/// at a distance in `[0, t_max)` (see the module documentation).
+///
+/// The cheap tests come first, each deciding as the full test would: the crossing's direction is
+/// the sign of `n . d` (a triangle facing the wrong way is no crossing, whatever its edges), and
+/// the distance is the plane's alone, so a triangle behind the ray or beyond `t_max` is rejected
+/// before its vertices are read; the edge functions run for the few that remain.
 #[inline(always)]
 fn intersect(
     tri: &MeshTriangle,
     ray: &Ray,
     sheared: &ShearedRay,
     crossing: Crossing,
+    t_max: f32,
 ) -> Option<f32> {
+    let n = Vec3::from(tri.normal);
+    let cos = n.dot(ray.dir);
+    let entering = match crossing {
+        Crossing::Entering => cos < 0.0,
+        Crossing::Leaving => false,
+        Crossing::Any => cos < 0.0,
+    };
+    let leaving = match crossing {
+        Crossing::Entering => false,
+        Crossing::Leaving | Crossing::Any => cos > 0.0,
+    };
+    if !entering && !leaving {
+        return None;
+    }
+    let distance = tri.offset - n.dot(ray.origin);
+    // Entering is the box's near slab (times the reciprocal), leaving its far slab (a quotient).
+    let t = if entering {
+        distance * recip_scalar(cos)
+    } else {
+        div_scalar(distance, cos)
+    };
+    // A NaN distance (a degenerate plane) is no crossing.
+    if !(t >= 0.0 && t < t_max) {
+        return None;
+    }
     let p = tri.v.map(|v| sheared.project(v));
     let w0 = edge_function(p[1], p[2]);
     let w1 = edge_function(p[2], p[0]);
     let w2 = edge_function(p[0], p[1]);
-    let entering = w0 <= 0.0 && w1 <= 0.0 && w2 <= 0.0;
-    let leaving = w0 >= 0.0 && w1 >= 0.0 && w2 >= 0.0;
-    let n = Vec3::from(tri.normal);
-    let cos = n.dot(ray.dir);
-    let distance = tri.offset - n.dot(ray.origin);
-    // The crossing's direction decides which arithmetic: entering is the box's near slab
-    // (times the reciprocal), leaving its far slab (a quotient).
-    let t = match crossing {
-        Crossing::Entering | Crossing::Any if entering && cos < 0.0 => distance * recip_scalar(cos),
-        Crossing::Leaving | Crossing::Any if leaving && cos > 0.0 => div_scalar(distance, cos),
-        _ => return None,
-    };
-    // A NaN distance (a degenerate plane) is no crossing.
-    if t >= 0.0 {
-        Some(t)
+    let inside = if entering {
+        w0 <= 0.0 && w1 <= 0.0 && w2 <= 0.0
     } else {
-        None
-    }
+        w0 >= 0.0 && w1 >= 0.0 && w2 >= 0.0
+    };
+    inside.then_some(t)
 }
 
 impl Shape for TriangleMesh<'_> {
@@ -355,9 +391,13 @@ impl Shape for TriangleMesh<'_> {
         self.bounds
     }
 
-    /// Inside if the nearest crossing along a fixed direction leaves the mesh.
+    /// Inside if the nearest crossing along a fixed direction leaves the mesh; a point outside
+    /// the mesh's box (a camera's) is outside without a cast.
     #[inline]
     fn contains(&self, p: Vec3) -> bool {
+        if !self.bounds.contains(p) {
+            return false;
+        }
         let ray = Ray::new(p, CONTAINS_DIRECTION);
         self.contains_by(&ray, self.nearest(&ray, Crossing::Any))
     }
