@@ -24,6 +24,9 @@
 #    print, not the predictions' noise (docs/printing.md, "Noise floor"). And $OUT/white/: a
 #    uniform white 96 x 96 target's naive print (one prediction), the noise floor's reference.
 #    Expected: four summary lines, best mean below naive on each of the three.
+# PRINT_STEPS (default "1 2 3") runs only the steps named; PRINT_TARGETS (default "lines photo
+# gradient") names step 3's targets (the white record is always made): e.g. PRINT_STEPS=3
+# PRINT_TARGETS=lines, the fine-detail target's records alone (about 30 s on one H200).
 set -uo pipefail
 cd "$(dirname "$0")"
 OUT=${OUT:-$PWD/out/print}
@@ -71,7 +74,11 @@ compensate() { # compensate NAME TARGET ARGS...
     fi
 }
 
+STEPS=" ${PRINT_STEPS:-1 2 3} "
+step() { [[ "$STEPS" == *" $1 "* ]]; }
+
 # 1. CPU against GPU.
+if step 1; then
 target 32 "$OUT/bars32.png"
 small=(--layers 100 --colour-layers 40 --spp 256 --noise-ratio 0 --iterations 3 --seed 1)
 compensate small-cpu "$OUT/bars32.png" "${small[@]}" --backend cpu
@@ -101,19 +108,24 @@ else
     log "FAIL default-backend: $(head -n 2 "$OUT/small-default.log" | tr '\n' ' ')"; failures=$((failures + 1))
 fi
 compensate small-gpus "$OUT/bars32.png" "${small[@]}" --gpus all
+fi
 
 # 2. The thesis's slab size, timed.
+if step 2; then
 target 320 "$OUT/bars320.png"
 compensate thesis-cuda "$OUT/bars320.png" --layers 100 --colour-layers 40 --spp 64 --max-spp 1024 \
     --iterations 10 --backend cuda
 grep "iteration [0-9]*:" "$OUT/thesis-cuda.log" | sed 's/^/   /' | tee -a "$OUT/summary.txt"
+fi
 
 # 3. The worked example's targets, for the Mitsuba 3 cross-check.
-for name in lines photo gradient; do
+if step 3; then
+for name in ${PRINT_TARGETS:-lines photo gradient}; do
     compensate "$name" "$EXAMPLES/$name.png" --layers 100 --colour-layers 40 --spp 1024 \
         --max-spp 16384 --noise-ratio 0.1 --iterations 10 --backend cuda
 done
 target 96 "$OUT/white96.png" white
 compensate white "$OUT/white96.png" --layers 100 --colour-layers 40 --spp 1024 --iterations 1 \
     --backend cuda
+fi
 log "failures $failures"

@@ -79,7 +79,7 @@ say ""
 say "device: $(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null | head -n 1); CPU: $(nproc) threads of $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)"
 say "volpt: $($VOLPT --version 2>/dev/null); GPU strategy $STRATEGIES, math $MATH; phases of $SECONDS_PER_PHASE s"
 say ""
-say "move->frame: a still camera move to its first frame (1 spp, full resolution), median of 10. still: frames/s of the refinement and the spp reached. orbit: 60 interactive moves/s; frames/s showing a move, move->frame median, the resolution the renderer chose, and the mean render / tone map / JPEG ms per frame."
+say "move->frame: a still camera move to its first frame (1 spp, full resolution), median of 10. still: frames/s of the refinement and the spp reached. orbit: 60 interactive moves/s; frames/s showing a move, move->frame median, the resolution the renderer chose, and the mean setup (the moves checked and applied, the epoch started) / render / tone map / JPEG ms per frame."
 say ""
 "$VOLPT" scene generate scenes >"$OUT/viewer-generate.log" 2>&1 || echo "viewer.sh: volpt scene generate failed (see viewer-generate.log)"
 
@@ -167,7 +167,7 @@ except Exception as e: print('no snapshot:', e)" <"$OUT/accumulation-$scene-$nam
 fi
 
 num() { python3 -c "import json,sys; v=json.loads(sys.argv[1]).get(sys.argv[2]); print('-' if v is None else (f'{v:.1f}' if isinstance(v,float) else v))" "$1" "$2"; }
-say "| scene | backend | resolution | move->frame ms | still frames/s | still spp after | orbit frames/s | orbit move->frame ms | orbit at | orbit render / tone / jpeg ms |"
+say "| scene | backend | resolution | move->frame ms | still frames/s | still spp after | orbit frames/s | orbit move->frame ms | orbit at | orbit setup / render / tone / jpeg ms |"
 say "|---|---|---|---|---|---|---|---|---|---|"
 # The backends to run: the CPU, and the GPU once per strategy of STRATEGIES.
 configs=()
@@ -206,7 +206,7 @@ for scene in $SCENES; do
           say "| $scene | $label | $res | FAIL: a view shown again is not its first image ($(num "$json" repeat_identical)) |"
           failures=$((failures + 1))
       fi
-      say "| $scene | $label | $res | $(num "$json" still_move_to_frame_ms_median) | $(num "$json" still_frames_per_s) | $(num "$json" still_spp_after) | $(num "$json" orbit_frames_per_s) | $(num "$json" orbit_move_to_frame_ms_median) | $(num "$json" orbit_resolution) | $(num "$json" orbit_render_ms_mean) / $(num "$json" orbit_tonemap_ms_mean) / $(num "$json" orbit_encode_ms_mean) |"
+      say "| $scene | $label | $res | $(num "$json" still_move_to_frame_ms_median) | $(num "$json" still_frames_per_s) | $(num "$json" still_spp_after) | $(num "$json" orbit_frames_per_s) | $(num "$json" orbit_move_to_frame_ms_median) | $(num "$json" orbit_resolution) | $(num "$json" orbit_setup_ms_mean) / $(num "$json" orbit_render_ms_mean) / $(num "$json" orbit_tonemap_ms_mean) / $(num "$json" orbit_encode_ms_mean) |"
     done
   done
 done

@@ -37,6 +37,11 @@ pub enum PrintCommand {
         /// has the print's far edge (a slice's bottom row) at its top.
         #[arg(long)]
         flip_rows: bool,
+        /// Also the mean per region of a PNG target: its ink (texels not white), the white
+        /// within 2 texels of ink, 3 to 6 texels away, and farther (docs/printing.md, "Where the
+        /// lines' error is").
+        #[arg(long)]
+        regions: bool,
     },
 }
 
@@ -102,13 +107,9 @@ pub struct CompensateArgs {
     quiet: bool,
 }
 
-/// An update's name.
+/// An update's name ([`Update::name`]).
 fn parse_update(s: &str) -> Result<Update, String> {
-    match s {
-        "cross-talk" => Ok(Update::CrossTalk),
-        "per-texel" => Ok(Update::PerTexel),
-        _ => Err(format!("expected cross-talk or per-texel, found {s:?}")),
-    }
+    s.parse()
 }
 
 /// `X,Y,Z` as three numbers.
@@ -127,16 +128,29 @@ pub fn run_command(command: PrintCommand) -> Result<()> {
             target,
             image,
             flip_rows,
-        } => delta_e(&target, &image, flip_rows),
+            regions,
+        } => delta_e(&target, &image, flip_rows, regions),
     }
 }
 
-fn delta_e(target: &std::path::Path, image: &std::path::Path, flip_rows: bool) -> Result<()> {
+fn delta_e(
+    target: &std::path::Path,
+    image: &std::path::Path,
+    flip_rows: bool,
+    regions: bool,
+) -> Result<()> {
     use volpt_print::colour::{ciede2000, LinearRgb};
+    use volpt_print::regions::{region_means, Region};
     let exr = |path: &std::path::Path| {
         path.extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
     };
+    if regions && exr(target) {
+        anyhow::bail!(
+            "{}: --regions expected a PNG target (its white and ink), found an OpenEXR",
+            target.display()
+        );
+    }
     let target = if exr(target) {
         let image = volpt::read_exr(target, "the reference image")?;
         volpt_print::target::Target {
@@ -159,14 +173,17 @@ fn delta_e(target: &std::path::Path, image: &std::path::Path, flip_rows: bool) -
             rendered.height
         );
     }
-    let mut delta_e = Vec::new();
+    let class = volpt_print::regions::regions(&target.texels, target.size);
+    let (mut delta_e, mut classes) = (Vec::new(), Vec::new());
     for y in 0..h {
         let row = if flip_rows { h - 1 - y } else { y };
         for x in 0..w {
             let p = LinearRgb(rendered.pixel(x, row).map(f64::from));
-            let t = target.texels[(x + w * y) as usize];
+            let i = (x + w * y) as usize;
+            let t = target.texels[i];
             if p.0.iter().chain(&t.0).all(|v| v.is_finite()) {
                 delta_e.push(ciede2000(p.to_lab(), t.to_lab()));
+                classes.push(class[i]);
             }
         }
     }
@@ -180,6 +197,17 @@ fn delta_e(target: &std::path::Path, image: &std::path::Path, flip_rows: bool) -
         volpt::metrics::quantile(&delta_e, 0.95),
         delta_e.len()
     );
+    if regions {
+        let parts: Vec<String> = Region::ALL
+            .iter()
+            .zip(region_means(&delta_e, &classes))
+            .map(|(r, (share, mean))| {
+                let mean = mean.map_or("-".into(), |m| format!("{m:.4}"));
+                format!("{} {mean} ({:.1}%)", r.name(), 100.0 * share)
+            })
+            .collect();
+        println!("regions: mean ΔE00 {}", parts.join(", "));
+    }
     Ok(())
 }
 

@@ -417,6 +417,10 @@ pub trait SceneAbi: Scene + Sized {
     /// meshes).
     fn on_device(&self) -> bool;
 
+    /// Whether the boundary scatters about vertex normals ([`crate::mesh::TriangleMesh::normals`]),
+    /// which no kernel traces: the parameters do not carry them.
+    fn shading_normals(&self) -> bool;
+
     /// This scene rebuilt from its parameters with its boundary a [`DeviceBoundary`], the shape a
     /// kernel traces a box or a mesh as (the CPU renders it too, to check that code).
     type Kernel: Scene + SceneAbi<Params = Self::Params>;
@@ -451,6 +455,10 @@ pub trait DeviceShape: Sized {
     fn device_box(&self) -> Aabb;
     /// Places a mesh's BVH with `upload`; a box has none.
     fn mesh_params(&self, upload: &mut Upload<'_>) -> MeshParams;
+    /// Whether this is a mesh with vertex normals ([`SceneAbi::shading_normals`]).
+    fn shading_normals(&self) -> bool {
+        false
+    }
     /// The device side: the shape of box `bounds` and BVH `mesh`.
     ///
     /// # Safety
@@ -553,6 +561,9 @@ impl<'a> DeviceShape for BoundaryShape<'a> {
             BoundaryShape::Mesh(m) => upload_mesh(m.nodes, m.triangles, upload),
         }
     }
+    fn shading_normals(&self) -> bool {
+        matches!(self, BoundaryShape::Mesh(m) if !m.normals.is_empty())
+    }
     /// A mesh comes back without its distance grid (which the kernels do not read): every
     /// flight casts its exit, and traces the same path.
     unsafe fn from_device(bounds: Aabb, mesh: &MeshParams) -> Self {
@@ -564,6 +575,7 @@ impl<'a> DeviceShape for BoundaryShape<'a> {
         BoundaryShape::Mesh(TriangleMesh {
             nodes,
             triangles,
+            normals: &[],
             bounds,
             distance: SurfaceDistance::NONE,
         })
@@ -588,6 +600,10 @@ where
 
     fn on_device(&self) -> bool {
         self.bounds.on_device()
+    }
+
+    fn shading_normals(&self) -> bool {
+        self.bounds.shading_normals()
     }
 
     fn to_params(&self, upload: &mut Upload<'_>) -> Self::Params {
@@ -643,6 +659,10 @@ impl<S: SceneAbi> SceneAbi for Lit<S> {
 
     fn on_device(&self) -> bool {
         self.0.on_device()
+    }
+
+    fn shading_normals(&self) -> bool {
+        self.0.shading_normals()
     }
 
     fn to_params(&self, upload: &mut Upload<'_>) -> Self::Params {

@@ -28,7 +28,12 @@ impl Ray {
 pub struct BoxHit {
     pub t: f32,
     pub point: Vec3,
+    /// The surface's outward geometric normal: which side is which.
     pub normal: Vec3,
+    /// The outward normal the boundary's BSDF scatters about: `normal` itself, except on a mesh
+    /// with vertex normals ([`crate::mesh::TriangleMesh::normals`]), where it is interpolated
+    /// and lies in `normal`'s hemisphere.
+    pub shading: Vec3,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -89,10 +94,12 @@ impl Aabb {
             component(self.min, axis)
         };
         let point = with_component(ray.at(t_enter), axis, face);
+        let normal = axis_normal(axis, entering_max_face);
         Some(BoxHit {
             t: t_enter,
             point: self.clamp(point),
-            normal: axis_normal(axis, entering_max_face),
+            normal,
+            shading: normal,
         })
     }
 
@@ -104,10 +111,12 @@ impl Aabb {
         let axis = argmin(t);
         let t_exit = component(t, axis).max(0.0);
         let point = with_component(ray.at(t_exit), axis, component(far_plane, axis));
+        let normal = axis_normal(axis, component(ray.dir, axis) > 0.0);
         BoxHit {
             t: t_exit,
             point: self.clamp(point),
-            normal: axis_normal(axis, component(ray.dir, axis) > 0.0),
+            normal,
+            shading: normal,
         }
     }
 

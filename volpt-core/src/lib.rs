@@ -64,7 +64,7 @@ pub use path::{Estimator, PathCounters, PathOf, PathSettings, PathState, Roulett
 pub use phase::{HenyeyGreenstein, Isotropic, PhaseFunction};
 pub use rng::Rng;
 pub use scene::{Lit, Scene, VolumeScene, WithShape};
-pub use shape::{BoundaryShape, DeviceBoundary, Shape};
+pub use shape::{BoundaryShape, DeviceBoundary, DeviceExit, Shape};
 pub use spectral::{HeroChannel, SpectralState};
 
 /// Linear RGB radiance, throughput or albedo.

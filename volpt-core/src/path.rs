@@ -333,7 +333,7 @@ fn advance<S: Scene, const DEFER_SCATTER: bool>(scene: &S, path: &mut PathOf<S>)
                 scatter(scene, path, p, None);
             }
             FreeFlight::Escaped => {
-                let exit = scene.shape().exit(&path.ray);
+                let exit = scene.shape().escaped_exit(&path.ray, &t_exit);
                 interact_with_boundary(scene, path, exit)
             }
             FreeFlight::OutOfSteps => path.truncate(Truncation::TrackingSteps),
@@ -584,7 +584,12 @@ fn boundary_next_event_estimate<S: Scene>(scene: &S, path: &mut PathOf<S>, hit: 
     {
         return;
     }
-    let bsdf = scene.boundary().eval(hit.normal, path.ray.dir, light.dir);
+    let d = path.ray.dir;
+    let shading = shading_normal::<S>(hit, d);
+    if !lobe_matches_side::<S>(hit, shading, d, light.dir) {
+        return;
+    }
+    let bsdf = scene.boundary().eval(shading, d, light.dir);
     if bsdf.value <= 0.0 {
         return;
     }
@@ -602,6 +607,33 @@ pub(crate) fn power_heuristic(a: f32, b: f32) -> f32 {
     } else {
         0.0
     }
+}
+
+/// The normal the boundary's BSDF scatters about at `hit` for a ray along `d`: the shading normal
+/// ([`BoxHit::shading`]). The BSDF reads which side a ray comes from off the normal it is given,
+/// so where the shading normal puts the ray on the other side than the geometric one does (a
+/// grazing ray on bent vertex normals), the geometric normal is used.
+#[inline(always)]
+fn shading_normal<S: Scene>(hit: &BoxHit, d: Vec3) -> Vec3 {
+    if S::Shape::SHADING_NORMALS && d.dot(hit.shading) * d.dot(hit.normal) > 0.0 {
+        hit.shading
+    } else {
+        hit.normal
+    }
+}
+
+/// Whether `wo`, scattered at `hit` by a ray along `d`, lies on the side of the surface its lobe
+/// about the shading normal `shading` says: a reflection stays on the ray's side of the geometric
+/// surface, a transmission crosses it. A direction where they disagree would cross the surface
+/// without its refraction (or refract without crossing), and leak or create light; such a
+/// direction carries nothing, for sampling and for next-event estimation alike (Veach 1997, 5.3;
+/// pbrt-v3's rule). Dropping it only removes energy; each transmission left still crosses the
+/// surface, so its `1 / eta^2` radiance factor pairs with the crossing back, as with face normals.
+#[inline(always)]
+fn lobe_matches_side<S: Scene>(hit: &BoxHit, shading: Vec3, d: Vec3, wo: Vec3) -> bool {
+    !S::Shape::SHADING_NORMALS
+        || (d.dot(hit.normal) * wo.dot(hit.normal) > 0.0)
+            == (d.dot(shading) * wo.dot(shading) > 0.0)
 }
 
 // Inlined into every kernel's step: called by address, it would take the scene with it and keep
@@ -623,7 +655,12 @@ fn interact_with_boundary<S: Scene>(scene: &S, path: &mut PathOf<S>, hit: BoxHit
     }
     let u_lobe = path.rng.next_f32();
     let u = path.rng.next_2d();
-    match scene.boundary().sample(hit.normal, path.ray.dir, u_lobe, u) {
+    let d = path.ray.dir;
+    let shading = shading_normal::<S>(&hit, d);
+    match scene.boundary().sample(shading, d, u_lobe, u) {
+        Some(sample) if !lobe_matches_side::<S>(&hit, shading, d, sample.wo) => {
+            path.alive = false;
+        }
         Some(sample) => {
             if next_event {
                 // A direction out of the box escapes at once (the box is convex), where its light
@@ -632,7 +669,7 @@ fn interact_with_boundary<S: Scene>(scene: &S, path: &mut PathOf<S>, hit: BoxHit
                 // density rounds to 0 leaves its light to the environment's sample, which weights
                 // it by 1 and the BSDF's value of it, 0 too).
                 path.mis_pdf = if sample.wo.dot(hit.normal) > 0.0 {
-                    let bsdf = scene.boundary().eval(hit.normal, path.ray.dir, sample.wo);
+                    let bsdf = scene.boundary().eval(shading, d, sample.wo);
                     bsdf.pdf.max(f32::MIN_POSITIVE)
                 } else {
                     0.0

@@ -22,6 +22,11 @@ pub trait Shape {
     /// leaves it reaches the environment, and a shadow ray needs one exit.
     const CONVEX: bool;
 
+    /// Whether a hit's shading normal may differ from its geometric one ([`BoxHit::shading`]):
+    /// only then does the path step check a scattered direction's side against both
+    /// (`path::shading_normal`), so a shape without vertex normals carries no such test.
+    const SHADING_NORMALS: bool = false;
+
     /// [`Shape::CONVEX`] for this shape: a shape chosen at run time ([`BoundaryShape`]) knows only
     /// then. A compile-time constant for every other shape.
     #[inline(always)]
@@ -45,11 +50,20 @@ pub trait Shape {
 
     /// `exit_distance(ray)` as a free flight compares with it: the distance itself for a box, a
     /// mesh's found only if a flight gets far enough to need it ([`crate::flight`]).
-    type Exit<'a>: FlightEnd
+    type Exit<'a>: FlightEnd + Copy
     where
         Self: 'a;
 
     fn flight_exit<'a>(&'a self, ray: &'a Ray) -> Self::Exit<'a>;
+
+    /// `exit(ray)` for a free flight that escaped, given `end`, its [`Shape::flight_exit`]: a
+    /// shape whose flight end holds the surface it found builds the hit from it instead of
+    /// casting the same ray again.
+    #[inline(always)]
+    fn escaped_exit<'a>(&'a self, ray: &'a Ray, end: &Self::Exit<'a>) -> BoxHit {
+        let _ = end;
+        self.exit(ray)
+    }
 }
 
 impl Shape for Aabb {
@@ -100,6 +114,7 @@ pub enum BoundaryShape<'a> {
 
 impl Shape for BoundaryShape<'_> {
     const CONVEX: bool = false;
+    const SHADING_NORMALS: bool = true;
 
     type Exit<'e>
         = LazyExit<'e>
@@ -191,9 +206,10 @@ fn mesh_exit_distance(mesh: &TriangleMesh<'_>, ray: &Ray) -> f32 {
 /// argument (a `Vec3`, a `Ray`, a reference into the path or the scene) passed to a call that is
 /// not inlined travels through the caller's local memory, and keeps the path state there; the
 /// traversal's stack stays in the callee's frame. A free flight casts the mesh's exit as it
-/// starts, so the trackers compare with an `f32`, as for the box: a lazy exit (the CPU's
-/// [`BoundaryShape`]) would carry its state and a call through every tracking loop. Both trace
-/// the same paths ([`crate::flight`]).
+/// starts, so the trackers compare with an `f32`, as for the box ([`DeviceExit`], which keeps
+/// the triangle for an escaped flight's exit): a lazy exit (the CPU's [`BoundaryShape`]) would
+/// carry its state and a call through every tracking loop. Both trace the same paths
+/// ([`crate::flight`]).
 #[derive(Clone, Copy, Debug)]
 pub struct DeviceBoundary<'a> {
     pub bounds: Aabb,
@@ -211,7 +227,8 @@ impl<'a> DeviceBoundary<'a> {
         }
     }
 
-    /// `mesh`, without its distance grid (the kernels cast every flight's exit).
+    /// `mesh`, without its distance grid (the kernels cast every flight's exit) and without
+    /// vertex normals: the GPU refuses a mesh that has them (`volpt_cuda`'s kernel sets).
     pub fn mesh(mesh: &TriangleMesh<'a>) -> Self {
         Self {
             bounds: mesh.bounds,
@@ -230,6 +247,7 @@ impl<'a> DeviceBoundary<'a> {
         TriangleMesh {
             nodes: self.nodes,
             triangles: self.triangles,
+            normals: &[],
             bounds: self.bounds,
             distance: SurfaceDistance::NONE,
         }
@@ -281,6 +299,7 @@ fn device_nearest(
     let mesh = TriangleMesh {
         nodes,
         triangles,
+        normals: &[],
         bounds: Aabb::new(Vec3::ZERO, Vec3::ZERO),
         distance: SurfaceDistance::NONE,
     };
@@ -296,17 +315,68 @@ fn device_nearest(
     }
 }
 
+/// A [`DeviceBoundary`]'s free-flight end: the exit distance, cast as the flight starts, and the
+/// triangle it leaves by (`u32::MAX`: none, or a box), so that an escaped flight's exit is built
+/// without a second cast ([`Shape::escaped_exit`]). Compares as its distance does.
+#[derive(Clone, Copy, Debug)]
+pub struct DeviceExit {
+    t: f32,
+    triangle: u32,
+}
+
+impl FlightEnd for DeviceExit {
+    #[inline(always)]
+    fn reached(&mut self, t: f32) -> bool {
+        t >= self.t
+    }
+    #[inline(always)]
+    fn before(&mut self, t: f32) -> bool {
+        t < self.t
+    }
+    #[inline(always)]
+    fn clip(&mut self, t: f32) -> f32 {
+        t.min(self.t)
+    }
+    #[inline(always)]
+    fn exact(&mut self) -> f32 {
+        self.t
+    }
+}
+
 impl Shape for DeviceBoundary<'_> {
     const CONVEX: bool = false;
 
     type Exit<'e>
-        = f32
+        = DeviceExit
     where
         Self: 'e;
 
+    /// [`Shape::exit_distance`], with the triangle.
     #[inline(always)]
-    fn flight_exit<'e>(&'e self, ray: &'e Ray) -> f32 {
-        self.exit_distance(ray)
+    fn flight_exit<'e>(&'e self, ray: &'e Ray) -> DeviceExit {
+        if self.is_box() {
+            return DeviceExit {
+                t: Aabb::exit_distance(&self.bounds, ray),
+                triangle: u32::MAX,
+            };
+        }
+        match self.nearest(ray, Crossing::Leaving) {
+            Some((t, triangle)) => DeviceExit { t, triangle },
+            None => DeviceExit {
+                t: 0.0,
+                triangle: u32::MAX,
+            },
+        }
+    }
+
+    /// [`Shape::exit`] from the cast `end` already made.
+    #[inline(always)]
+    fn escaped_exit<'e>(&'e self, ray: &'e Ray, end: &DeviceExit) -> BoxHit {
+        if self.is_box() {
+            return Aabb::exit(&self.bounds, ray);
+        }
+        let found = (end.triangle != u32::MAX).then_some((end.t, end.triangle));
+        self.as_mesh().exit_by(ray, found)
     }
 
     #[inline(always)]
@@ -321,7 +391,8 @@ impl Shape for DeviceBoundary<'_> {
 
     #[inline(always)]
     fn contains(&self, p: Vec3) -> bool {
-        if self.is_box() {
+        // A point outside the box is outside the mesh too, without a cast.
+        if self.is_box() || !Aabb::contains(&self.bounds, p) {
             return Aabb::contains(&self.bounds, p);
         }
         let ray = Ray::new(p, crate::mesh::CONTAINS_DIRECTION);

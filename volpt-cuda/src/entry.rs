@@ -26,9 +26,12 @@ fn set_entry_name<S: SceneAbi>(set: KernelSet, prefix: &str) -> String {
 
 /// The entry point that renders `scene` with `strategy`: the box kernels' unless the scene has a
 /// light on or a mesh boundary, then its kernel set's. An error where no kernel of this build
-/// traces it: lights and a mesh at once, a strategy the set has no kernels for (naming those it
+/// traces it: a mesh shaded with vertex normals, lights and a mesh at once, a strategy the set has no kernels for (naming those it
 /// has), a variant the set does not cover.
 pub fn scene_entry<S: SceneAbi>(scene: &S, strategy: Strategy) -> Result<String, CudaError> {
+    if scene.shading_normals() {
+        return Err(CudaError::ShadingNormals);
+    }
     let set = KernelSet::of_scene(scene).ok_or(CudaError::LightsAndMesh)?;
     if !set.strategies().contains(&strategy) {
         return Err(CudaError::SetStrategy {

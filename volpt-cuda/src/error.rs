@@ -38,6 +38,15 @@ pub enum CudaError {
          both: this scene renders on the CPU (--backend cpu)"
     )]
     LightsAndMesh,
+    /// A mesh boundary whose surface scatters about interpolated vertex normals: the kernels
+    /// refract at each triangle's own normal.
+    #[error(
+        "the GPU kernels refract at each triangle's own normal, and this mesh's surface scatters \
+         about interpolated vertex normals (Mitsuba's default for an obj or ply): this scene \
+         renders on the CPU (--backend cpu), or on the GPU with face_normals=\"true\" on the \
+         shape"
+    )]
+    ShadingNormals,
     /// A scene that needs a kernel set ([`volpt_device::KernelSet`]) rendered with a strategy
     /// that set has no kernels for.
     #[error(

@@ -174,8 +174,9 @@ fn no_kernel_keeps_the_scene_in_local_memory() {
     // The counters' 64 bytes and 192 of two paths with their pixels and flags (256 in every
     // regeneration-2p-sk kernel of both builds, 2026-11-24).
     const TWO_PATH_ARRAY_BYTES: usize = 256;
-    // The BVH walk's stack of node indices, in the walk's own frame.
-    const BVH_STACK_BYTES: usize = volpt_core::mesh::MAX_BVH_DEPTH * size_of::<u32>();
+    // The BVH walk's stack of far children (node index and entry distance), in the walk's own
+    // frame.
+    const BVH_STACK_BYTES: usize = volpt_core::mesh::MAX_BVH_DEPTH * size_of::<u64>();
     for math in Math::ALL.iter().copied() {
         let Some(pack) = embedded(math) else {
             continue;

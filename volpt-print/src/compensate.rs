@@ -124,6 +124,36 @@ pub enum Update {
     CrossTalk,
 }
 
+impl Update {
+    /// Every update, by the name the front ends take ([`Update::name`]).
+    pub const ALL: [Update; 2] = [Update::CrossTalk, Update::PerTexel];
+
+    /// The update's name on the command line and in Python.
+    pub fn name(self) -> &'static str {
+        match self {
+            Update::PerTexel => "per-texel",
+            Update::CrossTalk => "cross-talk",
+        }
+    }
+}
+
+impl std::str::FromStr for Update {
+    type Err = String;
+
+    fn from_str(name: &str) -> Result<Update, String> {
+        Update::ALL
+            .into_iter()
+            .find(|u| u.name() == name)
+            .ok_or_else(|| {
+                let names: Vec<_> = Update::ALL
+                    .iter()
+                    .map(|u| format!("{:?}", u.name()))
+                    .collect();
+                format!("expected {}, found {name:?}", names.join(" or "))
+            })
+    }
+}
+
 /// Projected-gradient steps of one cross-talk update ([`Response::update`]).
 const CROSS_TALK_STEPS: usize = 200;
 

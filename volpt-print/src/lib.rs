@@ -11,6 +11,7 @@
 //! - [`crosstalk`]: its update through the print's cross-texel response, fitted from its predictions.
 //! - [`predict`]: the real predictor, a volpt render of the print from straight above.
 //! - [`target`]: a compensation's target image, read from a PNG.
+//! - [`regions`]: a target's texels classed by their distance to its ink (where an error lies).
 //! - [`record`]: a compensation's record (predictions, ΔE maps and plot, the slice stack).
 //! - [`job`]: a whole compensation as the front ends run it (CLI and Python).
 //! - [`error`]: what reading or writing a print can refuse ([`PrintError`]).
@@ -25,6 +26,7 @@ pub mod material;
 pub mod predict;
 pub mod print;
 pub mod record;
+pub mod regions;
 pub mod slices;
 pub mod target;
 

@@ -398,3 +398,17 @@ fn on_fine_lines_under_an_absorbing_spread_the_cross_talk_update_gains_where_the
         "cross-talk {cross_talk}, per-texel {per_texel} (naive {naive})"
     );
 }
+
+#[test]
+fn every_update_is_found_by_its_name_and_an_unknown_name_is_refused_naming_them() {
+    for update in Update::ALL {
+        assert_eq!(update.name().parse::<Update>(), Ok(update));
+    }
+    let names: std::collections::BTreeSet<_> = Update::ALL.iter().map(|u| u.name()).collect();
+    assert_eq!(names.len(), Update::ALL.len(), "names differ");
+    let refused = "diagonal".parse::<Update>().unwrap_err();
+    assert_eq!(
+        refused,
+        r#"expected "cross-talk" or "per-texel", found "diagonal""#
+    );
+}

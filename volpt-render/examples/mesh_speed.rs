@@ -27,6 +27,7 @@ static CASTS: AtomicU64 = AtomicU64::new(0);
 /// A shape that counts its free flights and the ray casts they make.
 struct Counting<'a>(BoundaryShape<'a>);
 
+#[derive(Clone, Copy)]
 struct CountingExit<'a> {
     exit: LazyExit<'a>,
     counted: bool,

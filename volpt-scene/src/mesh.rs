@@ -16,14 +16,86 @@ use std::sync::Arc;
 use serde::{Serialize, Serializer};
 
 use volpt_core::mesh::build::{build_with, BuildError, Fork, MeshBuffers};
+use volpt_core::mesh::CornerNormals;
 
 use crate::error::SceneError;
 
-/// Vertices and triangles (indices into the vertices, counter-clockwise seen from outside).
+/// Vertices and triangles (indices into the vertices, counter-clockwise seen from outside), and
+/// the vertex normals the file gives at each triangle's corners.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TriangleSoup {
     pub vertices: Vec<[f32; 3]>,
     pub triangles: Vec<[u32; 3]>,
+    /// One entry per triangle, its corners' normals in its indices' order (not yet unit
+    /// vectors); empty where the file has none for every corner.
+    pub normals: Vec<CornerNormals>,
+}
+
+impl TriangleSoup {
+    /// These triangles with no vertex normals.
+    pub fn new(vertices: Vec<[f32; 3]>, triangles: Vec<[u32; 3]>) -> Self {
+        Self {
+            vertices,
+            triangles,
+            normals: Vec::new(),
+        }
+    }
+
+    /// Smooth vertex normals computed from the triangles, as Mitsuba 3 computes them for a mesh
+    /// file without normals (`Mesh::recompute_vertex_normals`): at each vertex, the sum of its
+    /// triangles' unit normals, each weighted by the triangle's angle at that vertex (Thürmer and
+    /// Wüthrich 1998, "Computing vertex normals from polygonal facets", JGT 3(1)), in f64.
+    /// Indices out of range and degenerate triangles add nothing (the build refuses them).
+    pub fn smooth_normals(&self) -> Vec<CornerNormals> {
+        let mut sums = vec![[0.0f64; 3]; self.vertices.len()];
+        let p = |i: u32| self.vertices.get(i as usize).map(|v| v.map(f64::from));
+        for t in &self.triangles {
+            let (Some(a), Some(b), Some(c)) = (p(t[0]), p(t[1]), p(t[2])) else {
+                continue;
+            };
+            let corners = [a, b, c];
+            let n = cross(sub3(b, a), sub3(c, a));
+            let length = dot(n, n).sqrt();
+            if length.is_nan() || length <= 0.0 {
+                continue;
+            }
+            for k in 0..3 {
+                let e0 = sub3(corners[(k + 1) % 3], corners[k]);
+                let e1 = sub3(corners[(k + 2) % 3], corners[k]);
+                let cos = dot(e0, e1) / (dot(e0, e0) * dot(e1, e1)).sqrt();
+                let angle = cos.clamp(-1.0, 1.0).acos();
+                let sum = &mut sums[t[k] as usize];
+                for axis in 0..3 {
+                    sum[axis] += n[axis] / length * angle;
+                }
+            }
+        }
+        self.triangles
+            .iter()
+            .map(|t| {
+                t.map(|i| {
+                    sums.get(i as usize)
+                        .map_or([0.0; 3], |s| s.map(|c| c as f32))
+                })
+            })
+            .collect()
+    }
+}
+
+fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 
 /// What is wrong with a mesh file.
@@ -106,7 +178,8 @@ pub struct MeshDesc {
     /// What it was made from (a file, or Mitsuba's `sphere`), for `volpt info`.
     pub source: String,
     pub buffers: MeshBuffers,
-    /// FNV-1a of the triangles' bytes: what a scene's fingerprint takes in for them.
+    /// FNV-1a of the triangles' and their vertex normals' bytes: what a scene's fingerprint
+    /// takes in for them.
     pub content: u64,
 }
 
@@ -114,7 +187,8 @@ impl MeshDesc {
     /// Checks `soup`, places it by `to_world` (a row-major affine transform, applied in f64, each
     /// coordinate then rounded once to f32) and builds its BVH; `source` names it in errors and
     /// in `volpt info`. A mirroring transform reverses every triangle, so that they still face
-    /// outwards.
+    /// outwards. The soup's vertex normals, if it has any, shade the mesh: transformed by the
+    /// inverse transpose (normals stay perpendicular to the placed surface) and normalised.
     pub fn placed(
         source: &Path,
         soup: &TriangleSoup,
@@ -134,19 +208,54 @@ impl MeshDesc {
                 })
             })
             .collect();
-        let triangles: Vec<[u32; 3]> = if det < 0.0 {
+        let mirrored = det < 0.0;
+        let triangles: Vec<[u32; 3]> = if mirrored {
             soup.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect()
         } else {
             soup.triangles.clone()
         };
+        // The cofactor matrix is the inverse transpose times the determinant, whose sign the
+        // normal must not take.
+        let cofactor = |r: usize, c: usize| {
+            let (r0, r1) = ((r + 1) % 3, (r + 2) % 3);
+            let (c0, c1) = ((c + 1) % 3, (c + 2) % 3);
+            (m[r0][c0] * m[r1][c1] - m[r0][c1] * m[r1][c0]) * det.signum()
+        };
+        let normal_matrix: [[f64; 3]; 3] =
+            core::array::from_fn(|r| core::array::from_fn(|c| cofactor(r, c)));
+        let place_normal = |n: [f32; 3]| -> [f32; 3] {
+            let n = n.map(f64::from);
+            core::array::from_fn(|r| {
+                (normal_matrix[r][0] * n[0]
+                    + normal_matrix[r][1] * n[1]
+                    + normal_matrix[r][2] * n[2]) as f32
+            })
+        };
+        let normals: Vec<CornerNormals> = soup
+            .normals
+            .iter()
+            .map(|&[a, b, c]| {
+                let corners = if mirrored { [a, c, b] } else { [a, b, c] };
+                corners.map(place_normal)
+            })
+            .collect();
         let placed = TriangleSoup {
             vertices,
             triangles,
+            normals,
         };
-        let buffers = with_distances(build_mesh(source, &placed)?);
+        let mut buffers = build_mesh(source, &placed)?;
+        if !placed.normals.is_empty() {
+            buffers = buffers
+                .with_vertex_normals(&placed.normals)
+                .map_err(|e| problem(source, MeshProblem::Geometry(e)))?;
+        }
+        let buffers = with_distances(buffers);
         let mut hash = FNV_OFFSET;
-        for t in &buffers.triangles {
-            for byte in bytemuck::bytes_of(t) {
+        let triangle_bytes = buffers.triangles.iter().map(bytemuck::bytes_of);
+        let normal_bytes = buffers.normals.iter().map(bytemuck::bytes_of);
+        for bytes in triangle_bytes.chain(normal_bytes) {
+            for byte in bytes {
                 hash = (hash ^ u64::from(*byte)).wrapping_mul(FNV_PRIME);
             }
         }
@@ -281,12 +390,16 @@ fn parse_f32(word: &str) -> Option<f32> {
     word.parse::<f32>().ok()
 }
 
-/// Wavefront OBJ: `v x y z [w]` and `f` with 1-based (or negative, relative) indices in any of
-/// the `i`, `i/t`, `i//n`, `i/t/n` forms; polygons are fanned into triangles. Everything else
-/// (normals, texture coordinates, groups, materials) is ignored.
+/// Wavefront OBJ: `v x y z [w]`, `vn x y z` and `f` with 1-based (or negative, relative) indices
+/// in any of the `i`, `i/t`, `i//n`, `i/t/n` forms; polygons are fanned into triangles. The
+/// normals are kept if every face's every corner names one. Everything else (texture
+/// coordinates, groups, materials) is ignored.
 pub fn parse_obj(bytes: &[u8]) -> Result<TriangleSoup, MeshProblem> {
     let text = String::from_utf8_lossy(bytes);
     let mut soup = TriangleSoup::default();
+    let mut normals: Vec<[f32; 3]> = Vec::new();
+    // Every corner so far named a normal.
+    let mut all_normals = true;
     for (i, line) in text.lines().enumerate() {
         let line_no = Some(i + 1);
         let mut words = line.split_whitespace();
@@ -298,26 +411,48 @@ pub fn parse_obj(bytes: &[u8]) -> Result<TriangleSoup, MeshProblem> {
                     _ => return Err(parse_error(line_no, "vertex (v)", "\"v x y z\"", line)),
                 }
             }
+            Some("vn") => {
+                let coords: Option<Vec<f32>> = words.map(parse_f32).collect();
+                match coords.as_deref() {
+                    Some(&[x, y, z]) => normals.push([x, y, z]),
+                    _ => return Err(parse_error(line_no, "normal (vn)", "\"vn x y z\"", line)),
+                }
+            }
             Some("f") => {
                 let mut face = Vec::new();
+                let mut face_normals = Vec::new();
                 for word in words {
-                    let index = word.split('/').next().and_then(|w| w.parse::<i64>().ok());
-                    let n = soup.vertices.len() as i64;
-                    let index = match index {
-                        Some(i) if i > 0 && i <= n => i - 1,
-                        Some(i) if i < 0 && -i <= n => n + i,
-                        _ => {
-                            return Err(parse_error(
-                                line_no,
-                                "face (f)",
-                                &format!(
-                                    "vertex indices 1..={n} (or -1..=-{n}) of the vertices so far"
-                                ),
-                                word,
-                            ))
-                        }
-                    };
-                    face.push(index as u32);
+                    let mut parts = word.split('/');
+                    let index = obj_index(parts.next(), soup.vertices.len()).ok_or_else(|| {
+                        let n = soup.vertices.len();
+                        parse_error(
+                            line_no,
+                            "face (f)",
+                            &format!(
+                                "vertex indices 1..={n} (or -1..=-{n}) of the vertices so far"
+                            ),
+                            word,
+                        )
+                    })?;
+                    face.push(index);
+                    match parts.nth(1).filter(|w| !w.is_empty()) {
+                        Some(w) => face_normals.push(
+                            obj_index(Some(w), normals.len())
+                                .map(|n| normals[n as usize])
+                                .ok_or_else(|| {
+                                    let n = normals.len();
+                                    parse_error(
+                                        line_no,
+                                        "face (f)",
+                                        &format!(
+                                            "normal indices 1..={n} (or -1..=-{n}) of the normals so far"
+                                        ),
+                                        word,
+                                    )
+                                })?,
+                        ),
+                        None => all_normals = false,
+                    }
                 }
                 if face.len() < 3 {
                     return Err(parse_error(
@@ -329,12 +464,31 @@ pub fn parse_obj(bytes: &[u8]) -> Result<TriangleSoup, MeshProblem> {
                 }
                 for k in 1..face.len() - 1 {
                     soup.triangles.push([face[0], face[k], face[k + 1]]);
+                    if all_normals {
+                        let n = &face_normals;
+                        soup.normals.push([n[0], n[k], n[k + 1]]);
+                    }
                 }
             }
             _ => {}
         }
     }
+    if !all_normals {
+        soup.normals.clear();
+    }
     Ok(soup)
+}
+
+/// An OBJ index (1-based, or negative: relative to the end) into a list of `len` so far, as a
+/// 0-based index.
+fn obj_index(word: Option<&str>, len: usize) -> Option<u32> {
+    let i = word?.parse::<i64>().ok()?;
+    let n = len as i64;
+    match i {
+        i if i > 0 && i <= n => Some((i - 1) as u32),
+        i if i < 0 && -i <= n => Some((n + i) as u32),
+        _ => None,
+    }
 }
 
 /// Welds STL's per-triangle corners into shared vertices.
@@ -519,8 +673,9 @@ enum PlyFormat {
     Binary { big_endian: bool },
 }
 
-/// PLY: `vertex` elements' `x y z` and `face` elements' `vertex_indices` (or `vertex_index`)
-/// lists, fanned into triangles; other elements and properties are skipped.
+/// PLY: `vertex` elements' `x y z` (and `nx ny nz`, the vertex normals, if all three are there)
+/// and `face` elements' `vertex_indices` (or `vertex_index`) lists, fanned into triangles; other
+/// elements and properties are skipped.
 pub fn parse_ply(bytes: &[u8]) -> Result<TriangleSoup, MeshProblem> {
     let header_end = bytes
         .windows(10)
@@ -597,6 +752,7 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriangleSoup, MeshProblem> {
         },
     };
     let mut soup = TriangleSoup::default();
+    let mut vertex_normals: Vec<[f32; 3]> = Vec::new();
     for element in &elements {
         // Every element takes at least one byte (binary) or two (ASCII: a number and a space)
         // per property: a count beyond that cannot be in the file.
@@ -614,6 +770,8 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriangleSoup, MeshProblem> {
         let is_vertex = element.name == "vertex";
         let is_face = element.name == "face";
         let xyz = ["x", "y", "z"].map(|c| element.properties.iter().position(|p| p.name == c));
+        let nxyz = ["nx", "ny", "nz"].map(|c| element.properties.iter().position(|p| p.name == c));
+        let has_normals = is_vertex && nxyz.iter().all(|p| p.is_some());
         if is_vertex && xyz.iter().any(|p| p.is_none()) {
             return Err(parse_error(
                 None,
@@ -624,6 +782,7 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriangleSoup, MeshProblem> {
         }
         for _ in 0..element.count {
             let mut position = [0.0f32; 3];
+            let mut normal = [0.0f32; 3];
             for (k, property) in element.properties.iter().enumerate() {
                 let field = || format!("{} property {}", element.name, property.name);
                 match property.list {
@@ -631,6 +790,9 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriangleSoup, MeshProblem> {
                         let value = reader.scalar(property.scalar, &field)?;
                         if let Some(axis) = xyz.iter().position(|&p| p == Some(k)) {
                             position[axis] = value as f32;
+                        }
+                        if let Some(axis) = nxyz.iter().position(|&p| p == Some(k)) {
+                            normal[axis] = value as f32;
                         }
                     }
                     Some(count_type) => {
@@ -681,7 +843,15 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriangleSoup, MeshProblem> {
             if is_vertex {
                 soup.vertices.push(position);
             }
+            if has_normals {
+                vertex_normals.push(normal);
+            }
         }
+    }
+    if !vertex_normals.is_empty() {
+        // An index out of range gets no normal here; the build refuses the triangle.
+        let normal = |i: u32| vertex_normals.get(i as usize).copied().unwrap_or([0.0; 3]);
+        soup.normals = soup.triangles.iter().map(|t| t.map(normal)).collect();
     }
     Ok(soup)
 }

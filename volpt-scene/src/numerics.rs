@@ -14,6 +14,7 @@ use std::path::Path;
 
 use crate::description::{Bounds, MediumDesc, SceneDescription};
 use crate::error::SceneError;
+use crate::validate::CheckedData;
 
 /// Shortest mean free path volpt renders, in `f32` position spacings of the box. At 16 the thick
 /// cube above is unbiased (within 3e-4); at 2 it is 1% too bright.
@@ -38,7 +39,28 @@ pub fn max_extinction(medium: &MediumDesc) -> f32 {
 /// Refuses a scene whose mean free path is too short for `f32` positions in its box (or whose
 /// extinction is not finite); `source` names the scene in the error.
 pub fn check_position_resolution(desc: &SceneDescription, source: &Path) -> Result<(), SceneError> {
-    let majorant = max_extinction(&desc.medium);
+    check_free_path(desc, source, max_extinction(&desc.medium))
+}
+
+/// [`check_position_resolution`] for a scene whose data `checked` says was checked
+/// ([`crate::validate::validate`]): its grids' largest values taken from `checked`, not read
+/// again (a viewer moves the camera at every frame, and reading a print's grid took longer than
+/// the frame's render).
+pub fn check_position_resolution_settings(
+    desc: &SceneDescription,
+    source: &Path,
+    checked: CheckedData,
+) -> Result<(), SceneError> {
+    let [(_, largest_density), _] = desc.medium.largest_values(checked);
+    check_free_path(desc, source, desc.medium.scale * largest_density)
+}
+
+/// The check of both: the mean free path at `majorant` against the box's position spacing.
+fn check_free_path(
+    desc: &SceneDescription,
+    source: &Path,
+    majorant: f32,
+) -> Result<(), SceneError> {
     let spacing = position_spacing(&desc.boundary.bounds);
     let free_path = 1.0 / majorant;
     // Written so that a NaN extinction fails too.

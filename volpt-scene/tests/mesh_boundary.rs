@@ -363,55 +363,116 @@ fn the_threaded_bvh_build_is_the_serial_one() {
     }
 }
 
-/// The warnings `f` logs, captured.
-fn warnings_of<T>(f: impl FnOnce() -> T) -> (T, String) {
-    use std::sync::{Arc, Mutex};
-    #[derive(Clone, Default)]
-    struct Buffer(Arc<Mutex<Vec<u8>>>);
-    impl std::io::Write for Buffer {
-        fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
-            self.0.lock().unwrap().extend_from_slice(b);
-            Ok(b.len())
-        }
-        fn flush(&mut self) -> std::io::Result<()> {
-            Ok(())
+/// Mitsuba 3 shades an `obj` or `ply` with interpolated vertex normals unless `face_normals` is
+/// true: the file's, or where it has none, smooth ones it computes. volpt does the same for a
+/// dielectric surface (an index-matched one has nothing to shade): the octahedron's smooth
+/// normals are its vertices' directions (by symmetry), and a file's own normals are placed by the
+/// inverse transpose of `to_world`.
+#[test]
+fn a_dielectric_mesh_is_shaded_with_vertex_normals_unless_face_normals_is_true() {
+    let dielectric = |shape: &str, kind: &str| {
+        mitsuba(shape, kind).replace("<bsdf type=\"null\"/>", "<bsdf type=\"dielectric\"/>")
+    };
+    let file = "<string name=\"filename\" value=\"octahedron.ply\"/>";
+    let face = "<boolean name=\"face_normals\" value=\"true\"/>";
+    for (xml, shaded) in [
+        (dielectric(file, "ply"), true),
+        (dielectric(&format!("{file}{face}"), "ply"), false),
+        (mitsuba(file, "ply"), false),
+    ] {
+        let (dir, path) = scene_file(&xml);
+        std::fs::write(dir.path().join("octahedron.ply"), octahedron_ply()).unwrap();
+        let desc = load_mitsuba(&path).expect("scene loads");
+        let mesh = desc.boundary.mesh.as_ref().expect("a mesh");
+        let buffers = &mesh.buffers;
+        assert_eq!(!buffers.normals.is_empty(), shaded, "{xml}");
+        // Exported for Mitsuba 3, with its normals where it has them, it reads back the same.
+        let written =
+            volpt_scene::mitsuba::write_mitsuba3(&desc, &dir.path().join("export"), "o").unwrap();
+        let again = load_mitsuba(&written[0]).expect("the export loads");
+        let again = &again.boundary.mesh.as_ref().expect("a mesh").buffers;
+        let corners = |b: &volpt_core::mesh::build::MeshBuffers| {
+            let mut c: Vec<[u32; 6]> = (0..b.triangles.len())
+                .flat_map(|i| {
+                    let n = b.normals.get(i).copied().unwrap_or([[0.0; 3]; 3]);
+                    (0..3).map(move |k| {
+                        let (v, n) = (b.triangles[i].v[k], n[k]);
+                        [v[0], v[1], v[2], n[0], n[1], n[2]].map(f32::to_bits)
+                    })
+                })
+                .collect();
+            c.sort_unstable();
+            c
+        };
+        assert_eq!(corners(buffers), corners(again), "{xml}");
+        for (tri, normals) in buffers.triangles.iter().zip(&buffers.normals) {
+            for (v, n) in tri.v.iter().zip(normals) {
+                for axis in 0..3 {
+                    assert!((v[axis] - n[axis]).abs() < 1e-6, "{v:?} has normal {n:?}");
+                }
+            }
         }
     }
-    let buffer = Buffer::default();
-    let writer = buffer.clone();
-    let subscriber = tracing_subscriber::fmt()
-        .with_max_level(tracing::Level::WARN)
-        .with_writer(move || writer.clone())
-        .with_ansi(false)
-        .finish();
-    let value = tracing::subscriber::with_default(subscriber, f);
-    let text = String::from_utf8_lossy(&buffer.0.lock().unwrap()).into_owned();
-    (value, text)
+
+    // A tetrahedron's OBJ with a normal per corner, squashed along z: a normal (0, 0, 1) stays
+    // (0, 0, 1), a normal (1, 0, 1) / sqrt 2 becomes (1, 0, 2) / sqrt 5 (inverse transpose).
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n\
+               vn 0 0 1\nvn 0.70710678 0 0.70710678\n\
+               f 1//1 3//1 2//1\nf 1//2 2//2 4//2\nf 1//1 4//1 3//1\nf 2//2 3//2 4//2\n";
+    let (dir, path) = scene_file(&dielectric(
+        "<string name=\"filename\" value=\"tet.obj\"/>\
+         <transform name=\"to_world\"><scale z=\"0.5\"/></transform>",
+        "obj",
+    ));
+    std::fs::write(dir.path().join("tet.obj"), obj).unwrap();
+    let desc = load_mitsuba(&path).expect("scene loads");
+    let buffers = &desc.boundary.mesh.as_ref().expect("a mesh").buffers;
+    let s5 = 1.0 / 5.0f32.sqrt();
+    let mut seen = [0; 2];
+    for n in buffers.normals.iter().flatten() {
+        if (n[0] - s5).abs() < 1e-6 && n[1] == 0.0 && (n[2] - 2.0 * s5).abs() < 1e-6 {
+            seen[1] += 1;
+        } else {
+            assert_eq!(*n, [0.0, 0.0, 1.0]);
+            seen[0] += 1;
+        }
+    }
+    assert_eq!(seen, [6, 6]);
 }
 
-/// Mitsuba 3 shades an `obj` or `ply` with interpolated vertex normals unless `face_normals` is
-/// true; volpt refracts at the triangles' own normals, so the loader says so where the two would
-/// render different surfaces, naming the shape, and is silent with `face_normals="true"`.
+/// A PLY's vertex normal of no length is refused, naming the triangle and its corner.
 #[test]
-fn a_mesh_mitsuba_would_shade_with_vertex_normals_is_named_in_a_warning() {
-    for (face_normals, warned) in [
-        ("", true),
-        ("<boolean name=\"face_normals\" value=\"true\"/>", false),
-    ] {
-        let (dir, path) = scene_file(&mitsuba(
-            &format!("<string name=\"filename\" value=\"octahedron.ply\"/>{face_normals}"),
-            "ply",
-        ));
-        std::fs::write(dir.path().join("octahedron.ply"), octahedron_ply()).unwrap();
-        let (desc, warnings) = warnings_of(|| load_mitsuba(&path));
-        desc.expect("scene loads");
-        assert_eq!(
-            warnings.contains("interpolated vertex normals"),
-            warned,
-            "face_normals {face_normals:?}: {warnings}"
-        );
-        if warned {
-            assert!(warnings.contains("<shape type=\"ply\">"), "{warnings}");
-        }
+fn a_vertex_normal_of_no_length_is_refused_naming_its_triangle() {
+    let ply = octahedron_ply().replace(
+        "property float z\n",
+        "property float z\nproperty float nx\nproperty float ny\nproperty float nz\n",
+    );
+    // Each vertex line gets its position as its normal; the first vertex gets none.
+    let mut lines: Vec<String> = ply.lines().map(String::from).collect();
+    let body = lines.iter().position(|l| l == "end_header").unwrap() + 1;
+    for (k, line) in lines[body..body + 6].iter_mut().enumerate() {
+        let normal = if k == 0 {
+            "0 0 0".to_string()
+        } else {
+            line.clone()
+        };
+        *line = format!("{line} {normal}");
     }
+    let (dir, path) = scene_file(
+        &mitsuba(
+            "<string name=\"filename\" value=\"octahedron.ply\"/>",
+            "ply",
+        )
+        .replace("<bsdf type=\"null\"/>", "<bsdf type=\"dielectric\"/>"),
+    );
+    std::fs::write(dir.path().join("octahedron.ply"), lines.join("\n") + "\n").unwrap();
+    message_of(
+        &load_mitsuba(&path).unwrap_err(),
+        &[
+            "octahedron.ply",
+            "vertex normal",
+            "triangle",
+            "[0.0, 0.0, 0.0]",
+        ],
+    );
 }

@@ -4,7 +4,10 @@
 mod common;
 
 use common::*;
-use volpt_scene::numerics::{check_position_resolution, max_extinction};
+use volpt_scene::numerics::{
+    check_position_resolution, check_position_resolution_settings, max_extinction,
+};
+use volpt_scene::validate::CheckedData;
 use volpt_scene::*;
 
 /// A homogeneous medium in the cube [-1, 1]^3: positions near 1 are 2^-23 apart.
@@ -53,4 +56,39 @@ fn the_mean_free_path_must_span_sixteen_position_steps() {
             "a largest extinction of 5.25312e5",
         ],
     );
+}
+
+/// A scene's settings are checked again at every change (a viewer's camera at every frame) with
+/// its grids' largest values as found when loaded: the same verdict as reading the grid, at the
+/// same bound (1024 x 512 passes, 1024 x 513 is refused), and the grid's values are not read again
+/// (a grid whose values changed behind the check's back keeps the verdict its checked data gives).
+#[test]
+fn the_settings_check_takes_the_grids_largest_density_from_the_checked_data() {
+    let mut desc = base();
+    let source = std::path::Path::new("scene.xml");
+    desc.medium.scale = 1024.0;
+    let grid = |largest: f32| {
+        DensityDesc::Grid(GridDesc {
+            layout: volpt_scene::SampleLayout::Dense,
+            resolution: [2, 1, 1],
+            channels: 1,
+            bounds: unit_bounds(),
+            convention: GridConvention::Cell,
+            data: vec![0.5, largest],
+        })
+    };
+    let checked = |largest_density: f32| CheckedData {
+        largest_density,
+        largest_albedo: 0.0,
+    };
+    for (largest, passes) in [(512.0, true), (513.0, false)] {
+        desc.medium.density = grid(largest);
+        let read = check_position_resolution(&desc, source);
+        let settings = check_position_resolution_settings(&desc, source, checked(largest));
+        assert_eq!(read.is_ok(), passes, "{largest}: {read:?}");
+        assert_eq!(settings.is_ok(), passes, "{largest}: {settings:?}");
+    }
+    desc.medium.density = grid(1e9);
+    check_position_resolution_settings(&desc, source, checked(512.0))
+        .expect("the checked data's largest density, not the grid's values");
 }

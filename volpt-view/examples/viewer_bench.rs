@@ -182,7 +182,10 @@ async fn main() {
         .next()
         .expect("usage: viewer_bench WS_URL [SECONDS | --snapshot FILE]");
     let mode = args.next();
-    let (mut ws, _) = tokio_tungstenite::connect_async(&url)
+    // Messages go out at once, as a browser's do (TCP_NODELAY): with Nagle's algorithm, a move
+    // sent right after an ack waits for the server's delayed ACK of that ack (40 ms on Linux)
+    // whenever the server has nothing to send: the frames it would send wait for the move.
+    let (mut ws, _) = tokio_tungstenite::connect_async_with_config(&url, None, true)
         .await
         .expect("connecting");
     let hello: Value = match ws.next().await {
@@ -271,8 +274,11 @@ async fn main() {
     let end = started + Duration::from_secs_f64(seconds);
     let mut tick = tokio::time::interval(Duration::from_micros(16_667));
     let mut sent: Vec<([f64; 3], Instant)> = Vec::new();
+    // The frames' numbers: a gap is frames the server made that this client never got.
+    let mut ids: Vec<u64> = Vec::new();
     let (mut frames, mut move_latency, mut widths) = (0u32, Vec::new(), Vec::new());
-    let (mut render, mut tonemap, mut encode, mut bytes) = (vec![], vec![], vec![], vec![]);
+    let (mut setup, mut render, mut tonemap, mut encode, mut bytes) =
+        (vec![], vec![], vec![], vec![], vec![]);
     let mut angle = 0.6;
     loop {
         tokio::select! {
@@ -288,6 +294,7 @@ async fn main() {
                 let Some((h, size, _)) = frame else { break };
                 if h["interactive"] != true { continue; }
                 frames += 1;
+                ids.push(h["frame"].as_u64().unwrap_or(0));
                 let shown = vec3(&h["view"]["origin"]);
                 // The move this frame shows: the server echoes the origin as f32.
                 if let Some((_, at)) = sent.iter().rev().find(|(o, _)| {
@@ -296,6 +303,7 @@ async fn main() {
                     move_latency.push(at.elapsed().as_secs_f64() * 1e3);
                 }
                 widths.push(format!("{}x{}", h["width"], h["height"]));
+                setup.push(h["setup_ms"].as_f64().unwrap_or(0.0));
                 render.push(h["render_ms"].as_f64().unwrap_or(0.0));
                 tonemap.push(h["tonemap_ms"].as_f64().unwrap_or(0.0));
                 encode.push(h["encode_ms"].as_f64().unwrap_or(0.0));
@@ -318,6 +326,10 @@ async fn main() {
         .iter()
         .map(|(h, _)| h["render_ms"].as_f64().unwrap_or(0.0))
         .collect();
+    let first_setup: Vec<f64> = first_frames
+        .iter()
+        .map(|(h, _)| h["setup_ms"].as_f64().unwrap_or(0.0))
+        .collect();
     let first_encode: Vec<f64> = first_frames
         .iter()
         .map(|(h, _)| {
@@ -330,14 +342,20 @@ async fn main() {
         "repeat_identical": repeat_identical,
         "still_move_to_frame_ms_median": median(latency.clone()),
         "still_move_to_frame_ms_all": latency,
+        "still_first_frame_setup_ms_median": median(first_setup),
         "still_first_frame_render_ms_median": median(first_render),
         "still_first_frame_tonemap_encode_ms_median": median(first_encode),
         "still_frames_per_s": f64::from(still_frames) / still_s,
         "still_spp_after": last_still["spp"], "still_paths_per_s": last_still["paths_per_s"],
         "orbit_frames_per_s": f64::from(frames) / orbit_s,
+        "orbit_moves_sent": sent.len(),
+        "orbit_frames_made_not_received": match (ids.first(), ids.last()) {
+            (Some(first), Some(last)) => (last - first + 1).saturating_sub(ids.len() as u64),
+            _ => 0,
+        },
         "orbit_move_to_frame_ms_median": median(move_latency),
         "orbit_resolution": common,
-        "orbit_render_ms_mean": mean(&render), "orbit_tonemap_ms_mean": mean(&tonemap),
+        "orbit_setup_ms_mean": mean(&setup), "orbit_render_ms_mean": mean(&render), "orbit_tonemap_ms_mean": mean(&tonemap),
         "orbit_encode_ms_mean": mean(&encode), "orbit_jpeg_bytes_mean": mean(&bytes),
     });
     println!("{report}");

@@ -28,6 +28,7 @@ use axum::http::{header, HeaderMap, HeaderValue, StatusCode};
 use axum::middleware::Next;
 use axum::response::{IntoResponse, Response};
 use axum::routing::get;
+use axum::serve::ListenerExt;
 use axum::Router;
 use serde::Deserialize;
 use tokio::sync::{broadcast, mpsc, watch};
@@ -154,6 +155,14 @@ impl Viewer {
         }
         let mut stop = shutdown_rx;
         let server = tokio::spawn(async move {
+            // Frames and replies go out at once (TCP_NODELAY), as browsers send their messages:
+            // with Nagle's algorithm a message's last segment waits for the peer's delayed ACK
+            // (40 ms on Linux) whenever an earlier one is unacknowledged.
+            let listener = listener.tap_io(|tcp| {
+                if let Err(e) = tcp.set_nodelay(true) {
+                    tracing::debug!("TCP_NODELAY: {e}");
+                }
+            });
             axum::serve(listener, app)
                 .with_graceful_shutdown(async move {
                     let _ = stop.wait_for(|s| *s).await;

@@ -255,6 +255,9 @@ pub struct FrameHeader {
     /// ended: a multi-kernel strategy's frame stopped at its deadline); 0 otherwise.
     pub spp_in_flight: u32,
     pub interactive: bool,
+    /// Milliseconds the render thread spent before this frame's render on the commands it took
+    /// (camera moves and parameters checked and applied, a new epoch started).
+    pub setup_ms: f64,
     /// Milliseconds of this frame's render (its new samples), tone mapping and JPEG encoding.
     pub render_ms: f64,
     pub tonemap_ms: f64,

@@ -141,6 +141,8 @@ struct Renderer {
     sample_time: Option<f64>,
     /// The latest frame needs tone mapping again (the exposure changed).
     retone: bool,
+    /// When the render thread took its latest commands (a frame's setup time runs from there).
+    commands_taken: Instant,
     next_frame: u64,
 }
 
@@ -217,6 +219,7 @@ impl Renderer {
             scale: 2,
             sample_time: None,
             retone: false,
+            commands_taken: now,
             next_frame: 0,
         };
         Ok((renderer, hello))
@@ -253,8 +256,9 @@ impl Renderer {
                 commands.extend(first);
             }
             commands.extend(rx.try_iter());
+            self.commands_taken = Instant::now();
             let mut restart = false;
-            for command in commands {
+            for command in superseded_moves_dropped(commands) {
                 match command {
                     Command::Shutdown => return,
                     Command::Wake => {}
@@ -320,7 +324,7 @@ impl Renderer {
             if self.done < self.cap() {
                 self.render_batch();
             } else if self.retone && self.shown() > 0 {
-                self.publish(Duration::ZERO);
+                self.publish(Duration::ZERO, Duration::ZERO);
             }
             self.retone = false;
         }
@@ -371,7 +375,14 @@ impl Renderer {
                 tracing::error!("resolution {w}x{h}: {e}");
             }
         }
-        self.film = self.scene.film();
+        // The film of the same size is cleared rather than allocated anew: a new film's pages
+        // are the kernel's zero pages, each faulted in when the first render's sums land there
+        // (a drag starts an epoch at every frame).
+        if (self.film.width, self.film.height) == self.scene.resolution() {
+            self.film.sums.fill([0.0; 3]);
+        } else {
+            self.film = self.scene.film();
+        }
         self.done = 0;
         // The old view's paths in flight are discarded (the GPU's, by the next render).
         self.in_flight = None;
@@ -419,6 +430,7 @@ impl Renderer {
             }
         };
         let started = Instant::now();
+        let setup = started.saturating_duration_since(self.commands_taken);
         let deadline = started + Duration::from_secs_f64(budget);
         let result =
             self.backend
@@ -441,7 +453,7 @@ impl Renderer {
                 } else {
                     self.in_flight = Some(samples);
                 }
-                let frame_time = self.publish(elapsed);
+                let frame_time = self.publish(setup, elapsed);
                 if self.interactive {
                     self.adapt_scale(frame_time);
                 }
@@ -470,8 +482,9 @@ impl Renderer {
         }
     }
 
-    /// Tone maps, encodes and publishes the film; returns the frame's seconds (render included).
-    fn publish(&mut self, render: Duration) -> f64 {
+    /// Tone maps, encodes and publishes the film; returns the frame's seconds (setup and render
+    /// included).
+    fn publish(&mut self, setup: Duration, render: Duration) -> f64 {
         let t0 = Instant::now();
         let linear = self.film.image(self.shown());
         let rgb = self.tone_map(&linear);
@@ -498,6 +511,7 @@ impl Renderer {
             spp_target: self.cap(),
             spp_in_flight: self.shown() - self.done,
             interactive: self.interactive,
+            setup_ms: ms(setup),
             render_ms: ms(render),
             tonemap_ms: ms(tonemap),
             encode_ms: ms(encode),
@@ -519,7 +533,7 @@ impl Renderer {
             jpeg,
             png: OnceLock::new(),
         })));
-        (render + tonemap + encode).as_secs_f64()
+        (setup + render + tonemap + encode).as_secs_f64()
     }
 
     /// The frame of the film (whose image is `linear`): tone mapped by the GPU that rendered
@@ -583,6 +597,30 @@ impl Renderer {
     }
 }
 
+/// `commands` without the camera moves a later move of the same batch supersedes (none of the
+/// scene's other changes between them): a drag sends moves faster than a frame renders, and only
+/// the latest is shown, so the render thread applies that one alone instead of falling behind
+/// checking each. Every other command stays, in order.
+fn superseded_moves_dropped(commands: Vec<Command>) -> Vec<Command> {
+    let mut kept: Vec<Command> = Vec::with_capacity(commands.len());
+    // Where in `kept` the latest move is, while nothing but exposure or wake-ups followed it.
+    let mut latest_move = None;
+    for command in commands {
+        match command {
+            Command::Camera { .. } => {
+                if let Some(i) = latest_move.take() {
+                    kept.remove(i);
+                }
+                latest_move = Some(kept.len());
+            }
+            Command::Exposure(_) | Command::Wake => {}
+            Command::Set { .. } | Command::Reset | Command::Shutdown => latest_move = None,
+        }
+        kept.push(command);
+    }
+    kept
+}
+
 fn refuse(reply: &Outbox, message: String) {
     let _ = reply.try_send(ServerMessage::Error { message }.to_json());
 }
@@ -642,6 +680,51 @@ fn initial_view(scene: &mut Scene) -> Result<View, ViewError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Of a batch of moves, the render thread applies the latest before any other change of the
+    /// scene; a `set` between two moves keeps both (the first move is the one it applies to), and
+    /// exposure changes and wake-ups neither keep a move nor are dropped.
+    #[test]
+    fn a_batch_keeps_the_latest_camera_move_before_each_change_of_the_scene() {
+        let (reply, _rx) = mpsc::channel(1);
+        let camera = |x: f32| Command::Camera {
+            origin: [x, 0.0, 1.0],
+            target: [0.0; 3],
+            fov: None,
+            interactive: true,
+            reply: reply.clone(),
+        };
+        let set = Command::Set {
+            key: "spp".into(),
+            value: ParamValue::Int(4),
+            reply: reply.clone(),
+        };
+        let batch = vec![
+            camera(1.0),
+            Command::Exposure(1.0),
+            camera(2.0),
+            set,
+            camera(3.0),
+            Command::Wake,
+            camera(4.0),
+            camera(5.0),
+        ];
+        let kept: Vec<String> = superseded_moves_dropped(batch)
+            .iter()
+            .map(|c| match c {
+                Command::Camera { origin, .. } => format!("camera {}", origin[0]),
+                Command::Set { key, .. } => format!("set {key}"),
+                Command::Exposure(e) => format!("exposure {e}"),
+                Command::Wake => "wake".into(),
+                Command::Reset => "reset".into(),
+                Command::Shutdown => "shutdown".into(),
+            })
+            .collect();
+        assert_eq!(
+            kept,
+            ["exposure 1", "camera 2", "set spp", "wake", "camera 5"]
+        );
+    }
 
     /// The included example cube looks down at the cube from above (its up, made perpendicular
     /// to the view, has y 0.899): the orbit's up is still the world's +y, the axis nearest.

@@ -103,7 +103,7 @@ pub fn describe(
             Some(mesh) => format!(
                 "closed triangle mesh from {}: {} triangles, BVH of {} nodes (bounds: its \
                  bounding box); one ray cast per crossing; on the GPU by the mesh kernels \
-                 ({}; homogeneous and dense-grid media under a constant environment)",
+                 ({}; homogeneous and dense-grid media)",
                 mesh.source,
                 mesh.triangle_count(),
                 mesh.buffers.nodes.len(),
@@ -111,6 +111,18 @@ pub fn describe(
             ),
         },
     );
+    if let Some(mesh) = &desc.boundary.mesh {
+        field(
+            "normals",
+            if mesh.buffers.normals.is_empty() {
+                "each triangle's own (face normals)".to_owned()
+            } else {
+                "interpolated vertex normals (Phong), on the CPU only: the GPU kernels refract at \
+                 the triangles' own normals (face_normals=\"true\")"
+                    .to_owned()
+            },
+        );
+    }
     field("boundary", desc.boundary.bsdf.to_string());
     field("density", format!("{}, scale {}", m.density, m.scale));
     field(

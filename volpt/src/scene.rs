@@ -500,8 +500,12 @@ impl Scene {
                 },
                 error => Error::Scene(error),
             };
-            volpt_scene::numerics::check_position_resolution(&self.desc, Path::new(&self.source))
-                .map_err(refused)?;
+            volpt_scene::numerics::check_position_resolution_settings(
+                &self.desc,
+                Path::new(&self.source),
+                self.data.checked,
+            )
+            .map_err(refused)?;
             self.validate().map_err(refused)?;
             check_lookup(&self.desc, self.desc.medium.lookup, self.data.checked)
         });

@@ -7,7 +7,10 @@
 #   MODE=gpu bash bench/peers/mitsuba3/device.sh   # only the GPU rows; MODE=cpu only the CPU rows
 #   MODE=print bash bench/peers/mitsuba3/device.sh # issue 40: compensated prints against naive ones,
 #                                                  # rendered by Mitsuba 3 (bundle/print.sh's records;
-#                                                  # it runs first if they are missing), print.py
+#                                                  # it runs first if they are missing), print.py;
+#                                                  # PRINT_STEPS and PRINT_TARGETS pass to print.sh
+#                                                  # (PRINT_STEPS=3 PRINT_TARGETS=lines: the fine
+#                                                  # target alone), PRINT_SPP to print.py
 #
 # Settings: GPU_RES/GPU_SPP (default 400/100, the thesis settings), CPU_RES/CPU_SPP (default 100/64:
 # Mitsuba's LLVM backend is slow on these dense scenes), SCENES (names, default the seven grey
@@ -16,8 +19,9 @@
 # emitters: `SCENES="sun-slab spot-fog spot-fog-chromatic"`; mesh-sphere-smooth and mesh-torus-rough
 # name scenes/mesh-peers' triangle-mesh boundaries, issue 39: a smooth dielectric sphere mesh and a
 # rough dielectric torus holding a density grid: `MODE=cpu SCENES="mesh-sphere-smooth
-# mesh-torus-rough"`; on the GPU the sphere alone, `MODE=gpu SCENES=mesh-sphere-smooth`: volpt's
-# mesh kernels have no environment map).
+# mesh-torus-rough"`, and on the GPU the same (`MODE=gpu`; the torus's environment map has mesh
+# kernels since session 13); mesh-sphere-shaded is the sphere with smooth vertex normals, which
+# volpt renders on the CPU only (`MODE=cpu`, or compare.py `--backend cpu --variant cuda_ad_rgb`).
 # Everything lands under $OUT/peers: results.md (one Markdown row per scene and device), <name>.json,
 # the EXR images, the Mitsuba 3 XML each scene was rendered from, and the logs.
 #
@@ -101,6 +105,7 @@ scene_args() { # name -> file and -D parameters
         spot-fog) echo "bundle/scenes/lights/spot-fog.xml" ;;
         spot-fog-chromatic) echo "bundle/scenes/lights/spot-fog.xml -D sigma_t=0.25,0.5,1" ;;
         mesh-sphere-smooth) echo "bundle/scenes/mesh-peers/sphere.xml" ;;
+        mesh-sphere-shaded) echo "bundle/scenes/mesh-peers/sphere.xml -D face_normals=false" ;;
         mesh-torus-rough) echo "bundle/scenes/mesh-peers/torus.xml" ;;
         *) echo "" ;;
     esac
@@ -131,7 +136,8 @@ if [ "$MODE" = print ]; then
         log "bundle/print.sh: $(tail -n 1 "$RECORDS/summary.txt" 2>/dev/null)"
     fi
     "$PY" bench/peers/mitsuba3/print.py --volpt "$VOLPT" --spp "${PRINT_SPP:-4096}" --fine lines \
-        --uniform "$RECORDS/white" "$RECORDS/lines" "$RECORDS/photo" "$RECORDS/gradient" 2>"$RES_DIR/print-mitsuba.log" \
+        --uniform "$RECORDS/white" $(for t in ${PRINT_TARGETS:-lines photo gradient}; do echo "$RECORDS/$t"; done) \
+        2>"$RES_DIR/print-mitsuba.log" \
         | tee -a "$RES_DIR/device-summary.txt"
     status=${PIPESTATUS[0]}
     log "print: $([ "$status" = 0 ] && echo PASS || echo "FAIL (status $status; $RES_DIR/print-mitsuba.log)")"

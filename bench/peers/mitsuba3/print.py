@@ -50,8 +50,11 @@ import mitsuba as mi
 mi.set_variant("cuda_ad_rgb")
 
 
-def delta_e(volpt, target, exr, flip=True):
-    run = subprocess.run([volpt, "print", "delta-e", str(target), str(exr)] + (["--flip-rows"] if flip else []),
+def delta_e(volpt, target, exr, flip=True, regions=False):
+    """(mean, p95, non-finite) of `exr` against `target`; with `regions`, also the line of the
+    per-region means (`volpt print delta-e --regions`)."""
+    run = subprocess.run([volpt, "print", "delta-e", str(target), str(exr)] + (["--flip-rows"] if flip else [])
+                         + (["--regions"] if regions else []),
                          capture_output=True, text=True)
     if run.returncode != 0:
         sys.exit(f"volpt print delta-e {target} {exr} failed: {run.stderr.strip()}")
@@ -59,6 +62,9 @@ def delta_e(volpt, target, exr, flip=True):
     m = re.search(r"mean ΔE00 ([0-9.]+), p95 ([0-9.]+) over (\d+) texels \((\d+) not finite", out)
     if not m:
         sys.exit(f"unexpected output of volpt print delta-e: {out}")
+    if regions:
+        r = re.search(r"^regions: (.*)$", out, re.M)
+        return float(m[1]), float(m[2]), int(m[4]), r[1] if r else "(no regions line)"
     return float(m[1]), float(m[2]), int(m[4])
 
 
@@ -83,11 +89,12 @@ def render(volpt, scene_toml, work, spp, seed):
 
 
 def measure(volpt, record, which, work, spp, seed):
-    """(mean, p95, non-finite, noise floor, seconds) of Mitsuba's image of `which` (naive, print)."""
+    """(mean, p95, non-finite, noise floor, seconds, the image) of Mitsuba's image of `which`
+    (naive, print)."""
     exr, half, seconds = render(volpt, record / f"{which}.toml", work, spp, seed)
     mean, p95, bad = delta_e(volpt, record / "target.png", exr)
     floor, _, _ = delta_e(volpt, exr, half, flip=False)
-    return mean, p95, bad, floor, seconds
+    return mean, p95, bad, floor, seconds, exr
 
 
 def main():
@@ -104,10 +111,12 @@ def main():
           "| volpt predicted naive / best (noise) | non-finite px | seconds |")
     print("|---|---|---|---|---|---|---|")
     ok = True
+    blank = None
+    regions = []
     if args.uniform:
         work = args.uniform / "mitsuba3"
         work.mkdir(exist_ok=True)
-        um, up95, ubad, ufloor, us = measure(args.volpt, args.uniform, "naive", work, args.spp, args.seed)
+        um, up95, ubad, ufloor, us, blank = measure(args.volpt, args.uniform, "naive", work, args.spp, args.seed)
         rows = list(csv.DictReader(open(args.uniform / "iterations.csv")))
         print(f"| uniform white ({args.uniform.name}, naive print) | {um:.2f} / {up95:.2f} (floor {ufloor:.2f}) | | "
               f"| {float(rows[0]['mean_delta_e']):.2f} ({float(rows[0]['noise_delta_e']):.2f}) | {ubad} | {us:.1f} |",
@@ -115,8 +124,8 @@ def main():
     for record in args.records:
         work = record / "mitsuba3"
         work.mkdir(exist_ok=True)
-        nm, np95, nbad, nfloor, ns = measure(args.volpt, record, "naive", work, args.spp, args.seed)
-        cm, cp95, cbad, cfloor, cs = measure(args.volpt, record, "print", work, args.spp, args.seed)
+        nm, np95, nbad, nfloor, ns, nexr = measure(args.volpt, record, "naive", work, args.spp, args.seed)
+        cm, cp95, cbad, cfloor, cs, cexr = measure(args.volpt, record, "print", work, args.spp, args.seed)
         rows = list(csv.DictReader(open(record / "iterations.csv")))
         means = [float(r["mean_delta_e"]) for r in rows]
         best = min(range(len(rows)), key=lambda k: means[k])
@@ -129,6 +138,17 @@ def main():
               f"| {cm:.2f} / {cp95:.2f} (floor {cfloor:.2f}) | {ratio:.2f}x {'PASS' if passed else 'FAIL'} "
               f"| {means[0]:.2f} ({noise[0]:.2f}) / {means[best]:.2f} ({noise[best]:.2f}) "
               f"| {nbad + cbad} | {ns + cs:.1f} |", flush=True)
+        if fine:
+            # Where the fine target's error is (docs/printing.md): per region of the target, and
+            # a blank print (the uniform white record's image, the target's size) against it.
+            target = record / "target.png"
+            regions.append((f"{record.name} naive", delta_e(args.volpt, target, nexr, regions=True)))
+            regions.append((f"{record.name} compensated", delta_e(args.volpt, target, cexr, regions=True)))
+            if blank is not None:
+                regions.append((f"{record.name} blank (the uniform white print)",
+                                delta_e(args.volpt, target, blank, regions=True)))
+    for name, (mean, _, _, line) in regions:
+        print(f"regions {name}: mean {mean:.2f}; {line}")
     sys.exit(0 if ok else 1)
 
 

@@ -20,6 +20,9 @@ use crate::Vec3;
 pub struct MeshBuffers {
     pub nodes: Vec<BvhNode>,
     pub triangles: Vec<MeshTriangle>,
+    /// Each triangle's vertex normals, in `triangles`' order; empty: face normals
+    /// ([`super::TriangleMesh::normals`], [`MeshBuffers::with_vertex_normals`]).
+    pub normals: Vec<super::CornerNormals>,
     /// `order[i]`: the input index of triangle `i`.
     pub order: Vec<u32>,
     pub bounds: Aabb,
@@ -42,6 +45,7 @@ impl MeshBuffers {
         super::TriangleMesh {
             nodes: &self.nodes,
             triangles: &self.triangles,
+            normals: &self.normals,
             bounds: self.bounds,
             distance,
         }
@@ -59,6 +63,41 @@ impl MeshBuffers {
         self.distances = values;
         self.distance_res = res;
         self
+    }
+
+    /// These buffers shaded with vertex normals: `corners[t]`, the normals at the corners of
+    /// input triangle `t` (as its indices list them), each normalised here in f64 and put in BVH
+    /// order. A normal that is not finite or has no length is refused: it has no direction.
+    pub fn with_vertex_normals(
+        mut self,
+        corners: &[super::CornerNormals],
+    ) -> Result<Self, BuildError> {
+        if corners.len() != self.order.len() {
+            return Err(BuildError::NormalCount {
+                normals: corners.len(),
+                triangles: self.order.len(),
+            });
+        }
+        let mut normals = Vec::with_capacity(corners.len());
+        for &input in &self.order {
+            let triangle = input as usize;
+            let mut unit = [[0.0f32; 3]; 3];
+            for (corner, (out, n)) in unit.iter_mut().zip(corners[triangle]).enumerate() {
+                let length =
+                    libm::sqrt(n.iter().map(|&c| f64::from(c) * f64::from(c)).sum::<f64>());
+                if !(length.is_finite() && length > 0.0) {
+                    return Err(BuildError::BadNormal {
+                        triangle,
+                        corner,
+                        normal: n,
+                    });
+                }
+                *out = n.map(|c| (f64::from(c) / length) as f32);
+            }
+            normals.push(unit);
+        }
+        self.normals = normals;
+        Ok(self)
     }
 }
 
@@ -108,6 +147,18 @@ pub enum BuildError {
     InsideOut {
         volume: f64,
     },
+    /// Corner `corner` of triangle `triangle` has a vertex normal `normal` that is not finite or
+    /// has no length.
+    BadNormal {
+        triangle: usize,
+        corner: usize,
+        normal: [f32; 3],
+    },
+    /// `normals` triangles' vertex normals for a mesh of `triangles` triangles.
+    NormalCount {
+        normals: usize,
+        triangles: usize,
+    },
 }
 
 impl fmt::Display for BuildError {
@@ -142,6 +193,15 @@ impl fmt::Display for BuildError {
                 "the mesh faces inwards: it encloses a signed volume of {volume:e}, expected a \
                  positive one (each triangle's vertices counter-clockwise seen from outside); \
                  reverse every triangle"
+            ),
+            Self::BadNormal { triangle, corner, normal } => write!(
+                f,
+                "the vertex normal at corner {corner} of triangle {triangle} is {normal:?}: \
+                 expected a finite, non-zero vector"
+            ),
+            Self::NormalCount { normals, triangles } => write!(
+                f,
+                "vertex normals for {normals} triangles, but the mesh has {triangles} triangles"
             ),
         }
     }
@@ -242,6 +302,7 @@ pub fn build_with(
     Ok(MeshBuffers {
         nodes,
         triangles: order.iter().map(|&i| triangles[i as usize]).collect(),
+        normals: Vec::new(),
         order,
         bounds,
         distances: Vec::new(),

@@ -25,6 +25,8 @@ pub mod distance;
 #[cfg(feature = "alloc")]
 pub mod primitives;
 
+use core::mem::MaybeUninit;
+
 use bytemuck::{Pod, Zeroable};
 
 use crate::geometry::{Aabb, BoxHit, Ray};
@@ -37,7 +39,9 @@ pub const MAX_BVH_DEPTH: usize = 64;
 
 /// A node of the BVH: its box, and either its two children (`count` 0: the first child follows
 /// the node, the second is node `first`) or its triangles (`count` > 0: `first..first + count`).
-#[repr(C)]
+///
+/// Aligned to 16 bytes, so that a GPU reads each half (box corner and index) in one load.
+#[repr(C, align(16))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct BvhNode {
     pub min: [f32; 3],
@@ -69,12 +73,19 @@ pub enum Crossing {
 
 pub use distance::SurfaceDistance;
 
+/// A triangle's unit vertex normals at its three corners, in its vertices' order.
+pub type CornerNormals = [[f32; 3]; 3];
+
 /// A closed triangle mesh, its BVH and its distance grid, borrowed from memory the caller keeps
 /// (host or device).
 #[derive(Clone, Copy, Debug)]
 pub struct TriangleMesh<'a> {
     pub nodes: &'a [BvhNode],
     pub triangles: &'a [MeshTriangle],
+    /// Each triangle's vertex normals (in `triangles`' order), which the boundary's BSDF scatters
+    /// about, interpolated ([`TriangleMesh::hit`]); empty: each triangle's own normal (Mitsuba's
+    /// `face_normals`).
+    pub normals: &'a [CornerNormals],
     pub bounds: Aabb,
     /// Lets a free flight that cannot reach the surface skip the ray cast.
     pub distance: SurfaceDistance<'a>,
@@ -92,7 +103,11 @@ impl<'a> TriangleMesh<'a> {
         let sheared = ShearedRay::new(ray);
         let mut best_t = f32::INFINITY;
         let mut best = None;
-        let mut stack = [0u32; MAX_BVH_DEPTH];
+        // The far children still to visit, each with its entry distance (bits high, node low):
+        // one popped once a nearer crossing was found is skipped, as its slab test would skip it
+        // now. Uninitialised (zeroing it would be 256 bytes of local-memory stores per cast on
+        // a GPU); only entries below `depth` are read.
+        let mut stack = [MaybeUninit::<u64>::uninit(); MAX_BVH_DEPTH];
         let mut depth = 0usize;
         let mut node = 0u32;
         loop {
@@ -100,12 +115,10 @@ impl<'a> TriangleMesh<'a> {
             let mut next = None;
             if n.count > 0 {
                 for i in n.first..n.first + n.count {
-                    if let Some(t) = intersect(&self.triangles[i as usize], ray, &sheared, crossing)
-                    {
-                        if t < best_t {
-                            best_t = t;
-                            best = Some((t, i));
-                        }
+                    let tri = &self.triangles[i as usize];
+                    if let Some(t) = intersect(tri, ray, &sheared, crossing, best_t) {
+                        best_t = t;
+                        best = Some((t, i));
                     }
                 }
             } else {
@@ -114,9 +127,14 @@ impl<'a> TriangleMesh<'a> {
                 let tb = slab(&self.nodes[b as usize], ray, inv, best_t);
                 next = match (ta, tb) {
                     (Some(ta), Some(tb)) => {
-                        let (near, far) = if ta <= tb { (a, b) } else { (b, a) };
+                        let ((near, _), (far, t_far)) = if ta <= tb {
+                            ((a, ta), (b, tb))
+                        } else {
+                            ((b, tb), (a, ta))
+                        };
                         if depth < MAX_BVH_DEPTH {
-                            stack[depth] = far;
+                            stack[depth] =
+                                MaybeUninit::new(u64::from(t_far.to_bits()) << 32 | u64::from(far));
                             depth += 1;
                         }
                         Some(near)
@@ -128,18 +146,24 @@ impl<'a> TriangleMesh<'a> {
             }
             node = match next {
                 Some(next) => next,
-                None if depth > 0 => {
+                None => loop {
+                    if depth == 0 {
+                        return best;
+                    }
                     depth -= 1;
-                    stack[depth]
-                }
-                None => return best,
+                    // SAFETY: every entry below `depth` was written by a push.
+                    let entry = unsafe { stack[depth].assume_init() };
+                    if f32::from_bits((entry >> 32) as u32) <= best_t {
+                        break entry as u32;
+                    }
+                },
             };
         }
     }
 
     /// The hit record of a crossing of triangle `i` at distance `t`: the point, snapped onto the
     /// plane of a triangle in an axis plane (as the box snaps it onto its face) and clamped into
-    /// the mesh's bounds, and the outward normal.
+    /// the mesh's bounds, the outward normal, and the shading normal ([`Self::shading_normal`]).
     #[inline]
     pub(crate) fn hit(&self, ray: &Ray, t: f32, i: u32) -> BoxHit {
         let tri = &self.triangles[i as usize];
@@ -152,10 +176,16 @@ impl<'a> TriangleMesh<'a> {
         } else if n.x == 0.0 && n.y == 0.0 {
             point.z = tri.offset * n.z;
         }
+        let point = point.max(self.bounds.min).min(self.bounds.max);
+        let shading = match self.normals.get(i as usize) {
+            Some(corners) => shading_normal(tri, corners, point),
+            None => n,
+        };
         BoxHit {
             t,
-            point: point.max(self.bounds.min).min(self.bounds.max),
+            point,
             normal: n,
+            shading,
         }
     }
 
@@ -180,8 +210,31 @@ impl<'a> TriangleMesh<'a> {
                 t: 0.0,
                 point: ray.origin,
                 normal: ray.dir,
+                shading: ray.dir,
             },
         }
+    }
+}
+
+/// Phong's interpolated normal (Phong 1975) of `tri` at `p`, a point on it: its corners' normals
+/// weighted by `p`'s barycentric coordinates (clamped to the triangle, as a point a rounding error
+/// outside it is on its edge), normalised. A normal that does not lie in the geometric normal's
+/// hemisphere (strongly bent corner normals, or degenerate ones) would put the two sides of the
+/// surface on one side: the geometric normal is used there.
+#[inline]
+pub fn shading_normal(tri: &MeshTriangle, corners: &CornerNormals, p: Vec3) -> Vec3 {
+    let n = Vec3::from(tri.normal);
+    let [a, b, c] = tri.v.map(Vec3::from);
+    let twice_area = (b - a).cross(c - a).dot(n);
+    let w0 = ((b - p).cross(c - p).dot(n) / twice_area).clamp(0.0, 1.0);
+    let w1 = ((c - p).cross(a - p).dot(n) / twice_area).clamp(0.0, 1.0);
+    let w2 = (1.0 - w0 - w1).max(0.0);
+    let [n0, n1, n2] = corners.map(Vec3::from);
+    let s = crate::math::normalize(n0 * w0 + n1 * w1 + n2 * w2);
+    if s.dot(n) > 0.0 {
+        s
+    } else {
+        n
     }
 }
 
@@ -305,40 +358,60 @@ fn edge_function(a: (f32, f32), b: (f32, f32)) -> f32 {
 }
 
 /// The distance at which `ray` crosses `tri` in the direction `crossing` asks for, if it does,
-/// at a distance >= 0 (see the module documentation).
+/// at a distance in `[0, t_max)` (see the module documentation).
+///
+/// The cheap tests come first, each deciding as the full test would: the crossing's direction is
+/// the sign of `n . d` (a triangle facing the wrong way is no crossing, whatever its edges), and
+/// the distance is the plane's alone, so a triangle behind the ray or beyond `t_max` is rejected
+/// before its vertices are read; the edge functions run for the few that remain.
 #[inline(always)]
 fn intersect(
     tri: &MeshTriangle,
     ray: &Ray,
     sheared: &ShearedRay,
     crossing: Crossing,
+    t_max: f32,
 ) -> Option<f32> {
+    let n = Vec3::from(tri.normal);
+    let cos = n.dot(ray.dir);
+    let entering = match crossing {
+        Crossing::Entering => cos < 0.0,
+        Crossing::Leaving => false,
+        Crossing::Any => cos < 0.0,
+    };
+    let leaving = match crossing {
+        Crossing::Entering => false,
+        Crossing::Leaving | Crossing::Any => cos > 0.0,
+    };
+    if !entering && !leaving {
+        return None;
+    }
+    let distance = tri.offset - n.dot(ray.origin);
+    // Entering is the box's near slab (times the reciprocal), leaving its far slab (a quotient).
+    let t = if entering {
+        distance * recip_scalar(cos)
+    } else {
+        div_scalar(distance, cos)
+    };
+    // A NaN distance (a degenerate plane) is no crossing.
+    if !(t >= 0.0 && t < t_max) {
+        return None;
+    }
     let p = tri.v.map(|v| sheared.project(v));
     let w0 = edge_function(p[1], p[2]);
     let w1 = edge_function(p[2], p[0]);
     let w2 = edge_function(p[0], p[1]);
-    let entering = w0 <= 0.0 && w1 <= 0.0 && w2 <= 0.0;
-    let leaving = w0 >= 0.0 && w1 >= 0.0 && w2 >= 0.0;
-    let n = Vec3::from(tri.normal);
-    let cos = n.dot(ray.dir);
-    let distance = tri.offset - n.dot(ray.origin);
-    // The crossing's direction decides which arithmetic: entering is the box's near slab
-    // (times the reciprocal), leaving its far slab (a quotient).
-    let t = match crossing {
-        Crossing::Entering | Crossing::Any if entering && cos < 0.0 => distance * recip_scalar(cos),
-        Crossing::Leaving | Crossing::Any if leaving && cos > 0.0 => div_scalar(distance, cos),
-        _ => return None,
-    };
-    // A NaN distance (a degenerate plane) is no crossing.
-    if t >= 0.0 {
-        Some(t)
+    let inside = if entering {
+        w0 <= 0.0 && w1 <= 0.0 && w2 <= 0.0
     } else {
-        None
-    }
+        w0 >= 0.0 && w1 >= 0.0 && w2 >= 0.0
+    };
+    inside.then_some(t)
 }
 
 impl Shape for TriangleMesh<'_> {
     const CONVEX: bool = false;
+    const SHADING_NORMALS: bool = true;
 
     type Exit<'e>
         = crate::flight::LazyExit<'e>
@@ -355,9 +428,13 @@ impl Shape for TriangleMesh<'_> {
         self.bounds
     }
 
-    /// Inside if the nearest crossing along a fixed direction leaves the mesh.
+    /// Inside if the nearest crossing along a fixed direction leaves the mesh; a point outside
+    /// the mesh's box (a camera's) is outside without a cast.
     #[inline]
     fn contains(&self, p: Vec3) -> bool {
+        if !self.bounds.contains(p) {
+            return false;
+        }
         let ray = Ray::new(p, CONTAINS_DIRECTION);
         self.contains_by(&ray, self.nearest(&ray, Crossing::Any))
     }

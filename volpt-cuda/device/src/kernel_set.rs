@@ -113,11 +113,11 @@ impl KernelSet {
     /// - Lit: an index-matched boundary (a dielectric one cannot connect to a delta light), any
     ///   medium, phase and environment.
     /// - Mesh: the grey media without an albedo grid in any layout but the dense one
-    ///   (homogeneous, the dense grids), every boundary and phase, a constant environment: the
-    ///   mesh is the boundary, so every boundary kind; the chromatic, any-layout and texture
-    ///   media and the environment map would double the set for scenes that combine them with
-    ///   a mesh, which render on the CPU ([`crate::export_set_kernels!`]'s filter is the same).
-    pub fn covers(self, [medium, boundary, _phase, environment]: [&str; 4]) -> bool {
+    ///   (homogeneous, the dense grids), every boundary, phase and environment: the mesh is the
+    ///   boundary, so every boundary kind; the chromatic, any-layout and texture media would
+    ///   double the set for scenes that combine them with a mesh, which render on the CPU
+    ///   ([`crate::export_set_kernels!`]'s filter is the same).
+    pub fn covers(self, [medium, boundary, _phase, _environment]: [&str; 4]) -> bool {
         match self {
             KernelSet::Box => true,
             KernelSet::Lit => boundary == "index_matched",
@@ -127,7 +127,7 @@ impl KernelSet {
                     "homogeneous"
                         | "grid_density__constant_albedo__dense_trilinear"
                         | "grid_density__grid_albedo__dense_trilinear"
-                ) && environment == "constant"
+                )
             }
         }
     }
@@ -157,23 +157,21 @@ macro_rules! export_set_kernels {
             @set lit LitScene ($m: $mt, index_matched: $bt, $p: $pt, $e: $et)
         } }
     };
-    (mesh, homogeneous: $mt:ty, $b:ident: $bt:ty, $p:ident: $pt:ty, constant: $et:ty) => {
+    (mesh, homogeneous: $mt:ty, $b:ident: $bt:ty, $p:ident: $pt:ty, $e:ident: $et:ty) => {
         $crate::kernel_sets! { $crate::export_set_kernels {
-            @set mesh MeshScene (homogeneous: $mt, $b: $bt, $p: $pt, constant: $et)
+            @set mesh MeshScene (homogeneous: $mt, $b: $bt, $p: $pt, $e: $et)
         } }
     };
     (mesh, grid_density__constant_albedo__dense_trilinear: $mt:ty, $b:ident: $bt:ty, $p:ident: $pt:ty,
-     constant: $et:ty) => {
+     $e:ident: $et:ty) => {
         $crate::kernel_sets! { $crate::export_set_kernels {
-            @set mesh MeshScene (grid_density__constant_albedo__dense_trilinear: $mt, $b: $bt, $p: $pt,
-                constant: $et)
+            @set mesh MeshScene (grid_density__constant_albedo__dense_trilinear: $mt, $b: $bt, $p: $pt, $e: $et)
         } }
     };
     (mesh, grid_density__grid_albedo__dense_trilinear: $mt:ty, $b:ident: $bt:ty, $p:ident: $pt:ty,
-     constant: $et:ty) => {
+     $e:ident: $et:ty) => {
         $crate::kernel_sets! { $crate::export_set_kernels {
-            @set mesh MeshScene (grid_density__grid_albedo__dense_trilinear: $mt, $b: $bt, $p: $pt,
-                constant: $et)
+            @set mesh MeshScene (grid_density__grid_albedo__dense_trilinear: $mt, $b: $bt, $p: $pt, $e: $et)
         } }
     };
     ($set:ident, $m:ident: $mt:ty, $b:ident: $bt:ty, $p:ident: $pt:ty, $e:ident: $et:ty) => {};

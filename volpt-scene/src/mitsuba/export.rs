@@ -17,8 +17,9 @@
 //!   is refused.
 //! - **Mesh boundaries** are written as a binary PLY of their world-space triangles
 //!   (`<name>-boundary.ply`, vertices shared where their positions are equal, so that volpt reads
-//!   it back as the same closed mesh) read with `face_normals`: volpt refracts at the geometric
-//!   normal, and Mitsuba would otherwise interpolate vertex normals it computes itself.
+//!   it back as the same closed mesh) read with `face_normals`, or with the mesh's vertex normals
+//!   (`nx ny nz`; a vertex shared where position and normal are equal: a mesh whose corners at
+//!   one position have different normals, a crease, reads back into volpt as open there).
 //! - **Environment maps** are written with Mitsuba 3's row convention (rows from pole to pole). A
 //!   Mitsuba 0.6 map (cell-centred rows) would move by half a row, so it is refused rather than
 //!   silently changed.
@@ -127,9 +128,13 @@ pub fn write_mitsuba3(
             let path = dir.join(&file);
             write_ply(&path, mesh)?;
             written.push(path);
+            let face_normals = if mesh.buffers.normals.is_empty() {
+                "\n        <boolean name=\"face_normals\" value=\"true\"/>"
+            } else {
+                ""
+            };
             format!(
-                "<shape type=\"ply\">\n        <string name=\"filename\" value=\"{file}\"/>\n        \
-                 <boolean name=\"face_normals\" value=\"true\"/>"
+                "<shape type=\"ply\">\n        <string name=\"filename\" value=\"{file}\"/>{face_normals}"
             )
         }
     };
@@ -204,29 +209,42 @@ pub fn write_mitsuba3(
     Ok(written)
 }
 
-/// Writes `mesh`'s triangles as a binary little-endian PLY, each position once.
+/// Writes `mesh`'s triangles as a binary little-endian PLY, each position (with its vertex
+/// normal, where the mesh has them) once.
 fn write_ply(path: &Path, mesh: &MeshDesc) -> Result<(), SceneError> {
-    let mut index: HashMap<[u32; 3], u32> = HashMap::new();
-    let mut vertices: Vec<[f32; 3]> = Vec::new();
+    let buffers = &mesh.buffers;
+    let shaded = !buffers.normals.is_empty();
+    let mut index: HashMap<[u32; 6], u32> = HashMap::new();
+    let mut vertices: Vec<[f32; 6]> = Vec::new();
     let mut faces: Vec<[u32; 3]> = Vec::with_capacity(mesh.triangle_count());
-    for t in &mesh.buffers.triangles {
-        faces.push(t.v.map(|v| {
-            *index.entry(v.map(f32::to_bits)).or_insert_with(|| {
-                vertices.push(v);
+    for (i, t) in buffers.triangles.iter().enumerate() {
+        let normals = buffers.normals.get(i).copied().unwrap_or([[0.0; 3]; 3]);
+        faces.push(core::array::from_fn(|k| {
+            let [x, y, z] = t.v[k];
+            let [nx, ny, nz] = normals[k];
+            let vertex = [x, y, z, nx, ny, nz];
+            *index.entry(vertex.map(f32::to_bits)).or_insert_with(|| {
+                vertices.push(vertex);
                 (vertices.len() - 1) as u32
             })
         }));
     }
+    let normal_properties = if shaded {
+        "property float nx\nproperty float ny\nproperty float nz\n"
+    } else {
+        ""
+    };
     let mut bytes = format!(
         "ply\nformat binary_little_endian 1.0\ncomment written by volpt: a closed mesh boundary\n\
          element vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
-         element face {}\nproperty list uchar int vertex_indices\nend_header\n",
+         {normal_properties}element face {}\nproperty list uchar int vertex_indices\nend_header\n",
         vertices.len(),
         faces.len()
     )
     .into_bytes();
+    let components = if shaded { 6 } else { 3 };
     for v in &vertices {
-        for c in v {
+        for c in &v[..components] {
             bytes.extend_from_slice(&c.to_le_bytes());
         }
     }

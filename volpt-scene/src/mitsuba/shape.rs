@@ -5,7 +5,11 @@
 //!   translates it (or rotates it by multiples of 90 degrees); under any other transform, its 12
 //!   triangles placed by it.
 //! - `obj`, `ply`: a closed triangle mesh file placed by `toWorld`; the box itself when its
-//!   vertices (after `toWorld`) are the 8 corners of an axis-aligned box.
+//!   vertices (after `toWorld`) are the 8 corners of an axis-aligned box. As in Mitsuba 3, a
+//!   dielectric surface scatters about interpolated vertex normals unless `face_normals` is
+//!   true: the file's (OBJ `vn`, PLY `nx ny nz`), or where it has none, smooth ones computed as
+//!   Mitsuba computes them ([`TriangleSoup::smooth_normals`]). An index-matched (`null`)
+//!   surface has no normals to shade with.
 //! - `sphere` (`center`, `radius`, `toWorld`): Mitsuba's sphere is analytic; volpt's is a
 //!   latitude-longitude mesh inscribed in it ([`SPHERE_RINGS`] x [`SPHERE_SEGMENTS`], 16,128
 //!   triangles), whose surface lies within 3.1e-4 radii (1 - cos(pi / 128)) inside the sphere's.
@@ -38,6 +42,13 @@ enum Geometry {
     Mesh(Arc<MeshDesc>),
 }
 
+/// A shape's geometry as read: placed, or a mesh file's triangles, placed once the surface says
+/// whether they need vertex normals.
+enum Read {
+    Placed(Geometry),
+    File(std::path::PathBuf, TriangleSoup),
+}
+
 pub(crate) fn boundary(
     el: &Element,
     ctx: &Ctx<'_>,
@@ -58,22 +69,19 @@ pub(crate) fn boundary(
         element: el.describe(),
         error: Box::new(error),
     };
-    let geometry = match kind {
+    let read = match kind {
         "cube" => match transformed_box(&to_world, [-1.0; 3], [1.0; 3]) {
-            Some(bounds) => Geometry::Box(bounds),
+            Some(bounds) => Read::Placed(Geometry::Box(bounds)),
             None => {
                 let (vertices, triangles) =
                     volpt_core::mesh::primitives::cuboid(volpt_core::Aabb::new(
                         volpt_core::Vec3::splat(-1.0),
                         volpt_core::Vec3::splat(1.0),
                     ));
-                let soup = TriangleSoup {
-                    vertices,
-                    triangles,
-                };
-                Geometry::Mesh(
+                let soup = TriangleSoup::new(vertices, triangles);
+                Read::Placed(Geometry::Mesh(
                     MeshDesc::placed(Path::new("cube"), &soup, &to_world).map_err(referenced)?,
-                )
+                ))
             }
         },
         "sphere" => {
@@ -100,14 +108,11 @@ pub(crate) fn boundary(
             }
             let (vertices, triangles) =
                 volpt_core::mesh::primitives::sphere([0.0; 3], 1.0, SPHERE_RINGS, SPHERE_SEGMENTS);
-            let soup = TriangleSoup {
-                vertices,
-                triangles,
-            };
-            Geometry::Mesh(
+            let soup = TriangleSoup::new(vertices, triangles);
+            Read::Placed(Geometry::Mesh(
                 MeshDesc::placed(Path::new("sphere"), &soup, &mul(&to_world, &local))
                     .map_err(referenced)?,
-            )
+            ))
         }
         _ => {
             let filename = p
@@ -115,7 +120,7 @@ pub(crate) fn boundary(
                 .ok_or_else(|| p.missing("<string name=\"filename\">"))?;
             let path = el.dir().join(filename.string()?);
             let soup = read_mesh(&path).map_err(referenced)?;
-            mesh_or_box(&path, &soup, &to_world).map_err(referenced)?
+            Read::File(path, soup)
         }
     };
     if let Some(arg) = p.find(&["flipNormals", "flip_normals"])? {
@@ -126,23 +131,10 @@ pub(crate) fn boundary(
             ));
         }
     }
-    // Mitsuba 3 shades an `obj` or `ply` with vertex normals unless `face_normals` is true: the
-    // file's, or where it has none, smoothed ones it computes (`Mesh::recompute_vertex_normals`).
-    // volpt refracts at each triangle's own normal (`face_normals`), a different surface.
     let face_normals = match p.find(&["faceNormals", "face_normals"])? {
         Some(arg) => arg.boolean()?,
         None => false,
     };
-    if matches!(kind, "obj" | "ply") && !face_normals {
-        tracing::warn!(
-            "{}, line {}: {}: Mitsuba 3 shades this mesh with interpolated vertex normals \
-             (face_normals is false); volpt refracts at each triangle's own normal, so the two \
-             render different surfaces: set face_normals=\"true\" for the surface volpt renders",
-            el.file.display(),
-            el.line,
-            el.describe()
-        );
-    }
     // Shading details that do not change the geometry.
     p.ignore(&[
         "maxSmoothAngle",
@@ -200,6 +192,22 @@ pub(crate) fn boundary(
     let surface = BsdfDesc::from_mitsuba(surface.target, ctx)?;
     let medium = MediumDesc::from_mitsuba(interior.target, ctx)?;
     p.finish()?;
+    let geometry = match read {
+        Read::File(path, mut soup) => {
+            if face_normals || surface == BsdfDesc::Null {
+                soup.normals.clear();
+            } else if soup.normals.is_empty() {
+                soup.normals = soup.smooth_normals();
+            }
+            if soup.normals.is_empty() {
+                mesh_or_box(&path, &soup, &to_world)
+            } else {
+                MeshDesc::placed(&path, &soup, &to_world).map(Geometry::Mesh)
+            }
+            .map_err(referenced)?
+        }
+        Read::Placed(geometry) => geometry,
+    };
     let boundary = match geometry {
         Geometry::Box(bounds) => BoundaryDesc::box_(bounds, surface),
         Geometry::Mesh(mesh) => BoundaryDesc::mesh(mesh, surface),
