@@ -34,7 +34,8 @@ python3 - <<'PY'
 import re
 s = open("scenes/cgg-logo/scene.xml").read()
 s, n = re.subn(r'<shape type="cube">\s*<transform name="to_world">\s*<scale value="0.5"/>\s*</transform>',
-              '<shape type="obj"><string name="filename" value="../mesh-cube/box.obj"/>', s)
+              '<shape type="obj"><string name="filename" value="../mesh-cube/box.obj"/>'
+              '<boolean name="face_normals" value="true"/>', s)
 assert n == 1, "cgg-logo's shape is not the cube this script expects"
 open("scenes/cgg-logo/mesh.xml", "w").write(s)
 PY
@@ -73,7 +74,9 @@ with open(sys.argv[1], "wb") as out:
     fb = f.tobytes()
     out.write(b"".join(b"\x03" + fb[12 * k:12 * k + 12] for k in range(n)))
 PY
-sed -e 's|<shape type="sphere">|<shape type="ply"><string name="filename" value="'"$W"'/sphere.ply"/>|' \
+# face_normals: the mesh kernels refract at the triangles' own normals (a dielectric obj or ply
+# without it is shaded with vertex normals, as in Mitsuba, which only the CPU renders).
+sed -e 's|<shape type="sphere">|<shape type="ply"><string name="filename" value="'"$W"'/sphere.ply"/><boolean name="face_normals" value="true"/>|' \
     -e '/<float name="radius" value="0.5"\/>/d' scenes/mesh-sphere/scene.xml >"$W/million.xml"
 
 # 1. speed
