@@ -163,7 +163,7 @@ impl<'a> TriangleMesh<'a> {
 
     /// The hit record of a crossing of triangle `i` at distance `t`: the point, snapped onto the
     /// plane of a triangle in an axis plane (as the box snaps it onto its face) and clamped into
-    /// the mesh's bounds, the outward normal, and the shading normal ([`Self::shading_normal`]).
+    /// the mesh's bounds, the outward normal, and the shading normal ([`shading_normal`]).
     #[inline]
     pub(crate) fn hit(&self, ray: &Ray, t: f32, i: u32) -> BoxHit {
         let tri = &self.triangles[i as usize];
