@@ -138,7 +138,9 @@ fn a_damaged_pack_says_so() {
 /// 2026-11-28), so that any growth still fails; a regression to remove, not a design. Only two
 /// kinds of chromatic kernel carry it: regeneration-2p-sk's two-path array holds 48 bytes more
 /// with two chromatic paths (`HeroChannel`), and multi-kernel behind a rough dielectric under a
-/// map 40. Grey kernels carry none (their path state has no spectral part), chromatic kernels
+/// map 48 (40 until the boundary's hit record gained its shading normal, `BoxHit::shading`, which
+/// the exact build keeps there beside the rest of the hit although a box never reads it). Grey
+/// kernels carry none (their path state has no spectral part), chromatic kernels
 /// that park paths none since the hero is a `u32` (a `u8` beside `r_u` cost them 8 bytes), and no
 /// chromatic kernel keeps the scene there (the spectral shadow ray's second tracking closure cost
 /// the index-matched ones up to 672).
@@ -152,7 +154,7 @@ fn known_debt(entry: &str) -> usize {
         && entry.contains("__rough_dielectric__")
         && entry.ends_with("__lat_long")
     {
-        40
+        48
     } else {
         0
     }
