@@ -139,7 +139,7 @@ fn a_damaged_pack_says_so() {
 /// kinds of chromatic kernel carry it: regeneration-2p-sk's two-path array holds 48 bytes more
 /// with two chromatic paths (`HeroChannel`), and multi-kernel behind a rough dielectric under a
 /// map 48 (40 until the boundary's hit record gained its shading normal, `BoxHit::shading`, which
-/// the exact build keeps there beside the rest of the hit although a box never reads it). Grey
+/// both builds keep there beside the rest of the hit although a box never reads it). Grey
 /// kernels carry none (their path state has no spectral part), chromatic kernels
 /// that park paths none since the hero is a `u32` (a `u8` beside `r_u` cost them 8 bytes), and no
 /// chromatic kernel keeps the scene there (the spectral shadow ray's second tracking closure cost
