@@ -148,12 +148,11 @@ fn known_debt(entry: &str) -> usize {
     if !entry.contains("__chromatic__") {
         return 0;
     }
-    if entry.starts_with("regeneration_2p_sk__") {
-        48
-    } else if entry.starts_with("multi_kernel__")
+    let two_paths = entry.starts_with("regeneration_2p_sk__");
+    let rough_under_a_map = entry.starts_with("multi_kernel__")
         && entry.contains("__rough_dielectric__")
-        && entry.ends_with("__lat_long")
-    {
+        && entry.ends_with("__lat_long");
+    if two_paths || rough_under_a_map {
         48
     } else {
         0
