@@ -80,7 +80,8 @@ python3 - <<'PY'
 import re
 s = open("scenes/cgg-logo/scene.xml").read()
 s, n = re.subn(r'<shape type="cube">\s*<transform name="to_world">\s*<scale value="0.5"/>\s*</transform>',
-              '<shape type="obj"><string name="filename" value="../mesh-cube/box.obj"/>', s)
+              '<shape type="obj"><string name="filename" value="../mesh-cube/box.obj"/>'
+              '<boolean name="face_normals" value="true"/>', s)
 assert n == 1, "cgg-logo's shape is not the cube this script expects"
 open("scenes/cgg-logo/mesh.xml", "w").write(s)
 PY
@@ -141,6 +142,7 @@ open("scenes/mesh-sphere/torus.obj", "w").write("\n".join(lines) + "\n")
 s = open("scenes/mesh-sphere/scene.xml").read()
 s, count = re.subn(r'<shape type="sphere">\s*<float name="radius" value="0.5"/>',
                    '<shape type="obj"><string name="filename" value="torus.obj"/>'
+                   '<boolean name="face_normals" value="true"/>'
                    '<transform name="to_world"><rotate x="1" angle="60"/></transform>', s)
 assert count == 1, "mesh-sphere's shape is not the sphere this script expects"
 open("scenes/mesh-sphere/torus.xml", "w").write(s)

@@ -56,7 +56,7 @@ with open(sys.argv[1], "wb") as out:
     fb = f.tobytes()
     out.write(b"".join(b"\x03" + fb[12 * k:12 * k + 12] for k in range(n)))
 PY
-sed -e 's|<shape type="sphere">|<shape type="ply"><string name="filename" value="sphere.ply"/>|' \
+sed -e 's|<shape type="sphere">|<shape type="ply"><string name="filename" value="sphere.ply"/><boolean name="face_normals" value="true"/>|' \
     -e '/<float name="radius" value="0.5"\/>/d' scenes/mesh-sphere/scene.xml >"$DIR/scene.xml"
 
 "$VOLPT" info "$DIR/scene.xml" 2>&1 | grep -E "^shape" | tee -a "$OUT/mesh_load.txt"

@@ -97,7 +97,8 @@ fn a_box_written_as_a_mesh_renders_the_box_image_bit_for_bit() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("box.obj"), split_box_obj()).unwrap();
     let cube = r#"<shape type="cube"><transform name="to_world"><scale value="0.5"/></transform>"#;
-    let obj = r#"<shape type="obj"><string name="filename" value="box.obj"/>"#;
+    // face_normals: the box's faces, not smooth normals interpolated over its corners.
+    let obj = r#"<shape type="obj"><string name="filename" value="box.obj"/><boolean name="face_normals" value="true"/>"#;
     for bsdf in [
         r#"<bsdf type="null"/>"#,
         r#"<bsdf type="dielectric"><float name="int_ior" value="1.33"/></bsdf>"#,
