@@ -47,27 +47,29 @@ impl TriangleSoup {
     /// Wüthrich 1998, "Computing vertex normals from polygonal facets", JGT 3(1)), in f64.
     /// Indices out of range and degenerate triangles add nothing (the build refuses them).
     pub fn smooth_normals(&self) -> Vec<CornerNormals> {
-        let mut sums = vec![[0.0f64; 3]; self.vertices.len()];
-        let p = |i: u32| self.vertices.get(i as usize).map(|v| v.map(f64::from));
+        use glam::DVec3;
+        let mut sums = vec![DVec3::ZERO; self.vertices.len()];
+        let p = |i: u32| {
+            self.vertices
+                .get(i as usize)
+                .map(|v| DVec3::from(v.map(f64::from)))
+        };
         for t in &self.triangles {
             let (Some(a), Some(b), Some(c)) = (p(t[0]), p(t[1]), p(t[2])) else {
                 continue;
             };
             let corners = [a, b, c];
-            let n = cross(sub3(b, a), sub3(c, a));
-            let length = dot(n, n).sqrt();
+            let n = (b - a).cross(c - a);
+            let length = n.length();
             if length.is_nan() || length <= 0.0 {
                 continue;
             }
             for k in 0..3 {
-                let e0 = sub3(corners[(k + 1) % 3], corners[k]);
-                let e1 = sub3(corners[(k + 2) % 3], corners[k]);
-                let cos = dot(e0, e1) / (dot(e0, e0) * dot(e1, e1)).sqrt();
+                let e0 = corners[(k + 1) % 3] - corners[k];
+                let e1 = corners[(k + 2) % 3] - corners[k];
+                let cos = e0.dot(e1) / (e0.length_squared() * e1.length_squared()).sqrt();
                 let angle = cos.clamp(-1.0, 1.0).acos();
-                let sum = &mut sums[t[k] as usize];
-                for axis in 0..3 {
-                    sum[axis] += n[axis] / length * angle;
-                }
+                sums[t[k] as usize] += n / length * angle;
             }
         }
         self.triangles
@@ -75,27 +77,11 @@ impl TriangleSoup {
             .map(|t| {
                 t.map(|i| {
                     sums.get(i as usize)
-                        .map_or([0.0; 3], |s| s.map(|c| c as f32))
+                        .map_or([0.0; 3], |s| s.as_vec3().to_array())
                 })
             })
             .collect()
     }
-}
-
-fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 /// What is wrong with a mesh file.
