@@ -384,6 +384,15 @@ fn an_absorber_in_a_sphere_and_a_torus_transmits_exp_minus_sigma_chord() {
     }
 }
 
+/// A furnace image's mean pixel (green channel, `spp` samples a pixel) and its z against 1, from
+/// the pixels' spread.
+fn furnace_mean_and_z(pixels: &[[f64; 3]], spp: u32) -> (f64, f64) {
+    let samples: Vec<f64> = pixels.iter().map(|p| p[1] / f64::from(spp)).collect();
+    let mean = samples.iter().sum::<f64>() / samples.len() as f64;
+    let var = samples.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (samples.len() - 1) as f64;
+    (mean, (mean - 1.0) / (var / samples.len() as f64).sqrt())
+}
+
 fn camera() -> PerspectiveCamera {
     PerspectiveCamera {
         origin: Vec3::new(0.3, 0.2, -4.0),
@@ -765,11 +774,7 @@ fn the_furnace_in_a_torus_returns_the_light_with_and_without_next_event_estimati
         let (pixels, counters) = image(&scene, SPP);
         let n = counters.paths as f64;
         assert_eq!(counters.truncated, 0);
-        let samples: Vec<f64> = pixels.iter().map(|p| p[1] / f64::from(SPP)).collect();
-        let mean = samples.iter().sum::<f64>() / samples.len() as f64;
-        let var =
-            samples.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (samples.len() - 1) as f64;
-        let z = (mean - 1.0) / (var / samples.len() as f64).sqrt();
+        let (mean, z) = furnace_mean_and_z(&pixels, SPP);
         eprintln!("{estimator:?}: mean {mean} over {n} paths, z {z:.2}");
         assert!(z.abs() < Z_MAX, "{estimator:?}: mean {mean}, z {z}");
     }
@@ -974,11 +979,7 @@ fn shading_normals_create_no_energy_in_the_white_furnace() {
         let (pixels, counters) = image(&scene, SPP);
         assert_eq!(counters.truncated, 0, "{what}");
         // The camera's rays that miss the sphere see the environment: 1 exactly.
-        let samples: Vec<f64> = pixels.iter().map(|p| p[1] / f64::from(SPP)).collect();
-        let mean = samples.iter().sum::<f64>() / samples.len() as f64;
-        let var =
-            samples.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (samples.len() - 1) as f64;
-        let z = (mean - 1.0) / (var / samples.len() as f64).sqrt();
+        let (mean, z) = furnace_mean_and_z(&pixels, SPP);
         eprintln!("{what} {estimator:?}: mean {mean}, z against 1 {z:.2}");
         assert!(
             z < Z_MAX,
